@@ -1,0 +1,60 @@
+"""The ``armtransfer`` command: one subcommand per module in ``armtransfer/commands``.
+
+Every error a user can cause is an ``ArmTransferError`` (or an argparse error) and ends as
+one line on stderr with exit code 2; anything else is a bug and keeps its traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import sys
+
+# Subcommand name -> module in armtransfer.commands. Each module has
+# ``add_arguments(parser)``, ``run(args) -> int`` and a one-line ``HELP``.
+COMMANDS = {
+    "rooms": "rooms",
+    "reproduce": "reproduce",
+    "bench": "bench",
+}
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, but a usage error is one line (the usage is in --help)."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="armtransfer", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+    for name, module_name in COMMANDS.items():
+        module = importlib.import_module(f"armtransfer.commands.{module_name}")
+        p = sub.add_parser(name, help=module.HELP, description=module.HELP)
+        module.add_arguments(p)
+        p.set_defaults(_run=module.run)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    # Offscreen rendering needs the GL backend chosen before mujoco is first imported.
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    from tasks.errors import ArmTransferError
+
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args._run(args) or 0)
+    except ArmTransferError as err:
+        print(f"armtransfer {args.command}: error: {err}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"armtransfer {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,61 @@
+"""Start/goal tasks: the paper's Table I, and tasks given by coordinates."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from tasks.errors import InvalidTaskError
+from tasks.layout import ROOMS, Layout
+
+
+@dataclass(frozen=True)
+class Task:
+    name: str
+    start: tuple[int, int]
+    goal: tuple[int, int]
+    paper_distance: int | None = None
+    """The optimal 1-cell distance Table I gives, where the task is one of the paper's."""
+
+    def cells(self, layout: Layout = ROOMS) -> tuple[int, int]:
+        """(start cell id, goal cell id); both must be free and differ."""
+        s = layout.free_cell(*self.start, what="start")
+        g = layout.free_cell(*self.goal, what="goal")
+        if s == g:
+            raise InvalidTaskError(f"start and goal are the same cell {self.start}")
+        return s, g
+
+
+TABLE_I = {
+    1: Task("task 1", (0, 0), (-8, 12), 20),
+    2: Task("task 2", (2, -2), (-12, 18), 34),
+    3: Task("task 3", (2, 6), (-6, -6), 40),
+    4: Task("task 4", (20, 18), (-22, -16), 76),
+}
+"""Table I of the paper: start in room 1; goal in room 2 (tasks 1, 2) or room 3 (3, 4)."""
+
+TABLE_I_ROOMS = {1: (1, 2), 2: (1, 2), 3: (1, 3), 4: (1, 3)}
+
+
+def table_task(number: int) -> Task:
+    if number not in TABLE_I:
+        raise InvalidTaskError(
+            f"unknown task {number}; valid tasks: {', '.join(str(k) for k in TABLE_I)}"
+        )
+    return TABLE_I[number]
+
+
+def parse_xy(text: str, what: str) -> tuple[int, int]:
+    """Parse 'X,Y' into integers, with a one-line error naming ``what``."""
+    parts = text.split(",")
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        return int(parts[0]), int(parts[1])
+    except ValueError:
+        raise InvalidTaskError(f"{what} must be two integers 'X,Y', got {text!r}") from None
+
+
+def custom_task(start: tuple[int, int], goal: tuple[int, int], layout: Layout = ROOMS) -> Task:
+    task = Task(f"({start[0]},{start[1]})->({goal[0]},{goal[1]})", start, goal)
+    task.cells(layout)  # validate now, so errors come before any work
+    return task
