@@ -29,3 +29,7 @@ __all__ = [
     "grid_robot",
     "table_task",
 ]
+
+from tasks.envs import register_envs as _register_envs
+
+_register_envs()
