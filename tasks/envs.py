@@ -23,7 +23,7 @@ from tasks.robot import DiscreteRobot
 class RobotRoomsEnv(gym.Env):
     """A start/goal task for one discrete robot, in the style of Gymnasium's toy_text."""
 
-    metadata = {"render_modes": ["ansi"]}
+    metadata = {"render_modes": ["ansi"], "render_fps": 4}
 
     def __init__(
         self,
