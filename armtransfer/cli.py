@@ -15,7 +15,6 @@ import sys
 # ``add_arguments(parser)``, ``run(args) -> int`` and a one-line ``HELP``.
 COMMANDS = {
     "rooms": "rooms",
-    "reproduce": "reproduce",
     "bench": "bench",
 }
 

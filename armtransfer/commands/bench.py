@@ -1,0 +1,67 @@
+"""armtransfer bench: learner steps per second (task 1, fine robot, no transfer)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import time
+
+import numpy as np
+
+from armtransfer.commands.common import positive_int
+from tasks.catalog import table_task
+from tasks.grid_robots import grid_robot
+from transfer import sarsa
+from transfer.config import LearnerConfig
+from transfer.io import check_writable, write_json_atomic
+
+HELP = "Measure the learner's steps per second on task 1 without transfer (median of repeats)."
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--steps", type=positive_int, default=2_000_000,
+                   help="learner steps per repeat, at least (default 2,000,000)")
+    p.add_argument("--repeats", type=positive_int, default=5, help="timed repeats (default 5)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--json", default=None, metavar="PATH", help="write the figures as JSON here")
+
+
+def measure(steps: int, seed: int) -> tuple[int, float]:
+    """Run trials of task 1 back to back until ``steps`` steps; (steps done, seconds)."""
+    robot = grid_robot("fine")
+    start, goal = table_task(1).cells()
+    s0 = robot.start_state(start)
+    config = LearnerConfig(max_total_steps=steps)
+    rng = np.random.default_rng(seed)
+    done = 0
+    t0 = time.perf_counter()
+    while done < steps:
+        cfg = LearnerConfig(max_total_steps=steps - done) if done else config
+        res = sarsa.learn(robot, s0, goal, cfg, rng)
+        done += int(np.abs(res.episode_steps).sum())
+    return done, time.perf_counter() - t0
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.json:
+        check_writable(args.json)
+    measure(10_000, args.seed)  # compile (or load the cached kernel) outside the timing
+    rates = []
+    for r in range(args.repeats):
+        done, secs = measure(args.steps, args.seed + r)
+        rates.append(done / secs)
+        print(f"repeat {r + 1}: {done:,} steps in {secs:.3f} s = {done / secs:,.0f} steps/s")
+    med = statistics.median(rates)
+    print(f"median: {med:,.0f} steps/s over {args.repeats} repeats (target >= 2,000,000)")
+    if args.json:
+        write_json_atomic(args.json, {
+            "benchmark": "learner steps per second, task 1, fine robot, no transfer",
+            "steps_per_repeat": args.steps,
+            "steps_per_second": rates,
+            "median_steps_per_second": med,
+            "machine": {"cpus": os.cpu_count(), "processor": platform.processor() or platform.machine(),
+                        "python": platform.python_version()},
+        })
+    return 0

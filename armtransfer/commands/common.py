@@ -1,0 +1,103 @@
+"""Arguments and steps shared by the experiment commands."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from tasks.catalog import Task, custom_task, parse_xy, table_task
+from tasks.errors import InvalidParameterError, InvalidTaskError
+from transfer.config import LearnerConfig
+
+
+def positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {text!r}")
+    return value
+
+
+def probability(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a probability in [0, 1], got {text!r}") from None
+    if not 0.0 <= value <= 1.0:
+        raise argparse.ArgumentTypeError(f"must be a probability in [0, 1], got {text!r}")
+    return value
+
+
+def k_value(text: str) -> float | str:
+    if text == "auto":
+        return text
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number >= 0 or 'auto', got {text!r}") from None
+    if not value >= 0:
+        raise argparse.ArgumentTypeError(f"must be a number >= 0 or 'auto', got {text!r}")
+    return value
+
+
+def add_task_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--task", type=int, default=None, help="Table I task 1-4 (default 1)")
+    p.add_argument("--start", default=None, metavar="X,Y", help="start cell (with --goal)")
+    p.add_argument("--goal", default=None, metavar="X,Y", help="goal cell (with --start)")
+
+
+def task_from_args(args: argparse.Namespace) -> Task:
+    if args.start is not None or args.goal is not None:
+        if args.task is not None:
+            raise InvalidTaskError("give either --task or --start/--goal, not both")
+        if args.start is None or args.goal is None:
+            raise InvalidTaskError("--start and --goal go together")
+        return custom_task(parse_xy(args.start, "--start"), parse_xy(args.goal, "--goal"))
+    return table_task(1 if args.task is None else args.task)
+
+
+def add_learning_arguments(p: argparse.ArgumentParser, trials: int = 10) -> None:
+    d = LearnerConfig()
+    p.add_argument("--trials", type=positive_int, default=trials, help=f"trials per method (default {trials})")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--wind", type=probability, default=0.0, help="wind probability (paper: 0.01; default 0)")
+    p.add_argument("--K", type=k_value, default="auto",
+                   help="pseudo reward scale; 'auto' = half the farming bound -step_reward/n (default)")
+    p.add_argument("--alpha", type=float, default=d.alpha, help=f"learning rate (default {d.alpha})")
+    p.add_argument("--gamma", type=float, default=d.gamma, help=f"discount (default {d.gamma})")
+    p.add_argument("--lam", type=float, default=d.lam, help=f"trace decay lambda (default {d.lam})")
+    p.add_argument("--epsilon", type=float, default=d.epsilon, help=f"exploration rate (default {d.epsilon})")
+    p.add_argument("--step-reward", type=float, default=d.step_reward, help=f"reward per step (default {d.step_reward})")
+    p.add_argument("--goal-reward", type=float, default=d.goal_reward, help=f"reward at the goal (default {d.goal_reward})")
+    p.add_argument("--max-episodes", type=positive_int, default=d.max_episodes,
+                   help=f"episodes per trial at most (default {d.max_episodes})")
+    p.add_argument("--patience", type=positive_int, default=d.patience,
+                   help=f"episodes the greedy path must stay the same to count as converged (default {d.patience})")
+
+
+def config_from_args(args: argparse.Namespace) -> LearnerConfig:
+    return LearnerConfig(
+        alpha=args.alpha,
+        gamma=args.gamma,
+        lam=args.lam,
+        epsilon=args.epsilon,
+        step_reward=args.step_reward,
+        goal_reward=args.goal_reward,
+        max_episodes=args.max_episodes,
+        patience=args.patience,
+    )
+
+
+def progress_bar(total: int, desc: str):
+    """A tqdm bar on a terminal, nothing otherwise."""
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=desc, disable=not sys.stderr.isatty(), leave=False)
+
+
+def check_methods(methods: list[str], valid: tuple[str, ...]) -> None:
+    for m in methods:
+        if m not in valid:
+            raise InvalidParameterError(f"unknown method {m!r}; valid methods: {', '.join(valid)}")

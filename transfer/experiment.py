@@ -1,0 +1,132 @@
+"""One transfer experiment: a source trajectory, a target robot, methods x trials.
+
+Every trial of every method gets its own generator from ``SeedSequence([seed, trial])``,
+so the methods meet the same random streams trial by trial (paired comparison) and the
+same seed gives the same result, bit for bit.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tasks.errors import InvalidParameterError
+from tasks.robot import DiscreteRobot
+from transfer import metrics, rewards, sarsa
+from transfer import trajectory as trajectories
+from transfer.config import LearnerConfig
+from transfer.trajectory import Trajectory
+
+BASE_METHODS = ("none", "pseudo", "first-visit", "potential", "progress")
+
+
+def trial_rng(seed: int, trial: int, stream: int = 0) -> np.random.Generator:
+    """The generator of one trial (``stream`` separates e.g. the source robot's learning)."""
+    return np.random.default_rng(np.random.SeedSequence([int(seed), int(stream), int(trial)]))
+
+
+def source_trajectory(
+    kind: str,
+    source: DiscreteRobot,
+    start_cell: int,
+    goal_cell: int,
+    config: LearnerConfig,
+    seed: int,
+) -> Trajectory:
+    """``optimal`` (breadth-first shortest path) or ``learned`` (the source robot's
+    converged greedy path after SARSA(lambda) without transfer)."""
+    if kind == "optimal":
+        return trajectories.shortest(source, start_cell, goal_cell)
+    if kind == "learned":
+        res = sarsa.learn(source, source.start_state(start_cell), goal_cell, config, trial_rng(seed, 0, stream=1))
+        if not res.converged:
+            raise InvalidParameterError(
+                f"the source robot {source.name} did not converge on a path in "
+                f"{config.max_episodes} episodes; use --trajectory optimal"
+            )
+        return trajectories.from_path(source, res.greedy_path)
+    raise InvalidParameterError(f"unknown trajectory kind {kind!r}; valid: optimal, learned, or a JSON path")
+
+
+@dataclass
+class MethodResult:
+    method: str
+    trials: list[sarsa.TrialResult] = field(default_factory=list)
+    extra: dict = field(default_factory=dict)
+
+    def column(self, name: str) -> list:
+        return [getattr(t, name) for t in self.trials]
+
+
+def run_method(
+    method: str,
+    target: DiscreteRobot,
+    start_cell: int,
+    goal_cell: int,
+    traj: Trajectory | None,
+    trials: int,
+    seed: int,
+    config: LearnerConfig,
+    wind: float = 0.0,
+    K: float | str | None = "auto",
+    macros=None,
+    on_trial: Callable[[], None] | None = None,
+) -> MethodResult:
+    """``trials`` independent trials of one method on the target robot."""
+    if trials < 1:
+        raise InvalidParameterError(f"trials must be a positive integer, got {trials}")
+    shaping = None
+    if method != "none":
+        if traj is None:
+            raise InvalidParameterError(f"method {method!r} needs a trajectory")
+        shaping = rewards.build(method, target, traj, K, config.step_reward, config.gamma)
+    start_state = target.start_state(start_cell)
+    out = MethodResult(method)
+    for trial in range(trials):
+        res = sarsa.learn(
+            target, start_state, goal_cell, config, trial_rng(seed, trial),
+            shaping=shaping, wind=wind, macros=macros,
+        )
+        out.trials.append(res)
+        if on_trial is not None:
+            on_trial()
+    if shaping is not None:
+        out.extra["K"] = shaping.K
+    return out
+
+
+def summarize(results: Sequence[MethodResult], baseline: str = "none") -> dict:
+    """The JSON ``results`` block: per method, per-trial lists, means, CIs, improvement."""
+    by_name = {r.method: r for r in results}
+    base = by_name.get(baseline)
+    base_ex = base.column("exploration_steps") if base else None
+    base_mean = metrics.mean_ci(base_ex)[0] if base else None
+    out: dict = {}
+    for r in results:
+        ex = r.column("exploration_steps")
+        mean, ci = metrics.mean_ci(ex)
+        total = r.column("total_steps")
+        greedy = r.column("greedy_steps")
+        t_mean, t_ci = metrics.mean_ci(total)
+        g_mean, g_ci = metrics.mean_ci(greedy)
+        entry = {
+            "exploration_steps": ex,
+            "mean": mean,
+            "ci95": ci,
+            "improvement_percent": None if r.method == baseline else metrics.improvement_percent(base_mean, mean),
+            "improvement_ci95": None if r.method == baseline or base is None else metrics.improvement_ci(base_ex, ex),
+            "greedy_steps": greedy,
+            "greedy_mean": g_mean,
+            "greedy_ci95": g_ci,
+            "total_steps": total,
+            "total_mean": t_mean,
+            "total_ci95": t_ci,
+            "converged": r.column("converged"),
+            "episodes": r.column("episodes"),
+            "episode_steps": [t.episode_steps.tolist() for t in r.trials],
+        }
+        entry.update(r.extra)
+        out[r.method] = entry
+    return out

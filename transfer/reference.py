@@ -1,0 +1,84 @@
+"""Algorithm 1, line by line, in plain Python with dense traces: the reference the
+compiled learner (``transfer.sarsa``) is tested against. Slow; for tests and benchmarks.
+
+It draws from the random stream exactly as ``transfer.sarsa`` documents, so with the
+same generator and ``trace_cutoff=0`` the two give bit-identical Q tables.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tasks.robot import DiscreteRobot
+from transfer.config import LearnerConfig
+from transfer.trajectory import Trajectory
+
+
+def _egreedy(q_row: np.ndarray, eps: float, rng: np.random.Generator) -> int:
+    n_actions = len(q_row)
+    if rng.random() < eps:
+        return int(rng.random() * n_actions)
+    best = q_row.max()
+    ties = [a for a in range(n_actions) if q_row[a] == best]
+    if len(ties) == 1:
+        return ties[0]
+    return ties[int(rng.random() * len(ties))]
+
+
+def pseudo_reward(robot: DiscreteRobot, traj: Trajectory | None, K: float, s2: int) -> float:
+    """r'(s') = i*K if s' is labelled s_ti, i = 1..n (the largest such i), else 0."""
+    if traj is None:
+        return 0.0
+    value = 0.0
+    for i in range(1, len(traj.cells)):
+        if robot.label[s2] == traj.cells[i]:
+            value = i * K
+    return value
+
+
+def learn(
+    robot: DiscreteRobot,
+    start_state: int,
+    goal_cell: int,
+    config: LearnerConfig,
+    rng: np.random.Generator,
+    episodes: int,
+    traj: Trajectory | None = None,
+    K: float = 0.0,
+    wind: float = 0.0,
+) -> tuple[np.ndarray, list[int]]:
+    """Run ``episodes`` episodes; returns (Q, steps per episode)."""
+    alpha, gamma = config.alpha, config.gamma
+    decay = gamma * config.lam
+    Q = np.zeros((robot.n_states, robot.n_actions))
+    steps_per_episode = []
+    for _ in range(episodes):
+        e = np.zeros_like(Q)  # Initialize e(s, a) = 0 for all s, a
+        s = start_state  # Initialize s, a
+        a = _egreedy(Q[s], config.epsilon, rng)
+        steps = 0
+        while True:  # repeat
+            # Take action a and observe next state s' and reward r
+            s2 = int(robot.next_state[s, a])
+            if wind > 0.0 and rng.random() < wind:
+                s2 = int(robot.wind_state[s2])
+            steps += 1
+            terminal = robot.label[s2] == goal_cell
+            r = config.step_reward + (config.goal_reward if terminal else 0.0)
+            # Choose a' from s' using the epsilon-greedy policy derived from Q
+            if terminal:
+                a2, q_next = 0, 0.0
+            else:
+                a2 = _egreedy(Q[s2], config.epsilon, rng)
+                q_next = Q[s2, a2]
+            # delta <- r' + r + gamma Q(s', a') - Q(s, a)  (r' = 0 off the trajectory)
+            r_prime = pseudo_reward(robot, traj, K, s2)
+            delta = (r + r_prime if traj is not None else r) + gamma * q_next - Q[s, a]
+            e[s, a] += 1.0
+            Q += alpha * delta * e  # for all (s, a)
+            e *= decay
+            s, a = s2, a2
+            if terminal:  # until s is terminal
+                break
+        steps_per_episode.append(steps)
+    return Q, steps_per_episode

@@ -1,0 +1,390 @@
+"""SARSA(lambda) with knowledge-based pseudo rewards: the paper's Algorithm 1, compiled.
+
+One call to :func:`learn` is one trial: episodes from the start state until the greedy
+path has converged (or a limit is hit). The inner loop is a numba kernel over the robot's
+plain arrays, so it runs the same on grid robots and compiled arms.
+
+Faithful to Algorithm 1:
+  * Q(s, a) = 0 and e(s, a) = 0 at the start; traces are reset at every episode start.
+  * epsilon-greedy: with probability epsilon a uniformly random action, otherwise an action
+    of largest Q with ties broken uniformly at random.
+  * delta = r + r'(s') + gamma Q(s', a') - Q(s, a), with Q(terminal, .) = 0;
+    e(s, a) += 1 (accumulating); then for every (s, a): Q += alpha delta e; e *= gamma lambda.
+  * The shaping term r' is the paper's pseudo reward i*K on reaching the i-th trajectory
+    state (``pseudo``), or one of the other methods in :mod:`transfer.rewards`.
+
+Sparse traces: only pairs with a non-zero trace are stored. A trace that decays below
+``trace_cutoff`` is dropped; with ``trace_cutoff=0`` nothing is dropped until it underflows
+to 0, and the result is bit-for-bit the dense Algorithm 1 (``transfer.reference``), as a
+test checks.
+
+The random stream, in the order it is drawn (the dense reference draws the same):
+  1. choosing an action at a state with a macro (``transfer.mapping``): one draw u,
+     the macro runs when u < 1 - epsilon;
+  2. epsilon-greedy: one draw u; if u < epsilon one more draw picks the action as
+     floor(u2 * n_actions); otherwise, when k > 1 actions tie for the largest Q, one more
+     draw picks the floor(u2 * k)-th of them in index order;
+  3. wind, only when its probability p > 0: one draw after every move, pushing when < p.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numba
+import numpy as np
+
+from tasks.robot import DiscreteRobot
+from transfer.config import LearnerConfig
+
+# Shaping modes (see transfer.rewards).
+MODE_NONE = 0
+MODE_PSEUDO = 1
+MODE_FIRST_VISIT = 2
+MODE_POTENTIAL = 3
+MODE_PROGRESS = 4
+
+
+@numba.njit(cache=True, inline="always")
+def _egreedy(Q, s, n_actions, eps, rng):
+    if rng.random() < eps:
+        return int(rng.random() * n_actions)
+    best = Q[s, 0]
+    ties = 1
+    for a in range(1, n_actions):
+        q = Q[s, a]
+        if q > best:
+            best = q
+            ties = 1
+        elif q == best:
+            ties += 1
+    if ties == 1:
+        for a in range(n_actions):
+            if Q[s, a] == best:
+                return a
+    k = int(rng.random() * ties)
+    for a in range(n_actions):
+        if Q[s, a] == best:
+            if k == 0:
+                return a
+            k -= 1
+    return n_actions - 1  # unreachable
+
+
+@numba.njit(cache=True)
+def _greedy_path(Q, next_state, label, start, goal, stamp, stamp_id, path_out):
+    """Follow argmax Q (lowest index on ties, no wind) from start. Returns the number of
+    states written to path_out, negated when the goal is not reached (a loop or a cap)."""
+    n_actions = next_state.shape[1]
+    s = start
+    n = 0
+    cap = path_out.shape[0]
+    while True:
+        path_out[n] = s
+        n += 1
+        if label[s] == goal:
+            return n
+        if stamp[s] == stamp_id or n >= cap:
+            return -n
+        stamp[s] = stamp_id
+        best = Q[s, 0]
+        ba = 0
+        for a in range(1, n_actions):
+            if Q[s, a] > best:
+                best = Q[s, a]
+                ba = a
+        s = next_state[s, ba]
+
+
+@numba.njit(cache=True)
+def _shaping(mode, s, s2, terminal, bonus, traj_index, phi, gamma, paid_stamp, episode, best):
+    """The shaping term for the move s -> s2; returns (term, new best index)."""
+    if mode == MODE_PSEUDO:
+        return bonus[s2], best
+    if mode == MODE_FIRST_VISIT:
+        i = traj_index[s2]
+        if i > 0 and paid_stamp[i] != episode:
+            paid_stamp[i] = episode
+            return bonus[s2], best
+        return 0.0, best
+    if mode == MODE_POTENTIAL:
+        phi2 = 0.0 if terminal else phi[s2]
+        return gamma * phi2 - phi[s], best
+    if mode == MODE_PROGRESS:
+        i = traj_index[s2]
+        if i > best:
+            # bonus is i*K on trajectory states: pay only the progress beyond the best so far
+            return bonus[s2] * (i - best) / i, i
+        return 0.0, best
+    return 0.0, best
+
+
+@numba.njit(cache=True)
+def _run_trial(
+    next_state,
+    wind_state,
+    label,
+    start,
+    goal,
+    mode,
+    bonus,
+    traj_index,
+    phi,
+    macro_start,
+    macro_len,
+    macro_actions,
+    alpha,
+    gamma,
+    lam,
+    eps,
+    r_step,
+    r_goal,
+    wind_p,
+    cutoff,
+    max_episodes,
+    max_total_steps,
+    max_episode_steps,
+    patience,
+    rng,
+    Q,
+    episode_steps,
+    greedy_len,
+    macro_steps_out,
+    path_buf,
+    prev_path,
+):
+    n_states, n_actions = next_state.shape
+    n_traj = traj_index.max() + 1 if traj_index.shape[0] > 0 else 1
+    paid_stamp = np.full(max(n_traj, 1), -1, np.int64)
+    stamp = np.full(n_states, -1, np.int64)
+    # sparse traces: tr_sa holds s * n_actions + a, pos maps a pair to its slot
+    cap = n_states * n_actions
+    tr_sa = np.empty(cap, np.int64)
+    tr_e = np.empty(cap, np.float64)
+    pos = np.full(cap, -1, np.int64)
+    n_tr = 0
+    decay = gamma * lam
+    total = 0
+    prev_n = 0
+    stable = 0
+    converged_episode = -1
+    episodes = 0
+    use_macros = macro_actions.shape[0] > 0
+    for ep in range(max_episodes):
+        # reset traces
+        for k in range(n_tr):
+            pos[tr_sa[k]] = -1
+        n_tr = 0
+        s = start
+        best = 0
+        m_pos = 0  # position in the running macro, m_end its end (exclusive)
+        m_end = 0
+        macro_used = 0
+        # choose the first action
+        if use_macros and macro_len[s] > 0 and rng.random() < 1.0 - eps:
+            m_pos = macro_start[s]
+            m_end = m_pos + macro_len[s]
+            a = macro_actions[m_pos]
+            m_pos += 1
+            macro_used += 1
+            in_macro = True
+        else:
+            a = _egreedy(Q, s, n_actions, eps, rng)
+            in_macro = False
+        steps = 0
+        reached = False
+        limit = max_total_steps - total
+        if ep > 0 and max_episode_steps < limit:
+            limit = max_episode_steps
+        while steps < limit:
+            s2 = next_state[s, a]
+            blocked = s2 == s
+            if wind_p > 0.0 and rng.random() < wind_p:
+                s2 = wind_state[s2]
+            steps += 1
+            terminal = label[s2] == goal
+            r = r_step
+            if terminal:
+                r += r_goal
+            if mode != MODE_NONE:
+                term, best = _shaping(
+                    mode, s, s2, terminal, bonus, traj_index, phi, gamma, paid_stamp, ep, best
+                )
+                r += term
+            if terminal:
+                q_next = 0.0
+                a2 = 0
+            else:
+                if in_macro and (blocked or m_pos >= m_end):
+                    in_macro = False
+                if in_macro:
+                    a2 = macro_actions[m_pos]
+                    m_pos += 1
+                    macro_used += 1
+                elif use_macros and macro_len[s2] > 0 and rng.random() < 1.0 - eps:
+                    m_pos = macro_start[s2]
+                    m_end = m_pos + macro_len[s2]
+                    a2 = macro_actions[m_pos]
+                    m_pos += 1
+                    macro_used += 1
+                    in_macro = True
+                else:
+                    a2 = _egreedy(Q, s2, n_actions, eps, rng)
+                q_next = Q[s2, a2]
+            sa = s * n_actions + a
+            delta = r + gamma * q_next - Q[s, a]
+            p = pos[sa]
+            if p < 0:
+                pos[sa] = n_tr
+                tr_sa[n_tr] = sa
+                tr_e[n_tr] = 1.0
+                n_tr += 1
+            else:
+                tr_e[p] += 1.0
+            k = 0
+            while k < n_tr:
+                pair = tr_sa[k]
+                e = tr_e[k]
+                Q[pair // n_actions, pair % n_actions] += alpha * delta * e
+                e *= decay
+                if e < cutoff or e == 0.0:
+                    # drop: move the last trace into this slot
+                    pos[pair] = -1
+                    n_tr -= 1
+                    if k < n_tr:
+                        tr_sa[k] = tr_sa[n_tr]
+                        tr_e[k] = tr_e[n_tr]
+                        pos[tr_sa[k]] = k
+                    continue
+                tr_e[k] = e
+                k += 1
+            if terminal:
+                reached = True
+                break
+            s = s2
+            a = a2
+        total += steps
+        episode_steps[ep] = steps if reached else -steps
+        macro_steps_out[ep] = macro_used
+        episodes = ep + 1
+        n = _greedy_path(Q, next_state, label, start, goal, stamp, ep, path_buf)
+        greedy_len[ep] = n - 1 if n > 0 else -1
+        same = n > 0 and n == prev_n
+        if same:
+            for i in range(n):
+                if path_buf[i] != prev_path[i]:
+                    same = False
+                    break
+        if same:
+            stable += 1
+        else:
+            stable = 0
+            converged_episode = ep if n > 0 else -1
+            prev_n = n
+            for i in range(abs(n)):
+                prev_path[i] = path_buf[i]
+        if n > 0 and stable >= patience:
+            break
+        if total >= max_total_steps:
+            break
+    if stable < patience:
+        converged_episode = -1
+    return episodes, converged_episode, prev_n
+
+
+@dataclass
+class TrialResult:
+    """What one trial of :func:`learn` measured."""
+
+    exploration_steps: int | None
+    """Steps of the first episode, i.e. until the goal is first reached (None: never)."""
+    converged: bool
+    total_steps: int | None
+    """Steps until the greedy path stopped changing (through its first episode)."""
+    greedy_steps: int | None
+    """Length of the converged greedy path (None when not converged)."""
+    episodes: int
+    episode_steps: np.ndarray
+    """Steps per episode (negative: the episode hit a cap before the goal)."""
+    greedy_lengths: np.ndarray
+    """Greedy path length after each episode (-1: the greedy path misses the goal)."""
+    macro_steps: np.ndarray
+    """Primitive steps taken inside mapped macros, per episode."""
+    greedy_path: list[tuple[int, int]] = field(default_factory=list)
+    """The converged greedy path as (state, action) pairs ending with (goal state, -1)."""
+    Q: np.ndarray | None = None
+
+
+def learn(
+    robot: DiscreteRobot,
+    start_state: int,
+    goal_cell: int,
+    config: LearnerConfig,
+    rng: np.random.Generator,
+    shaping=None,
+    wind: float = 0.0,
+    macros=None,
+    q_init: np.ndarray | None = None,
+    keep_q: bool = False,
+) -> TrialResult:
+    """Run one trial of SARSA(lambda) on ``robot`` from ``start_state`` to ``goal_cell``.
+
+    ``shaping`` is a :class:`transfer.rewards.Shaping` (None: no transfer); ``macros`` a
+    :class:`transfer.mapping.MacroTable` (None: no action sequence mapping). ``rng`` is the
+    only source of randomness.
+    """
+    from transfer.rewards import Shaping
+
+    n = robot.n_states
+    sh = shaping if shaping is not None else Shaping.none(n)
+    if macros is None:
+        m_start = np.zeros(n, np.int64)
+        m_len = np.zeros(n, np.int64)
+        m_actions = np.zeros(0, np.int64)
+    else:
+        m_start, m_len, m_actions = macros.arrays(robot)
+    Q = np.zeros((n, robot.n_actions)) if q_init is None else np.array(q_init, dtype=np.float64)
+    E = config.max_episodes
+    episode_steps = np.zeros(E, np.int64)
+    greedy_len = np.zeros(E, np.int64)
+    macro_steps = np.zeros(E, np.int64)
+    path_buf = np.zeros(n + 1, np.int64)
+    prev_path = np.zeros(n + 1, np.int64)
+    episodes, conv_ep, path_n = _run_trial(
+        robot.next_state, robot.wind_state, robot.label, int(start_state), int(goal_cell),
+        sh.mode, sh.bonus, sh.traj_index, sh.phi,
+        m_start, m_len, m_actions,
+        config.alpha, config.gamma, config.lam, config.epsilon,
+        config.step_reward, config.goal_reward, float(wind), config.trace_cutoff,
+        config.max_episodes, config.max_total_steps, config.max_episode_steps, config.patience,
+        rng, Q, episode_steps, greedy_len, macro_steps, path_buf, prev_path,
+    )
+    episode_steps = episode_steps[:episodes].copy()
+    first = int(episode_steps[0]) if episodes and episode_steps[0] > 0 else None
+    converged = conv_ep >= 0
+    path: list[tuple[int, int]] = []
+    if converged:
+        states = prev_path[:path_n]
+        for i in range(path_n - 1):
+            s, t = int(states[i]), int(states[i + 1])
+            a = _greedy_action(Q, s)
+            assert robot.next_state[s, a] == t
+            path.append((s, a))
+        path.append((int(states[-1]), -1))
+    return TrialResult(
+        exploration_steps=first,
+        converged=converged,
+        total_steps=int(np.abs(episode_steps[: conv_ep + 1]).sum()) if converged else None,
+        greedy_steps=path_n - 1 if converged else None,
+        episodes=int(episodes),
+        episode_steps=episode_steps,
+        greedy_lengths=greedy_len[:episodes].copy(),
+        macro_steps=macro_steps[:episodes].copy(),
+        greedy_path=path,
+        Q=Q if keep_q else None,
+    )
+
+
+def _greedy_action(Q: np.ndarray, s: int) -> int:
+    """argmax with the lowest index on ties, as the kernel's greedy path uses."""
+    return int(np.argmax(Q[s]))

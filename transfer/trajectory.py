@@ -1,0 +1,186 @@
+"""The knowledge one robot hands another: a trajectory of (cell, action index) pairs.
+
+As in the paper, a trajectory is ``{(s_t0, a_t0), ..., (s_tn, a_tn), s_tg}``: the shared
+cells the source robot visited in order, the index of the action it took in each, and the
+goal cell. The receiving robot does not know what the indices mean; it only uses the cells
+(for pseudo rewards) and the index sequence (for action sequence mapping).
+
+JSON form (``--trajectory PATH``)::
+
+    {"format": "armtransfer-trajectory/1", "source": "coarse",
+     "goal": [-8, 12],
+     "steps": [{"cell": [0, 0], "action": 0}, {"cell": [0, 2], "action": 3}, ...]}
+
+Action indices are 0-based (the paper's coarse actions 1-4 are 0-3 here).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from tasks.errors import InvalidTrajectoryError
+from tasks.layout import ROOMS, Layout
+from tasks.robot import DiscreteRobot
+
+FORMAT = "armtransfer-trajectory/1"
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    cells: tuple[int, ...]
+    """s_t0 .. s_tn: shared cell ids, the start first, the goal not included."""
+    actions: tuple[int, ...]
+    """a_t0 .. a_tn: the source robot's action index taken in each of ``cells``."""
+    goal: int
+    """s_tg, the goal cell."""
+    source: str = "unknown"
+
+    def __post_init__(self) -> None:
+        if len(self.cells) != len(self.actions):
+            raise InvalidTrajectoryError(
+                f"a trajectory needs one action per cell, got {len(self.cells)} cells "
+                f"and {len(self.actions)} actions"
+            )
+        if not self.cells:
+            raise InvalidTrajectoryError("a trajectory needs at least one (cell, action) step")
+
+    def __len__(self) -> int:
+        return len(self.cells)
+
+    @property
+    def n(self) -> int:
+        """The index n of the last trajectory state s_tn (pseudo rewards go up to n*K)."""
+        return len(self.cells) - 1
+
+    @property
+    def start(self) -> int:
+        return self.cells[0]
+
+    def xy(self, layout: Layout = ROOMS) -> list[tuple[int, int]]:
+        return [layout.xy(c) for c in self.cells]
+
+    def to_json(self, layout: Layout = ROOMS) -> dict:
+        return {
+            "format": FORMAT,
+            "source": self.source,
+            "goal": list(layout.xy(self.goal)),
+            "steps": [
+                {"cell": list(layout.xy(c)), "action": int(a)}
+                for c, a in zip(self.cells, self.actions)
+            ],
+        }
+
+    def save(self, path: str | os.PathLike, layout: Layout = ROOMS) -> None:
+        from transfer.io import write_json_atomic
+
+        write_json_atomic(path, self.to_json(layout))
+
+
+def from_path(robot: DiscreteRobot, path: list[tuple[int, int]]) -> Trajectory:
+    """Turn a robot's own path ``[(state, action), ..., (goal_state, -1)]`` into a trajectory."""
+    if len(path) < 2:
+        raise InvalidTrajectoryError("a path needs at least one move to make a trajectory")
+    cells = tuple(int(robot.label[s]) for s, _ in path[:-1])
+    actions = tuple(int(a) for _, a in path[:-1])
+    return Trajectory(cells, actions, int(robot.label[path[-1][0]]), source=robot.name)
+
+
+def shortest(robot: DiscreteRobot, start_cell: int, goal_cell: int) -> Trajectory:
+    """The source robot's breadth-first shortest path as a trajectory."""
+    path = robot.shortest_path(robot.start_state(start_cell), goal_cell)
+    if path is None:
+        raise InvalidTrajectoryError(
+            f"robot {robot.name} cannot reach the goal cell {ROOMS.xy(goal_cell)} from {ROOMS.xy(start_cell)}"
+        )
+    return from_path(robot, path)
+
+
+def via(robot: DiscreteRobot, start_cell: int, goal_cell: int, waypoints: list[int]) -> Trajectory:
+    """A longer trajectory: the source robot's shortest paths start -> waypoints... -> goal.
+
+    Used for Table IV's sub-optimal trajectories (detours, and loops when a waypoint lies
+    behind the robot)."""
+    state = robot.start_state(start_cell)
+    full: list[tuple[int, int]] = []
+    for cell in [*waypoints, goal_cell]:
+        leg = robot.shortest_path(state, cell)
+        if leg is None:
+            raise InvalidTrajectoryError(f"robot {robot.name} cannot reach waypoint {ROOMS.xy(cell)}")
+        full.extend(leg[:-1])
+        state = leg[-1][0]
+    full.append((state, -1))
+    return from_path(robot, full)
+
+
+def parse(data: object, layout: Layout = ROOMS, where: str = "trajectory") -> Trajectory:
+    """Validate and convert the JSON form; every problem is a one-line error."""
+    if not isinstance(data, dict):
+        raise InvalidTrajectoryError(f"{where}: expected a JSON object with 'steps' and 'goal'")
+    for key in ("steps", "goal"):
+        if key not in data:
+            raise InvalidTrajectoryError(f"{where}: missing key {key!r}")
+
+    def cell_of(value: object, what: str) -> int:
+        if (
+            not isinstance(value, (list, tuple))
+            or len(value) != 2
+            or not all(isinstance(v, int) and not isinstance(v, bool) for v in value)
+        ):
+            raise InvalidTrajectoryError(f"{where}: {what} must be [x, y] integers, got {value!r}")
+        x, y = value
+        if not layout.in_grid(x, y):
+            raise InvalidTrajectoryError(
+                f"{where}: {what} ({x},{y}) is off the grid [{layout.lo}, {layout.hi}]"
+            )
+        if not layout.free[layout.cell(x, y)]:
+            raise InvalidTrajectoryError(f"{where}: {what} ({x},{y}) is inside a wall")
+        return layout.cell(x, y)
+
+    steps = data["steps"]
+    if not isinstance(steps, list) or not steps:
+        raise InvalidTrajectoryError(f"{where}: 'steps' must be a non-empty list")
+    cells, actions = [], []
+    for i, step in enumerate(steps):
+        if not isinstance(step, dict) or "cell" not in step or "action" not in step:
+            raise InvalidTrajectoryError(f"{where}: step {i} must be an object with 'cell' and 'action'")
+        cells.append(cell_of(step["cell"], f"step {i} cell"))
+        a = step["action"]
+        if not isinstance(a, int) or isinstance(a, bool) or a < 0:
+            raise InvalidTrajectoryError(f"{where}: step {i} action must be an index >= 0, got {a!r}")
+        actions.append(a)
+    goal = cell_of(data["goal"], "goal")
+    source = data.get("source", "unknown")
+    return Trajectory(tuple(cells), tuple(actions), goal, source=str(source))
+
+
+def load(path: str | os.PathLike, layout: Layout = ROOMS) -> Trajectory:
+    p = Path(path)
+    try:
+        text = p.read_text()
+    except OSError as err:
+        raise InvalidTrajectoryError(f"cannot read trajectory file {str(p)!r}: {err.strerror}") from None
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as err:
+        raise InvalidTrajectoryError(
+            f"trajectory file {str(p)!r} is not valid JSON (line {err.lineno}: {err.msg})"
+        ) from None
+    return parse(data, layout, where=f"trajectory file {str(p)!r}")
+
+
+def check_task(traj: Trajectory, start_cell: int, goal_cell: int, layout: Layout = ROOMS) -> None:
+    """A transferred trajectory must be for this task: same start and goal cells."""
+    if traj.start != start_cell or traj.goal != goal_cell:
+        raise InvalidTrajectoryError(
+            f"the trajectory goes {layout.xy(traj.start)} -> {layout.xy(traj.goal)} but the task is "
+            f"{layout.xy(start_cell)} -> {layout.xy(goal_cell)}"
+        )
+
+
+def as_array(traj: Trajectory) -> np.ndarray:
+    return np.asarray(traj.cells, dtype=np.int64)
