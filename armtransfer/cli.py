@@ -38,13 +38,30 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+_XY_OPTIONS = ("--start", "--goal")
+
+
+def _join_xy_values(argv: list[str]) -> list[str]:
+    """Let ``--goal -8,12`` through: argparse would take '-8,12' for an option."""
+    out: list[str] = []
+    i = 0
+    while i < len(argv):
+        if argv[i] in _XY_OPTIONS and i + 1 < len(argv) and argv[i + 1][:1] == "-" and argv[i + 1][1:2].isdigit():
+            out.append(f"{argv[i]}={argv[i + 1]}")
+            i += 2
+        else:
+            out.append(argv[i])
+            i += 1
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     # Offscreen rendering needs the GL backend chosen before mujoco is first imported.
     os.environ.setdefault("MUJOCO_GL", "egl")
     from tasks.errors import ArmTransferError
 
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(_join_xy_values(sys.argv[1:] if argv is None else list(argv)))
     try:
         return int(args._run(args) or 0)
     except ArmTransferError as err:

@@ -1,0 +1,129 @@
+"""The armtransfer command: smoke runs in a fast mode, JSON schema, determinism, bad input."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from armtransfer.cli import main
+
+
+def run_cli(*args):
+    """Run the command in a fresh interpreter, as a user would."""
+    return subprocess.run(
+        [sys.executable, "-m", "armtransfer.cli", *args], capture_output=True, text=True, timeout=300
+    )
+
+
+def test_rooms_writes_the_documented_json(tmp_path, capsys):
+    out = tmp_path / "r.json"
+    assert main(["rooms", "--task", "1", "--trials", "2", "--method", "none", "pseudo", "--json", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "pseudo" in printed and "exploration steps" in printed
+    data = json.loads(out.read_text())
+    assert data["distance"] == 20
+    for method in ("none", "pseudo"):
+        r = data["results"][method]
+        assert len(r["exploration_steps"]) == 2 and all(x > 0 for x in r["exploration_steps"])
+        assert r["mean"] == pytest.approx(sum(r["exploration_steps"]) / 2)
+        assert r["ci95"][0] <= r["mean"] <= r["ci95"][1]
+        assert len(r["greedy_steps"]) == 2
+    assert data["results"]["none"]["improvement_percent"] is None
+    assert isinstance(data["results"]["pseudo"]["improvement_percent"], float)
+
+
+def test_same_seed_gives_the_same_json_bit_for_bit(tmp_path):
+    paths = [tmp_path / "a.json", tmp_path / "b.json"]
+    for p in paths:
+        assert main(["rooms", "--task", "2", "--trials", "2", "--seed", "7", "--wind", "0.01", "--json", str(p)]) == 0
+    assert paths[0].read_bytes() == paths[1].read_bytes()
+
+
+def test_trajectory_file_round_trip_and_custom_task(tmp_path):
+    from tasks.grid_robots import grid_robot
+    from tasks.layout import ROOMS
+    from transfer import trajectory
+
+    traj = trajectory.shortest(grid_robot("coarse"), ROOMS.cell(0, 0), ROOMS.cell(6, 10))
+    path = tmp_path / "t.json"
+    traj.save(path)
+    assert trajectory.load(path) == trajectory.Trajectory(traj.cells, traj.actions, traj.goal, "coarse")
+    out = tmp_path / "r.json"
+    assert main(["rooms", "--trajectory", str(path), "--trials", "1", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert data["task"]["goal"] == [6, 10] and data["trajectory_length"] == len(traj)
+
+
+BAD = [
+    (["rooms", "--start", "-3,0", "--goal", "0,0"], "inside a wall"),
+    (["rooms", "--start", "0,0", "--goal", "40,0"], "off the grid"),
+    (["rooms", "--start", "0,0", "--goal", "0,0"], "same cell"),
+    (["rooms", "--start", "0,0"], "--start and --goal go together"),
+    (["rooms", "--start", "a,b", "--goal", "0,0"], "two integers"),
+    (["rooms", "--task", "9"], "unknown task 9"),
+    (["rooms", "--target", "medium"], "unknown robot 'medium'"),
+    (["rooms", "--method", "magic"], "unknown method 'magic'"),
+    (["rooms", "--trials", "0"], "positive integer"),
+    (["rooms", "--trials", "-3"], "positive integer"),
+    (["rooms", "--K", "5"], "can be farmed"),
+    (["rooms", "--wind", "2"], "probability"),
+    (["rooms", "--epsilon", "3"], "epsilon must be in"),
+    (["nonsense"], "invalid choice"),
+]
+
+
+@pytest.mark.parametrize("args,message", BAD, ids=[" ".join(a) for a, _ in BAD])
+def test_bad_input_is_one_line_and_exit_code_2(args, message, capsys):
+    with pytest.raises(SystemExit) as exc:
+        code = main(args)
+        raise SystemExit(code)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert message in err
+    assert len(err.strip().splitlines()) == 1, err
+    assert "Traceback" not in err
+
+
+def test_bad_trajectory_files(tmp_path, capsys):
+    cases = {
+        "missing.json": None,
+        "notjson.json": "{not json",
+        "nosteps.json": json.dumps({"goal": [0, 0]}),
+        "offgrid.json": json.dumps({"goal": [-8, 12], "steps": [{"cell": [0, 0], "action": 0}, {"cell": [99, 0], "action": 1}]}),
+        "wall.json": json.dumps({"goal": [-8, 12], "steps": [{"cell": [-3, 0], "action": 0}]}),
+        "badaction.json": json.dumps({"goal": [-8, 12], "steps": [{"cell": [0, 0], "action": "up"}]}),
+        "othertask.json": json.dumps({"goal": [4, 4], "steps": [{"cell": [0, 0], "action": 0}]}),
+    }
+    expect = {
+        "missing.json": "cannot read",
+        "notjson.json": "not valid JSON",
+        "nosteps.json": "missing key 'steps'",
+        "offgrid.json": "off the grid",
+        "wall.json": "inside a wall",
+        "badaction.json": "action must be an index",
+        "othertask.json": "but the task is",
+    }
+    for name, text in cases.items():
+        path = tmp_path / name
+        if text is not None:
+            path.write_text(text)
+        code = main(["rooms", "--task", "1", "--trials", "1", "--trajectory", str(path)])
+        err = capsys.readouterr().err
+        assert code == 2, name
+        assert expect[name] in err and len(err.strip().splitlines()) == 1, (name, err)
+
+
+def test_unwritable_json_path_fails_before_any_work(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    code = main(["rooms", "--trials", "1", "--json", str(blocker / "out.json")])
+    assert code == 2
+    assert "cannot write" in capsys.readouterr().err
+
+
+def test_console_script_runs_in_a_fresh_interpreter():
+    proc = run_cli("rooms", "--task", "1", "--trials", "1", "--method", "none")
+    assert proc.returncode == 0, proc.stderr
+    proc = run_cli("rooms", "--task", "7")
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
