@@ -15,6 +15,7 @@ import sys
 # ``add_arguments(parser)``, ``run(args) -> int`` and a one-line ``HELP``.
 COMMANDS = {
     "rooms": "rooms",
+    "reproduce": "reproduce",
     "bench": "bench",
 }
 

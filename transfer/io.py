@@ -10,12 +10,26 @@ from pathlib import Path
 from tasks.errors import ArmTransferError
 
 
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+_UMASK = _umask()
+
+
 class OutputError(ArmTransferError):
     """An output path cannot be written."""
 
 
 def write_text_atomic(path: str | os.PathLike, text: str) -> None:
     """Write ``text`` to a temporary file beside ``path``, then rename it into place."""
+    write_bytes_atomic(path, text.encode())
+
+
+def write_bytes_atomic(path: str | os.PathLike, data: bytes) -> None:
+    """Write ``data`` to a temporary file beside ``path``, then rename it into place."""
     p = Path(path)
     try:
         p.parent.mkdir(parents=True, exist_ok=True)
@@ -23,10 +37,11 @@ def write_text_atomic(path: str | os.PathLike, text: str) -> None:
     except OSError as err:
         raise OutputError(f"cannot write {str(p)!r}: {err.strerror}") from None
     try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())
+        os.chmod(tmp, 0o666 & ~_UMASK)
         os.replace(tmp, p)
     except OSError as err:
         Path(tmp).unlink(missing_ok=True)

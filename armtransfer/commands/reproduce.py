@@ -1,0 +1,56 @@
+"""armtransfer reproduce: the paper's Tables II, IV, V and Fig. 4-6 on our rooms world."""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+from armtransfer.commands import common
+from transfer import figures
+from transfer import reproduce as rep
+from transfer.config import LearnerConfig
+from transfer.io import check_writable, write_json_atomic, write_text_atomic
+
+HELP = "Reproduce the paper's tables and figures on the rooms world; writes report.md."
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--out", default="runs/reproduce", help="output directory (default runs/reproduce)")
+    p.add_argument("--trials", type=common.positive_int, default=30,
+                   help="trials per table cell (default 30; the paper used 10)")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+
+
+def _bars(res: dict, key: str) -> dict:
+    groups = sorted(res)
+    series = {}
+    for method, label in (("none", "no transfer"), ("pseudo", "transfer")):
+        series[label] = (
+            [res[t]["results"][method]["mean"] for t in groups],
+            [res[t]["results"][method]["ci95"] for t in groups],
+        )
+    return series
+
+
+def run(args: argparse.Namespace) -> int:
+    out = Path(args.out)
+    check_writable(out / "report.md")
+    config = LearnerConfig()
+    t0 = time.perf_counter()
+    with common.progress_bar(rep.plan(args.trials), "reproduce") as bar:
+        res = rep.run_all(args.trials, args.seed, config, tick=bar.update)
+    groups = [f"task {t}" for t in rep.TASKS]
+    names = {"fig4": "fig4_coarse_to_fine.png", "fig5": "fig5_fine_to_coarse.png", "fig6": "fig6_wind.png"}
+    figures.bar_chart(groups, _bars(res["table_ii"], "table_ii"),
+                      "Fig. 4 analog: coarse -> fine", "exploration steps to the goal", out / names["fig4"])
+    figures.bar_chart(groups, _bars(res["table_v"], "table_v"),
+                      "Fig. 5 analog: fine -> coarse", "exploration steps to the goal", out / names["fig5"])
+    figures.bar_chart(groups, _bars(res["wind"], "wind"),
+                      "Fig. 6 analog: coarse -> fine, wind 0.01", "exploration steps to the goal", out / names["fig6"])
+    write_json_atomic(out / "results.json", res)
+    # report.md last: its presence means everything else was written
+    write_text_atomic(out / "report.md", rep.report_markdown(res, names))
+    print(f"wrote {out / 'report.md'} ({time.perf_counter() - t0:.0f} s)")
+    print(rep.table_ii_markdown(res["table_ii"], rep.paper.TABLE_II, "Table II A-C: coarse -> fine"))
+    return 0
