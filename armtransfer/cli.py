@@ -17,6 +17,8 @@ COMMANDS = {
     "rooms": "rooms",
     "reproduce": "reproduce",
     "bench": "bench",
+    "sweep": "sweep",
+    "summarize": "summarize",
 }
 
 

@@ -1,0 +1,35 @@
+"""armtransfer summarize: per-group tables (mean, 95% CI, improvement) and plots of a sweep."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from transfer.io import write_json_atomic, write_text_atomic
+from transfer.store import ResultStore
+from transfer.summary import plot, summarize, summary_markdown
+
+HELP = "Summarize a sweep directory: summary.md, summary.json and summary.png."
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("dir", metavar="DIR", help="a directory written by `armtransfer sweep`")
+
+
+def run(args: argparse.Namespace) -> int:
+    store = ResultStore.open_existing(args.dir)
+    records = store.records()
+    rows = summarize(records)
+    failures = store.failures()
+    text = summary_markdown(rows) if rows else "(no finished runs yet)"
+    out = Path(args.dir)
+    write_json_atomic(out / "summary.json", {"sweep": store.meta["name"], "runs": len(records),
+                                            "failed": len(failures), "rows": rows})
+    if rows:
+        plot(rows, out / "summary.png")
+    write_text_atomic(out / "summary.md", f"# Sweep {store.meta['name']!r}\n\n{len(records)} finished runs, "
+                      f"{len(failures)} failed.\n\n{text}\n")
+    print(text)
+    if failures:
+        print(f"{len(failures)} runs failed; see {out / 'failed'}")
+    return 0

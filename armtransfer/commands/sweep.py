@@ -1,0 +1,59 @@
+"""armtransfer sweep: run a TOML grid of experiments into a store that resumes and loses nothing."""
+
+from __future__ import annotations
+
+import argparse
+import os
+
+from armtransfer.commands import common
+from armtransfer.execute import robot_specs
+from armtransfer.executors import run_local, run_ray
+from armtransfer.robots import resolve
+from transfer import sweep as sweeps
+from transfer.store import ResultStore
+
+HELP = "Run a sweep file (TOML) into --out; re-running resumes, skipping finished runs."
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("sweep_file", metavar="SWEEP.toml", help="the sweep (see scripts/sweeps/)")
+    p.add_argument("--out", required=True, help="result store directory")
+    p.add_argument("--executor", choices=["local", "ray"], default="local",
+                   help="local process pool (default) or Ray")
+    p.add_argument("--workers", type=common.positive_int, default=None,
+                   help="worker processes (default: all cores)")
+    p.add_argument("--address", default=None, help="Ray cluster address (default: start a local instance)")
+    p.add_argument("--retries", type=int, default=2, help="retries of a run whose worker died (default 2)")
+
+
+def run(args: argparse.Namespace) -> int:
+    sweep = sweeps.load(args.sweep_file)
+    store = ResultStore.open_for(args.out, sweep)
+    todo = [r for r in sweep.runs if not store.is_done(r["key"])]
+    print(f"sweep {sweep.name!r}: {len(sweep.runs)} runs, {len(sweep.runs) - len(todo)} already done, "
+          f"{len(todo)} to run ({args.executor})")
+    if not todo:
+        return 0
+    # every robot is built once here (arms come from the on-disk cache) and shared with workers
+    robots = {spec: resolve(spec) for spec in robot_specs(todo)}
+    failed: list[str] = []
+    with common.progress_bar(len(todo), "sweep") as bar:
+        def on_done(run, result, secs):
+            store.write_run(run, result, secs)
+            bar.update()
+
+        def on_failed(run, error, attempts):
+            store.write_failure(run, error, attempts)
+            failed.append(f"{run['key']}: {error}")
+            bar.update()
+
+        workers = args.workers or os.cpu_count() or 1
+        if args.executor == "ray":
+            run_ray(todo, robots, args.workers, args.address, on_done, on_failed, retries=args.retries)
+        else:
+            run_local(todo, robots, workers, on_done, on_failed, retries=args.retries)
+    done = len(store.records())
+    print(f"{done}/{len(sweep.runs)} runs in {args.out}; {len(failed)} failed")
+    for line in failed[:10]:
+        print(f"  failed {line}")
+    return 1 if failed else 0

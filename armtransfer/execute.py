@@ -1,0 +1,57 @@
+"""Run one sweep run: build its task, trajectory and learner, return a JSON-able result.
+
+Robots come in already built (``robots`` maps a spec like ``"fine"`` or
+``"planar2:joint"`` to a ``DiscreteRobot``), so an executor can build each robot once
+and share it with every worker.
+"""
+
+from __future__ import annotations
+
+import time
+
+from tasks.catalog import custom_task
+from tasks.robot import DiscreteRobot
+from transfer import experiment
+from transfer.config import LearnerConfig
+
+
+def learner_config(run: dict) -> LearnerConfig:
+    return LearnerConfig(
+        alpha=run["alpha"], gamma=run["gamma"], lam=run["lam"], epsilon=run["epsilon"],
+        patience=run["patience"], max_episodes=run["max_episodes"],
+    )
+
+
+def robot_specs(runs: list[dict]) -> list[str]:
+    """The distinct robots a list of runs needs, in first-seen order."""
+    seen: dict[str, None] = {}
+    for run in runs:
+        seen.setdefault(run["source"], None)
+        seen.setdefault(run["target"], None)
+    return list(seen)
+
+
+def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
+    """(result, seconds) of one run."""
+    t0 = time.perf_counter()
+    task = custom_task(tuple(run["start"]), tuple(run["goal"]))
+    start, goal = task.cells()
+    source, target = robots[run["source"]], robots[run["target"]]
+    config = learner_config(run)
+    traj = None
+    if run["method"] != "none":
+        traj = experiment.source_trajectory(run["trajectory"], source, start, goal, config, run["seed"])
+    res = experiment.run_method(
+        run["method"], target, start, goal, traj, run["trials"], run["seed"], config,
+        wind=run["wind"], K=run["K"],
+    )
+    result = {
+        "exploration_steps": res.column("exploration_steps"),
+        "total_steps": res.column("total_steps"),
+        "greedy_steps": res.column("greedy_steps"),
+        "converged": res.column("converged"),
+        "episodes": res.column("episodes"),
+        "K": res.extra.get("K"),
+        "trajectory_length": None if traj is None else len(traj),
+    }
+    return result, time.perf_counter() - t0

@@ -1,0 +1,140 @@
+"""Where sweep runs execute: a local process pool, or Ray (a cluster or a local instance).
+
+Both executors hand finished runs back to the driver, which alone writes the store, so
+a run is recorded exactly once. A run whose worker crashes (or is killed) is retried up to
+``retries`` more times, then recorded as failed; it is never lost silently.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+from collections.abc import Callable
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+
+from armtransfer.execute import execute
+from tasks.errors import ArmTransferError
+from tasks.robot import DiscreteRobot
+
+Done = Callable[[dict, dict, float], None]  # (run, result, seconds)
+Failed = Callable[[dict, str, int], None]  # (run, error, attempts)
+
+
+class ExecutorError(ArmTransferError):
+    """An executor cannot start (e.g. Ray is not installed or unreachable)."""
+
+
+def _worker_init() -> None:
+    # one thread per worker process: the workers are the parallelism
+    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
+        os.environ.setdefault(var, "1")
+
+
+def run_local(
+    runs: list[dict], robots: dict[str, DiscreteRobot], workers: int, on_done: Done, on_failed: Failed,
+    retries: int = 2, fn: Callable = execute,
+) -> None:
+    """A process pool over this machine's cores; a broken pool is rebuilt and its runs retried.
+
+    ``fn(run, robots) -> (result, seconds)`` is what a worker runs (tests inject faults here)."""
+    attempts = {r["key"]: 0 for r in runs}
+    pending = list(runs)
+    ctx = multiprocessing.get_context("spawn")
+    while pending:
+        needed = {r["source"] for r in pending} | {r["target"] for r in pending}
+        subset = {k: v for k, v in robots.items() if k in needed}
+        broken = False
+        with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init) as pool:
+            futures = {pool.submit(fn, run, subset): run for run in pending}
+            pending = []
+            not_done = set(futures)
+            while not_done:
+                finished, not_done = wait(not_done, return_when=FIRST_COMPLETED)
+                for fut in finished:
+                    run = futures[fut]
+                    try:
+                        result, secs = fut.result()
+                    except BrokenProcessPool:
+                        broken = True
+                        attempts[run["key"]] += 1
+                        if attempts[run["key"]] > retries:
+                            on_failed(run, "worker process died", attempts[run["key"]])
+                        else:
+                            pending.append(run)
+                        continue
+                    except ArmTransferError as err:
+                        on_failed(run, str(err), attempts[run["key"]] + 1)
+                        continue
+                    except Exception as err:  # noqa: BLE001 - recorded, not lost
+                        on_failed(run, f"{type(err).__name__}: {err}", attempts[run["key"]] + 1)
+                        continue
+                    on_done(run, result, secs)
+        if broken:
+            pending.sort(key=lambda r: r["key"])
+
+
+def _import_ray():
+    try:
+        import ray
+    except ImportError:
+        raise ExecutorError(
+            "--executor ray needs Ray: pip install -e \".[cluster]\" (or pip install ray)"
+        ) from None
+    return ray
+
+
+def run_ray(
+    runs: list[dict], robots: dict[str, DiscreteRobot], workers: int | None, address: str | None,
+    on_done: Done, on_failed: Failed, retries: int = 2,
+) -> None:
+    """Ray tasks on the cluster at ``address``, or on a local instance with ``workers`` CPUs.
+
+    Each robot is put in Ray's object store once and shared by every task that needs it."""
+    ray = _import_ray()
+    started_here = False
+    if not ray.is_initialized():
+        try:
+            if address:
+                ray.init(address=address, log_to_driver=False, configure_logging=False)
+            else:
+                ray.init(num_cpus=workers or os.cpu_count(), include_dashboard=False,
+                         log_to_driver=False, configure_logging=False)
+        except Exception as err:  # noqa: BLE001 - one line for the user
+            raise ExecutorError(f"cannot start or reach Ray ({address or 'local'}): {err}".splitlines()[0]) from None
+        started_here = True
+    try:
+        remote_execute = ray.remote(max_retries=retries, retry_exceptions=False)(execute)
+        refs = {spec: ray.put(robot) for spec, robot in robots.items()}
+        futures = {}
+        for run in runs:
+            needed = {run["source"]: refs[run["source"]], run["target"]: refs[run["target"]]}
+            futures[remote_execute.remote(run, _RobotRefs(needed))] = run
+        not_done = list(futures)
+        while not_done:
+            finished, not_done = ray.wait(not_done, num_returns=1)
+            for ref in finished:
+                run = futures[ref]
+                try:
+                    result, secs = ray.get(ref)
+                except Exception as err:  # noqa: BLE001 - recorded, not lost
+                    cause = getattr(err, "cause", None) or err
+                    on_failed(run, f"{type(cause).__name__}: {cause}".splitlines()[0], retries + 1)
+                    continue
+                on_done(run, result, secs)
+    finally:
+        if started_here:
+            ray.shutdown()
+
+
+class _RobotRefs(dict):
+    """A dict of robot ObjectRefs that a Ray worker resolves on first access."""
+
+    def __getitem__(self, key):
+        value = super().__getitem__(key)
+        if not isinstance(value, DiscreteRobot):
+            import ray
+
+            value = ray.get(value)
+            super().__setitem__(key, value)
+        return value

@@ -1,0 +1,131 @@
+"""A result store that loses nothing: one JSON file per finished run, written atomically.
+
+    DIR/sweep.json          the sweep this directory belongs to (its normalised spec and key)
+    DIR/runs/<key>.json     one finished run: its full configuration and its result
+    DIR/failed/<key>.json   a run that failed every attempt, with the error
+
+A run file appears only by ``os.replace`` of a complete temporary file, so after a crash
+(even ``kill -9``) every run file present is whole, and a run without one is simply not
+done. Temporary files a crash leaves behind start with '.' and are removed on open.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+from tasks.errors import ArmTransferError
+from transfer.io import OutputError, write_json_atomic
+from transfer.sweep import Sweep
+
+STORE_FORMAT = "armtransfer-store/1"
+
+
+class StoreError(ArmTransferError):
+    """The output directory cannot hold this sweep."""
+
+
+class ResultStore:
+    def __init__(self, root: str | os.PathLike) -> None:
+        self.root = Path(root)
+        self.runs_dir = self.root / "runs"
+        self.failed_dir = self.root / "failed"
+
+    # -- opening -----------------------------------------------------------------------
+    @classmethod
+    def open_for(cls, root: str | os.PathLike, sweep: Sweep) -> "ResultStore":
+        """Open ``root`` for ``sweep``: create it, or resume it if it holds the same sweep."""
+        store = cls(root)
+        meta_path = store.root / "sweep.json"
+        if store.root.exists() and not store.root.is_dir():
+            raise StoreError(f"output {str(store.root)!r} exists and is not a directory")
+        if meta_path.exists():
+            meta = store._read_meta()
+            if meta.get("key") != sweep.key:
+                raise StoreError(
+                    f"output directory {str(store.root)!r} holds another sweep "
+                    f"({meta.get('name')!r}); choose a new --out"
+                )
+        else:
+            if store.root.exists() and any(p.name != ".lock" for p in store.root.iterdir()):
+                raise StoreError(
+                    f"output directory {str(store.root)!r} is not empty and holds no sweep; choose a new --out"
+                )
+            write_json_atomic(meta_path, {"format": STORE_FORMAT, "name": sweep.name, "key": sweep.key,
+                                          "spec": sweep.spec})
+        for d in (store.runs_dir, store.failed_dir):
+            try:
+                d.mkdir(parents=True, exist_ok=True)
+            except OSError as err:
+                raise OutputError(f"cannot write {str(d)!r}: {err.strerror}") from None
+            for tmp in d.glob(".*.tmp"):
+                tmp.unlink(missing_ok=True)
+        return store
+
+    @classmethod
+    def open_existing(cls, root: str | os.PathLike) -> "ResultStore":
+        store = cls(root)
+        if not (store.root / "sweep.json").is_file():
+            raise StoreError(f"{str(store.root)!r} holds no sweep (no sweep.json)")
+        store._read_meta()
+        return store
+
+    def _read_meta(self) -> dict:
+        path = self.root / "sweep.json"
+        try:
+            meta = json.loads(path.read_text())
+        except (OSError, json.JSONDecodeError):
+            raise StoreError(f"{str(path)!r} is unreadable; this is not a sweep directory") from None
+        if not isinstance(meta, dict) or meta.get("format") != STORE_FORMAT:
+            raise StoreError(f"{str(path)!r} is not an armtransfer sweep")
+        return meta
+
+    @property
+    def meta(self) -> dict:
+        return self._read_meta()
+
+    # -- runs --------------------------------------------------------------------------
+    def run_path(self, key: str) -> Path:
+        return self.runs_dir / f"{key}.json"
+
+    def load_run(self, key: str) -> dict | None:
+        """A finished run, or None when it is absent or not whole (then it is redone)."""
+        try:
+            record = json.loads(self.run_path(key).read_text())
+        except (OSError, json.JSONDecodeError):
+            return None
+        if not isinstance(record, dict) or record.get("key") != key or "result" not in record:
+            return None
+        return record
+
+    def is_done(self, key: str) -> bool:
+        return self.load_run(key) is not None
+
+    def write_run(self, run: dict, result: dict, elapsed: float) -> None:
+        key = run["key"]
+        write_json_atomic(self.run_path(key), {"key": key, "config": run, "result": result,
+                                               "elapsed_seconds": round(elapsed, 3)})
+        (self.failed_dir / f"{key}.json").unlink(missing_ok=True)
+
+    def write_failure(self, run: dict, error: str, attempts: int) -> None:
+        write_json_atomic(self.failed_dir / f"{run['key']}.json",
+                          {"key": run["key"], "config": run, "error": error, "attempts": attempts})
+
+    def records(self) -> list[dict]:
+        """Every finished run, sorted by key (so summaries do not depend on finishing order)."""
+        out = []
+        for path in sorted(self.runs_dir.glob("*.json")):
+            rec = self.load_run(path.stem)
+            if rec is not None:
+                out.append(rec)
+        return out
+
+    def failures(self) -> list[dict]:
+        out = []
+        for path in sorted(self.failed_dir.glob("*.json")):
+            try:
+                out.append(json.loads(path.read_text()))
+            except (OSError, json.JSONDecodeError):
+                continue
+        return out

@@ -1,0 +1,203 @@
+"""Sweep files: a TOML grid of (task x robot pair x method x seed x parameter) runs.
+
+A sweep file has one table, ``[sweep]``; every key but ``name``, ``trials`` and
+``trajectory`` takes a value or a list of values, and the sweep is their product::
+
+    [sweep]
+    name = "table-ii"
+    tasks = [1, 2, 3, 4]                 # Table I tasks, and/or
+    start_goal = [["0,0", "-20,-20"]]    # explicit (start, goal) cells
+    pairs = [["coarse", "fine"]]         # (source, target) robots; arms as "ARM:ACTIONS"
+    methods = ["none", "pseudo"]
+    seeds = [0, 1, 2]
+    trials = 10                          # trials per run
+    trajectory = "optimal"               # or "learned"
+    K = ["auto"]
+    epsilon = [0.1]
+    lam = [0.9]
+    alpha = [0.1]
+    gamma = [0.99]
+    wind = [0.0, 0.01]
+
+One *run* is one combination: ``trials`` trials of one method, seeded by its seed. Its
+content key is a hash of its full, normalised configuration, so the same run is never done
+twice (``none`` ignores K, so its runs are shared by every K).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import os
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+from tasks.catalog import TABLE_I, parse_xy
+from tasks.errors import ArmTransferError
+from transfer.config import LearnerConfig
+
+RUN_FORMAT = "armtransfer-run/1"
+METHODS = ("none", "pseudo", "first-visit", "potential", "progress")
+
+# key -> (default, is a list axis)
+_AXES = {
+    "tasks": [],
+    "start_goal": [],
+    "pairs": [["coarse", "fine"]],
+    "methods": ["none", "pseudo"],
+    "seeds": [0],
+    "K": ["auto"],
+    "epsilon": [LearnerConfig.epsilon],
+    "lam": [LearnerConfig.lam],
+    "alpha": [LearnerConfig.alpha],
+    "gamma": [LearnerConfig.gamma],
+    "wind": [0.0],
+}
+_SCALARS = {"name": "sweep", "trials": 10, "trajectory": "optimal", "patience": LearnerConfig.patience,
+            "max_episodes": LearnerConfig.max_episodes}
+
+
+class SweepFileError(ArmTransferError):
+    """A sweep file is unreadable, malformed, or names an unknown key or value."""
+
+
+@dataclass(frozen=True)
+class Sweep:
+    name: str
+    spec: dict
+    """The normalised sweep (every key present, lists everywhere)."""
+    runs: tuple[dict, ...]
+
+    @property
+    def key(self) -> str:
+        return content_key(self.spec)
+
+
+def content_key(obj: object) -> str:
+    text = json.dumps(obj, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:20]
+
+
+def _as_list(name: str, value: object) -> list:
+    return value if isinstance(value, list) else [value]
+
+
+def _check_number(where: str, value: object, lo: float, hi: float, integer: bool = False) -> float | int:
+    ok_type = isinstance(value, int) if integer else isinstance(value, (int, float))
+    if isinstance(value, bool) or not ok_type or not lo <= value <= hi:
+        kind = "an integer" if integer else "a number"
+        raise SweepFileError(f"{where}: must be {kind} in [{lo:g}, {hi:g}], got {value!r}")
+    return value
+
+
+def normalise(raw: dict, where: str = "sweep file") -> dict:
+    """Validate a parsed sweep file; returns the spec with every key filled in."""
+    if set(raw) != {"sweep"} or not isinstance(raw.get("sweep"), dict):
+        extra = sorted(set(raw) - {"sweep"})
+        what = f"unknown table {extra[0]!r}" if extra else "missing the [sweep] table"
+        raise SweepFileError(f"{where}: {what}; a sweep file has exactly one table, [sweep]")
+    body = raw["sweep"]
+    valid = sorted([*_AXES, *_SCALARS])
+    for key in body:
+        if key not in _AXES and key not in _SCALARS:
+            raise SweepFileError(f"{where}: unknown key {key!r}; valid keys: {', '.join(valid)}")
+    spec: dict = {}
+    for key, default in _SCALARS.items():
+        spec[key] = body.get(key, default)
+    for key, default in _AXES.items():
+        spec[key] = _as_list(key, body[key]) if key in body else list(default)
+    w = where
+    if not isinstance(spec["name"], str) or not spec["name"]:
+        raise SweepFileError(f"{w}: name must be a non-empty string")
+    _check_number(f"{w}: trials", spec["trials"], 1, 10_000, integer=True)
+    _check_number(f"{w}: patience", spec["patience"], 1, 100_000, integer=True)
+    _check_number(f"{w}: max_episodes", spec["max_episodes"], 1, 1_000_000, integer=True)
+    if spec["trajectory"] not in ("optimal", "learned"):
+        raise SweepFileError(f"{w}: trajectory must be 'optimal' or 'learned', got {spec['trajectory']!r}")
+    for t in spec["tasks"]:
+        if isinstance(t, bool) or t not in TABLE_I:
+            raise SweepFileError(f"{w}: unknown task {t!r}; valid tasks: {', '.join(map(str, TABLE_I))}")
+    pairs = []
+    for sg in spec["start_goal"]:
+        if not (isinstance(sg, list) and len(sg) == 2 and all(isinstance(x, str) for x in sg)):
+            raise SweepFileError(f"{w}: start_goal entries must be [\"X,Y\", \"X,Y\"], got {sg!r}")
+        try:
+            pairs.append([list(parse_xy(sg[0], "start")), list(parse_xy(sg[1], "goal"))])
+        except ArmTransferError as err:
+            raise SweepFileError(f"{w}: start_goal: {err}") from None
+    spec["start_goal"] = pairs
+    if not spec["tasks"] and not spec["start_goal"]:
+        raise SweepFileError(f"{w}: give tasks or start_goal (or both)")
+    for p in spec["pairs"]:
+        if not (isinstance(p, list) and len(p) == 2 and all(isinstance(x, str) and x for x in p)):
+            raise SweepFileError(f"{w}: pairs entries must be [\"SOURCE\", \"TARGET\"], got {p!r}")
+    for m in spec["methods"]:
+        if m not in METHODS:
+            raise SweepFileError(f"{w}: unknown method {m!r}; valid methods: {', '.join(METHODS)}")
+    for s in spec["seeds"]:
+        _check_number(f"{w}: seeds", s, 0, 2**63 - 1, integer=True)
+    for k in spec["K"]:
+        if k != "auto":
+            _check_number(f"{w}: K", k, 0, 1e9)
+    for key, lo, hi in (("epsilon", 0, 1), ("lam", 0, 1), ("gamma", 0, 1), ("wind", 0, 1), ("alpha", 1e-12, 1)):
+        for v in spec[key]:
+            _check_number(f"{w}: {key}", v, lo, hi)
+    for key in _AXES:
+        if len(spec[key]) != len({json.dumps(v) for v in spec[key]}):
+            raise SweepFileError(f"{w}: {key} lists a value twice")
+    return spec
+
+
+def expand(spec: dict) -> list[dict]:
+    """Every run of the sweep, in a fixed order, each a flat configuration."""
+    tasks = [{"task": t, "start": list(TABLE_I[t].start), "goal": list(TABLE_I[t].goal)} for t in spec["tasks"]]
+    tasks += [{"task": None, "start": s, "goal": g} for s, g in spec["start_goal"]]
+    runs: dict[str, dict] = {}
+    for task, pair, method, seed, K, eps, lam, alpha, gamma, wind in itertools.product(
+        tasks, spec["pairs"], spec["methods"], spec["seeds"], spec["K"], spec["epsilon"],
+        spec["lam"], spec["alpha"], spec["gamma"], spec["wind"],
+    ):
+        run = {
+            "format": RUN_FORMAT,
+            **task,
+            "source": pair[0],
+            "target": pair[1],
+            "method": method,
+            "seed": seed,
+            "trials": spec["trials"],
+            "trajectory": spec["trajectory"],
+            "K": None if method == "none" else K,
+            "epsilon": eps,
+            "lam": lam,
+            "alpha": alpha,
+            "gamma": gamma,
+            "wind": wind,
+            "patience": spec["patience"],
+            "max_episodes": spec["max_episodes"],
+        }
+        runs.setdefault(content_key(run), run)
+    return [dict(r, key=k) for k, r in runs.items()]
+
+
+def load(path: str | os.PathLike) -> Sweep:
+    p = Path(path)
+    where = f"sweep file {str(p)!r}"
+    try:
+        raw = tomllib.loads(p.read_text())
+    except OSError as err:
+        raise SweepFileError(f"cannot read {where}: {err.strerror}") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
+        raise SweepFileError(f"{where} is not valid TOML: {str(err).splitlines()[0]}") from None
+    spec = normalise(raw, where)
+    return Sweep(spec["name"], spec, tuple(expand(spec)))
+
+
+def group_key(run: dict) -> tuple:
+    """Runs that differ only in seed are pooled; ``method`` is the column."""
+    return (
+        run["task"], tuple(run["start"]), tuple(run["goal"]), run["source"], run["target"],
+        run["trajectory"], run["epsilon"], run["lam"], run["alpha"], run["gamma"], run["wind"],
+        run["trials"], run["patience"], run["max_episodes"],
+    )
