@@ -127,3 +127,26 @@ def test_console_script_runs_in_a_fresh_interpreter():
     assert proc.returncode == 0, proc.stderr
     proc = run_cli("rooms", "--task", "7")
     assert proc.returncode == 2 and proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
+
+
+def test_bench_fast_mode_writes_its_figures(tmp_path):
+    out = tmp_path / "bench.json"
+    assert main(["bench", "--steps", "20000", "--repeats", "2", "--baseline-steps", "200",
+                 "--baseline-repeats", "1", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert len(data["steps_per_second"]) == 2 and data["median_steps_per_second"] > 0
+    assert data["speedup_vs_baseline"] == pytest.approx(
+        data["median_steps_per_second"] / data["baseline_median_steps_per_second"])
+
+
+def test_reproduce_fast_mode_writes_report_figures_and_results(tmp_path):
+    out = tmp_path / "rep"
+    assert main(["reproduce", "--out", str(out), "--trials", "2"]) == 0
+    report = (out / "report.md").read_text()
+    for needle in ("Table II", "Table IV", "Table V", "Wind"):
+        assert needle in report
+    assert "9,777.8" in report  # the paper's Table II A, task 1, beside ours
+    data = json.loads((out / "results.json").read_text())
+    assert set(data["table_ii"]) == {"1", "2", "3", "4"}
+    for name in ("fig4_coarse_to_fine.png", "fig5_fine_to_coarse.png", "fig6_wind.png"):
+        assert (out / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

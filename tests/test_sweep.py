@@ -178,3 +178,4 @@ def test_ray_executor_without_ray_says_how_to_install_it(sweep_file, tmp_path, c
     assert main(["sweep", str(sweep_file), "--out", str(tmp_path / "o"), "--executor", "ray"]) == 2
     err = capsys.readouterr().err
     assert 'pip install -e ".[cluster]"' in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "o").exists()

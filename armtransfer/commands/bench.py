@@ -25,6 +25,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="learner steps per repeat, at least (default 2,000,000)")
     p.add_argument("--repeats", type=positive_int, default=5, help="timed repeats (default 5)")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--baseline-steps", type=positive_int, default=2_000,
+                   help="steps per repeat of the plain-Python baseline, at least (default 2,000)")
+    p.add_argument("--baseline-repeats", type=int, default=3, help="baseline repeats (default 3; 0 skips it)")
     p.add_argument("--json", default=None, metavar="PATH", help="write the figures as JSON here")
 
 
@@ -44,6 +47,21 @@ def measure(steps: int, seed: int) -> tuple[int, float]:
     return done, time.perf_counter() - t0
 
 
+def measure_reference(steps: int, seed: int) -> tuple[int, float]:
+    """The baseline: the dense, line-by-line Algorithm 1 in plain Python (transfer.reference)."""
+    from transfer import reference
+
+    robot = grid_robot("fine")
+    start, goal = table_task(1).cells()
+    rng = np.random.default_rng(seed)
+    t0 = time.perf_counter()
+    done = 0
+    while done < steps:
+        _, per_episode = reference.learn(robot, robot.start_state(start), goal, LearnerConfig(), rng, episodes=1)
+        done += sum(per_episode)
+    return done, time.perf_counter() - t0
+
+
 def run(args: argparse.Namespace) -> int:
     if args.json:
         check_writable(args.json)
@@ -55,12 +73,24 @@ def run(args: argparse.Namespace) -> int:
         print(f"repeat {r + 1}: {done:,} steps in {secs:.3f} s = {done / secs:,.0f} steps/s")
     med = statistics.median(rates)
     print(f"median: {med:,.0f} steps/s over {args.repeats} repeats (target >= 2,000,000)")
+    base = []
+    for r in range(args.baseline_repeats):
+        done, secs = measure_reference(args.baseline_steps, args.seed + r)
+        base.append(done / secs)
+    base_med = statistics.median(base) if base else None
+    if base_med:
+        print(f"baseline (dense Algorithm 1 in plain Python): median {base_med:,.0f} steps/s "
+              f"over {len(base)} repeats; compiled / baseline = {med / base_med:,.0f}x")
     if args.json:
         write_json_atomic(args.json, {
             "benchmark": "learner steps per second, task 1, fine robot, no transfer",
             "steps_per_repeat": args.steps,
             "steps_per_second": rates,
             "median_steps_per_second": med,
+            "baseline": "dense Algorithm 1 in plain Python (transfer.reference)",
+            "baseline_steps_per_second": base,
+            "baseline_median_steps_per_second": base_med,
+            "speedup_vs_baseline": None if not base_med else med / base_med,
             "machine": {"cpus": os.cpu_count(), "processor": platform.processor() or platform.machine(),
                         "python": platform.python_version()},
         })

@@ -7,7 +7,7 @@ import os
 
 from armtransfer.commands import common
 from armtransfer.execute import robot_specs
-from armtransfer.executors import run_local, run_ray
+from armtransfer.executors import _import_ray, run_local, run_ray
 from armtransfer.robots import resolve
 from transfer import sweep as sweeps
 from transfer.store import ResultStore
@@ -28,6 +28,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     sweep = sweeps.load(args.sweep_file)
+    if args.executor == "ray":
+        _import_ray()  # say how to install Ray before anything is written
     store = ResultStore.open_for(args.out, sweep)
     todo = [r for r in sweep.runs if not store.is_done(r["key"])]
     print(f"sweep {sweep.name!r}: {len(sweep.runs)} runs, {len(sweep.runs) - len(todo)} already done, "
