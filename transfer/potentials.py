@@ -1,0 +1,85 @@
+"""State potentials for potential-based shaping (Ng, Harada and Russell, 1999).
+
+With a potential Phi over the robot's states, the shaping term of a move s -> s' is
+F = gamma * Phi(s') - Phi(s) (Phi of a terminal state is 0). Summed over an episode it
+telescopes to -Phi(s_0), so the optimal policy is unchanged; learning with it is the same
+as starting from Q(s, a) = Phi(s) (Wiewiora, 2003).
+
+``dense`` (new here): a potential over the shared workspace the robot perceives,
+
+    Phi(s) = K * (i*(s) - n) - K * beta * d(s)
+
+where d(s) is the Euclidean distance, in cells, between the robot's label and the nearest
+trajectory cell, i*(s) the largest index among the trajectory cells at that distance, and n
+the index of the last trajectory state. Two parameters: ``K``, the potential gained per
+trajectory index, and ``beta``, the indices lost per cell of distance from the trajectory.
+Phi <= 0 and rises towards the goal, so standing still (a blocked move) earns nothing.
+It uses distances between labels only, never the map's walls or connectivity, which the
+robot does not know; so across a wall it can point the wrong way.
+
+``oracle`` (a control, not a transfer method): Phi(s) = -K * (the robot's true
+shortest-path distance to the goal). It uses the map, which no robot has; it bounds what
+any state potential can do for this learner.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tasks.layout import ROOMS, Layout
+from tasks.robot import DiscreteRobot
+from transfer.trajectory import Trajectory
+
+DENSE_K = 3.0
+DENSE_BETA = 1.5
+
+
+def _label_xy(robot: DiscreteRobot, layout: Layout) -> np.ndarray:
+    width = layout.width
+    y, x = np.divmod(robot.label.astype(np.int64), width)
+    return np.stack([x + layout.lo, y + layout.lo], axis=1).astype(np.float64)
+
+
+def dense(
+    robot: DiscreteRobot,
+    traj: Trajectory,
+    K: float = DENSE_K,
+    beta: float = DENSE_BETA,
+    layout: Layout = ROOMS,
+) -> np.ndarray:
+    """The ``dense`` potential of every robot state (float64 [n_states])."""
+    p = _label_xy(robot, layout)
+    t = np.array([layout.xy(c) for c in traj.cells], dtype=np.float64)
+    n = len(t) - 1
+    best_d = np.full(len(p), np.inf)
+    best_i = np.zeros(len(p))
+    for i in range(len(t)):  # one pass per trajectory cell keeps memory at O(states)
+        d = np.sqrt(((p - t[i]) ** 2).sum(axis=1))
+        closer = d < best_d - 1e-9
+        tie = np.abs(d - best_d) <= 1e-9
+        best_i = np.where(closer | tie, i, best_i)
+        best_d = np.where(closer, d, best_d)
+    return K * (best_i - n) - K * beta * best_d
+
+
+def oracle(robot: DiscreteRobot, goal_cell: int, K: float = 2.0) -> np.ndarray:
+    """-K times each state's breadth-first distance to the goal (unreachable: the largest)."""
+    n = robot.n_states
+    dist = np.full(n, -1, dtype=np.int64)
+    # reverse edges once, then breadth-first search from every goal state
+    src = np.repeat(np.arange(n), robot.n_actions)
+    dst = robot.next_state.reshape(-1).astype(np.int64)
+    order = np.argsort(dst, kind="stable")
+    src, dst = src[order], dst[order]
+    starts = np.searchsorted(dst, np.arange(n + 1))
+    frontier = np.flatnonzero(robot.label == goal_cell)
+    dist[frontier] = 0
+    level = 0
+    while len(frontier):
+        level += 1
+        preds = np.concatenate([src[starts[t]:starts[t + 1]] for t in frontier])
+        preds = np.unique(preds[dist[preds] < 0])
+        dist[preds] = level
+        frontier = preds
+    dist[dist < 0] = level
+    return -K * dist.astype(np.float64)
