@@ -17,6 +17,7 @@ COMMANDS = {
     "rooms": "rooms",
     "reproduce": "reproduce",
     "bench": "bench",
+    "arms": "arms",
 }
 
 
