@@ -19,6 +19,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "(tabletop z=0, table centre at the origin; default 0,0,0)")
     parser.add_argument("--base-yaw", metavar="RAD", type=float, default=0.0,
                         help="rotation of --arm-xml's base about z (rad)")
+    parser.add_argument("--arm", default=None, metavar="NAMES",
+                        help="only these built-in arms, comma-separated (e.g. planar2,ur5e_like)")
     parser.add_argument("--actions", default=None,
                         help="only these action models, comma-separated (e.g. joint,cartesian)")
     parser.add_argument("--cell-size", type=float, default=0.01, help="cell size in metres")
@@ -58,10 +60,18 @@ def run(args: argparse.Namespace) -> int:
             if a not in ACTION_MODELS:
                 raise ArmModelError(
                     f"unknown action model {a!r}; valid action models: {', '.join(ACTION_MODELS)}")
+    from models import ARMS
+
+    arms = None
+    if args.arm:
+        arms = [a.strip() for a in args.arm.split(",") if a.strip()]
+        for a in arms:
+            if a not in ARMS:
+                raise ArmModelError(f"unknown arm {a!r}; valid arms: {', '.join(ARMS)}")
     jobs = []
     for spec in robot_specs():
         arm, actions = spec.split(":")
-        if wanted is None or actions in wanted:
+        if (wanted is None or actions in wanted) and (arms is None or arm in arms):
             jobs.append(dict(arm=arm, actions=actions))
     if args.arm_xml:
         custom = [a for a in (wanted or ["cartesian"])]
