@@ -80,6 +80,22 @@ class TipIK:
                 break
         return IKResult(cfg.q.copy(), float(err), float(tilt), it)
 
+    def solve_any(self, xy: np.ndarray, q0: np.ndarray, rng: np.random.Generator,
+                  restarts: int = 8) -> IKResult:
+        """``solve`` from q0, then from home, then from random configurations drawn with
+        ``rng`` inside the joint limits, until one succeeds; returns the best found."""
+        lo = np.maximum(self.scene.lower, -np.pi)
+        hi = np.minimum(self.scene.upper, np.pi)
+        seeds = [q0, self.scene.home] + [rng.uniform(lo, hi) for _ in range(restarts)]
+        best = None
+        for seed in seeds:
+            res = self.solve(xy, seed)
+            if self.ok(res):
+                return res
+            if best is None or res.error < best.error:
+                best = res
+        return best
+
     def _residual(self, target: np.ndarray) -> tuple[float, float]:
         pose = self.configuration.get_transform_frame_to_world(self.scene.tip, "site")
         err = float(np.linalg.norm(pose.translation() - target))
