@@ -35,7 +35,7 @@ import numpy as np
 from ik.errors import ArmModelError, UnreachableTableError
 from ik.labels import OFF_TABLE, cells_of_xy
 from ik.scene import ArmScene, ContactChecker
-from ik.solve import TipIK
+from ik.solve import MAX_TIP_HEIGHT, TipIK
 
 
 def _near_wall_mask(layout) -> np.ndarray:
@@ -103,7 +103,9 @@ def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = 
             if free[n] and n not in q_of and attempts[n] < 3 and try_cell(n, q_of[c]):
                 queue.append(n)
     if not q_of:
-        raise UnreachableTableError("the arm's tip cannot reach any free cell of the table")
+        raise UnreachableTableError(
+            "the arm's tip cannot reach the table: IK finds no configuration with the tip "
+            "over a free cell, at most 1 cm above the tabletop")
     _progress(progress, f"  IK: {len(q_of)} cells reached")
 
     cells = np.array(sorted(q_of), dtype=np.int64)
@@ -225,13 +227,34 @@ class PlanarFK:
         return float(np.sum(np.linalg.norm(self.offsets[j:], axis=1)))
 
 
+def _lattice_origin(scene: ArmScene, fk: PlanarFK) -> np.ndarray:
+    """Home if its tip is over a free cell, else an IK configuration over the free cell
+    nearest home's tip (the joint lattice is laid out from this configuration)."""
+    layout, cell = scene.layout, scene.cell
+    home = scene.home.astype(float)
+    c = int(cells_of_xy(fk.tip(home), cell, layout))
+    if c >= 0 and layout.free[c]:
+        return home
+    ik = TipIK(scene, False)
+    for c in _cells_by_distance(fk.tip(home), cell, layout)[:50]:
+        x, y = layout.xy(int(c))
+        res = ik.solve(np.array([x * cell, y * cell]), home)
+        if ik.ok(res):
+            return res.q
+    raise UnreachableTableError("the arm's tip cannot reach the table near its home configuration")
+
+
 def compile_joint(scene: ArmScene, step: float, progress: bool = False) -> dict:
     layout, cell = scene.layout, scene.cell
     fk = PlanarFK(scene)
     contact = ContactChecker(scene)
     free = layout.free
     near = _near_wall_mask(layout)
-    home = scene.home.astype(float)
+    if not -1e-3 <= fk.tip_z <= MAX_TIP_HEIGHT:
+        raise UnreachableTableError(
+            f"the arm's tip cannot reach the table: it moves {fk.tip_z:.3f} m above the "
+            f"tabletop (at most {MAX_TIP_HEIGHT} m allowed)")
+    home = _lattice_origin(scene, fk)
     dof = len(home)
     lo = np.where(np.isfinite(scene.lower), scene.lower, home - np.pi)
     hi = np.where(np.isfinite(scene.upper), scene.upper, home + np.pi)

@@ -37,6 +37,8 @@ class ArmScene:
     arm_geoms: np.ndarray
     cell: float
     layout: Layout
+    planar: bool
+    """All joint axes vertical: the tip moves in a horizontal plane at a fixed height."""
 
     @property
     def nq(self) -> int:
@@ -121,8 +123,13 @@ def build_scene(xml_path: Path, tip_site: str = "tip", mount_pos=(0.0, 0.0, 0.0)
         adr = model.jnt_qposadr[j]
         if model.jnt_limited[j]:
             lower[adr], upper[adr] = model.jnt_range[j]
+    data = mujoco.MjData(model)
+    data.qpos[:] = home
+    mujoco.mj_kinematics(model, data)
+    planar = bool(np.all(np.abs(np.abs(data.xaxis[:, 2]) - 1.0) < 1e-6))
     return ArmScene(model=model, xml=xml, tip=PREFIX + tip_site, home=home, lower=lower,
-                    upper=upper, env_geoms=env, arm_geoms=arm_geoms, cell=cell, layout=layout)
+                    upper=upper, env_geoms=env, arm_geoms=arm_geoms, cell=cell, layout=layout,
+                    planar=planar)
 
 
 class ContactChecker:

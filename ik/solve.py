@@ -17,7 +17,9 @@ import numpy as np
 from ik.scene import ArmScene
 
 TIP_HEIGHT = 0.004
-"""Height of the tool tip above the tabletop for spatial arms (m)."""
+"""Height IK puts the tool tip at above the tabletop (m). Planar arms keep their own."""
+MAX_TIP_HEIGHT = 0.01
+"""A tip higher than this above the tabletop (m) is not on the table."""
 
 # Tool z axis pointing down: a rotation of pi about the world x axis.
 _DOWN = mink.SO3.from_x_radians(np.pi)
@@ -31,6 +33,8 @@ class IKResult:
     tilt: float
     """Angle between the tool axis and straight down (rad; 0 for planar arms)."""
     iterations: int
+    height: float = TIP_HEIGHT
+    """Height of the tip above the tabletop (m)."""
 
 
 class TipIK:
@@ -42,7 +46,7 @@ class TipIK:
         self.configuration = mink.Configuration(scene.model)
         self.frame = mink.FrameTask(
             frame_name=scene.tip, frame_type="site",
-            position_cost=1.0 if tip_down else np.array([1.0, 1.0, 0.0]),
+            position_cost=np.array([1.0, 1.0, 0.0]) if scene.planar else 1.0,
             orientation_cost=np.array([1.0, 1.0, 0.0]) if tip_down else 0.0,
             lm_damping=1e-3,
         )
@@ -56,7 +60,7 @@ class TipIK:
         self.tasks = [self.frame, self.posture]
 
     def target_height(self, q: np.ndarray) -> float:
-        if self.tip_down:
+        if not self.scene.planar:
             return TIP_HEIGHT
         self.configuration.update(q)
         return float(self.configuration.get_transform_frame_to_world(self.scene.tip, "site").translation()[2])
@@ -78,7 +82,8 @@ class TipIK:
             err, tilt = self._residual(target)
             if err < self.tol * 0.2 and tilt < self.tilt_tol * 0.2:
                 break
-        return IKResult(cfg.q.copy(), float(err), float(tilt), it)
+        height = float(cfg.get_transform_frame_to_world(self.scene.tip, "site").translation()[2])
+        return IKResult(cfg.q.copy(), float(err), float(tilt), it, height)
 
     def solve_any(self, xy: np.ndarray, q0: np.ndarray, rng: np.random.Generator,
                   restarts: int = 8) -> IKResult:
@@ -105,4 +110,5 @@ class TipIK:
         return err, float(np.arccos(np.clip(-z[2], -1.0, 1.0)))
 
     def ok(self, result: IKResult) -> bool:
-        return result.error <= self.tol and result.tilt <= self.tilt_tol
+        return (result.error <= self.tol and result.tilt <= self.tilt_tol
+                and -1e-3 <= result.height <= MAX_TIP_HEIGHT)
