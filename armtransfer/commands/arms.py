@@ -16,7 +16,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="the tool-tip site of --arm-xml (default: tip)")
     parser.add_argument("--base-pos", metavar="X,Y,Z", default=None,
                         help="base position of --arm-xml in the table frame, metres "
-                             "(tabletop z=0, table centre at the origin; default 0,0,0)")
+                             "(tabletop z=0, table centre at the origin; default 0,0,0); write "
+                             "negative values as --base-pos=-0.1,0,0")
     parser.add_argument("--base-yaw", metavar="RAD", type=float, default=0.0,
                         help="rotation of --arm-xml's base about z (rad)")
     parser.add_argument("--arm", default=None, metavar="NAMES",
