@@ -19,6 +19,7 @@ COMMANDS = {
     "bench": "bench",
     "sweep": "sweep",
     "summarize": "summarize",
+    "arms": "arms",
 }
 
 

@@ -1,0 +1,107 @@
+"""``armtransfer arms``: the arm robots (``arms list``); transfer between arms comes later."""
+
+from __future__ import annotations
+
+import argparse
+
+HELP = "list the arm robots: arms, DOF, action models, states and reachability"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("action", nargs="?", choices=["list"],
+                        help="'list': compile (or load) every arm robot and report it")
+    parser.add_argument("--arm-xml", metavar="PATH",
+                        help="also list a bring-your-own MJCF serial arm with hinge joints")
+    parser.add_argument("--tip-site", metavar="NAME", default="tip",
+                        help="the tool-tip site of --arm-xml (default: tip)")
+    parser.add_argument("--base-pos", metavar="X,Y,Z", default=None,
+                        help="base position of --arm-xml in the table frame, metres "
+                             "(tabletop z=0, table centre at the origin; default 0,0,0); write "
+                             "negative values as --base-pos=-0.1,0,0")
+    parser.add_argument("--base-yaw", metavar="RAD", type=float, default=0.0,
+                        help="rotation of --arm-xml's base about z (rad)")
+    parser.add_argument("--arm", default=None, metavar="NAMES",
+                        help="only these built-in arms, comma-separated (e.g. planar2,ur5e_like)")
+    parser.add_argument("--actions", default=None,
+                        help="only these action models, comma-separated (e.g. joint,cartesian)")
+    parser.add_argument("--cell-size", type=float, default=0.01, help="cell size in metres")
+    parser.add_argument("--no-cache", action="store_true", help="compile without the cache")
+    parser.add_argument("--source", help=argparse.SUPPRESS)
+    parser.add_argument("--target", help=argparse.SUPPRESS)
+
+
+def _base_pos(text: str | None):
+    from ik.errors import ArmModelError
+
+    if text is None:
+        return None
+    try:
+        values = tuple(float(v) for v in text.split(","))
+        if len(values) != 3:
+            raise ValueError
+    except ValueError:
+        raise ArmModelError(f"--base-pos must be three numbers 'X,Y,Z', got {text!r}") from None
+    return values
+
+
+def run(args: argparse.Namespace) -> int:
+    from ik.actions import ACTION_MODELS
+    from ik.errors import ArmModelError
+    from tasks.errors import ArmTransferError
+
+    if args.action != "list":
+        raise ArmTransferError("not implemented yet: use `armtransfer arms list`")
+    from ik.robots import arm_robot, robot_specs
+    from tasks.catalog import TABLE_I
+
+    wanted = None
+    if args.actions:
+        wanted = [a.strip() for a in args.actions.split(",") if a.strip()]
+        for a in wanted:
+            if a not in ACTION_MODELS:
+                raise ArmModelError(
+                    f"unknown action model {a!r}; valid action models: {', '.join(ACTION_MODELS)}")
+    from models import ARMS
+
+    arms = None
+    if args.arm:
+        arms = [a.strip() for a in args.arm.split(",") if a.strip()]
+        for a in arms:
+            if a not in ARMS:
+                raise ArmModelError(f"unknown arm {a!r}; valid arms: {', '.join(ARMS)}")
+    jobs = []
+    for spec in robot_specs():
+        arm, actions = spec.split(":")
+        if (wanted is None or actions in wanted) and (arms is None or arm in arms):
+            jobs.append(dict(arm=arm, actions=actions))
+    if args.arm_xml:
+        custom = [a for a in (wanted or ["cartesian"])]
+        # Validate the file before the long built-in listing, so bad input fails fast.
+        from ik.robots import arm_scene
+
+        arm_scene(xml_path=args.arm_xml, tip_site=args.tip_site, base_pos=_base_pos(args.base_pos),
+                  base_yaw=args.base_yaw, cell_size=args.cell_size)
+        for a in custom:
+            jobs.append(dict(arm=None, actions=a, xml_path=args.arm_xml, tip_site=args.tip_site,
+                             base_pos=_base_pos(args.base_pos), base_yaw=args.base_yaw))
+    header = f"{'robot':<24} {'dof':>3} {'actions':>7} {'states':>7} {'reach':>6} {'tableI':>6} {'cache':>6}"
+    print(header)
+    for job in jobs:
+        r = arm_robot(job.pop("arm"), job.pop("actions"), cell_size=args.cell_size,
+                      cache=not args.no_cache, **job)
+        solved = sum(_solvable(r, t) for t in TABLE_I.values())
+        print(f"{r.name:<24} {r.meta['dof']:>3} {r.n_actions:>7} {r.n_states:>7} "
+              f"{r.meta['reach']:>6.1%} {solved:>4}/{len(TABLE_I)} {r.meta['cache']:>6}")
+    return 0
+
+
+def _solvable(robot, task) -> bool:
+    from tasks.errors import InvalidCellError
+
+    try:
+        s, g = task.cells()
+        start = robot.start_state(s)
+        robot.start_state(g, what="goal")
+    except InvalidCellError:
+        return False
+    return robot.shortest_path(start, g) is not None

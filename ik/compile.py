@@ -1,0 +1,366 @@
+"""Compile (arm scene, action model) into the arrays of a discrete robot.
+
+``cartesian``: one canonical configuration per reachable free cell, found by mink IK in a
+breadth-first sweep over cells from the home cell (each IK warm-started from the
+neighbour it was reached from). A move of k cells is a table lookup, blocked when the
+target or a cell passed over is a wall or off the table, when IK found no configuration
+for the target, or when the straight joint-space move between the two configurations
+(checked at 3k interpolated points) touches the table or a wall in MuJoCo, or strays
+more than 0.75 cell from the straight line between the cells.
+
+``joint`` (planar arms): states are the points of a joint lattice (home + n * delta,
+inside the joint limits) reachable from home by +-delta moves, whose tip is over a free
+cell and not touching a wall. The lattice's forward kinematics is vectorised with numpy
+(vertical joint axes: the tip is a sum of rotated link vectors taken from MuJoCo at
+q = 0; the tests check it against mink). A move is blocked when it leaves the limits,
+the tip passes over a wall cell or off the table at any of the interpolated points
+(spaced at most half a cell apart), or MuJoCo reports contact with the table or a wall
+at up to 3 points along the move; MuJoCo is asked only near walls (tip within one cell
+of a wall cell), since a planar arm's links ride above the walls and only the stylus can
+touch them.
+
+Wind pushes the tip one cell towards +x: for cartesian robots it is the 1-cell +x move;
+for joint robots it is the lattice state labelled with the cell to the right that is
+nearest to the joint step a Jacobian step predicts (blocked when none is).
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections import deque
+
+import mujoco
+import numpy as np
+
+from ik.errors import ArmModelError, UnreachableTableError
+from ik.labels import OFF_TABLE, cells_of_xy
+from ik.scene import ArmScene, ContactChecker
+from ik.solve import MAX_TIP_HEIGHT, TipIK
+
+
+def _near_wall_mask(layout) -> np.ndarray:
+    """Boolean over cell ids: a wall cell or one of its 8 neighbours."""
+    w = layout.wall_mask
+    pad = np.pad(w, 1)
+    near = np.zeros_like(w)
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            near |= pad[1 + dy:1 + dy + w.shape[0], 1 + dx:1 + dx + w.shape[1]]
+    return near.reshape(-1)
+
+
+def _progress(enabled: bool, text: str) -> None:
+    if enabled:
+        import sys
+
+        print(text, file=sys.stderr, flush=True)
+
+
+# --------------------------------------------------------------------------- cartesian
+
+
+def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = False) -> dict:
+    layout, cell = scene.layout, scene.cell
+    free = layout.free
+    ik = TipIK(scene, tip_down)
+    contact = ContactChecker(scene)
+
+    home_tip = ik.configuration
+    home_tip.update(scene.home)
+    p = home_tip.get_transform_frame_to_world(scene.tip, "site").translation()
+    seed = _nearest_free_cell(p[:2], cell, layout)
+
+    q_of: dict[int, np.ndarray] = {}
+    attempts = np.zeros(layout.n_cells, dtype=np.int8)
+
+    def try_cell(c: int, q0: np.ndarray) -> bool:
+        attempts[c] += 1
+        x, y = layout.xy(c)
+        res = ik.solve(np.array([x * cell, y * cell]), q0)
+        if not ik.ok(res):
+            return False
+        tip = ik.configuration.get_transform_frame_to_world(scene.tip, "site").translation()
+        if int(cells_of_xy(tip, cell, layout)) != c or contact.touches(res.q):
+            return False
+        q_of[c] = res.q
+        return True
+
+    queue: deque[int] = deque()
+    # Seed from home; if the nearest cell fails, walk outwards over cells by distance.
+    order = _cells_by_distance(p[:2], cell, layout)
+    for c in [seed, *order[:50]]:
+        if c >= 0 and free[c] and attempts[c] == 0 and try_cell(c, scene.home):
+            queue.append(c)
+            break
+    while queue:
+        c = queue.popleft()
+        x, y = layout.xy(c)
+        for dx, dy in ((1, 0), (-1, 0), (0, 1), (0, -1)):
+            nx, ny = x + dx, y + dy
+            if not layout.in_grid(nx, ny):
+                continue
+            n = layout.cell(nx, ny)
+            if free[n] and n not in q_of and attempts[n] < 3 and try_cell(n, q_of[c]):
+                queue.append(n)
+    if not q_of:
+        raise UnreachableTableError(
+            "the arm's tip cannot reach the table: IK finds no configuration with the tip "
+            "over a free cell, at most 1 cm above the tabletop")
+    _progress(progress, f"  IK: {len(q_of)} cells reached")
+
+    cells = np.array(sorted(q_of), dtype=np.int64)
+    index = np.full(layout.n_cells, -1, dtype=np.int64)
+    index[cells] = np.arange(len(cells))
+    qpos = np.stack([q_of[int(c)] for c in cells])
+    n = len(cells)
+
+    checked: dict[tuple[int, int], bool] = {}
+
+    def move_ok(s: int, dx: int, dy: int, steps: int) -> int:
+        x, y = layout.xy(int(cells[s]))
+        for i in range(1, steps + 1):
+            if not layout.in_grid(x + dx * i, y + dy * i) or not free[layout.cell(x + dx * i, y + dy * i)]:
+                return s
+        t = int(index[layout.cell(x + dx * steps, y + dy * steps)])
+        if t < 0:
+            return s
+        key = (min(s, t), max(s, t))
+        if key not in checked:
+            checked[key] = _segment_clear(contact, qpos[s], qpos[t], np.array([x, y]) * cell,
+                                          np.array([x + dx * steps, y + dy * steps]) * cell,
+                                          3 * steps, cell, layout)
+        return t if checked[key] else s
+
+    next_state = np.empty((n, 4), dtype=np.int32)
+    wind = np.empty(n, dtype=np.int32)
+    for s in range(n):
+        for a, (dx, dy) in enumerate(((0, 1), (0, -1), (1, 0), (-1, 0))):
+            next_state[s, a] = move_ok(s, dx, dy, k)
+        wind[s] = move_ok(s, 1, 0, 1)
+    tips = np.array([contact.tip(q) for q in qpos])
+    canonical = np.full(layout.n_cells, -1, dtype=np.int32)
+    canonical[cells] = np.arange(n)
+    return dict(next_state=next_state, wind_state=wind, label=cells.astype(np.int32),
+                canonical=canonical, qpos=qpos, tip=tips)
+
+
+def _segment_clear(contact: ContactChecker, qa, qb, pa, pb, n_points: int, cell, layout) -> bool:
+    d = pb - pa
+    length2 = float(d @ d)
+    for t in np.linspace(0.0, 1.0, n_points + 2)[1:-1]:
+        hit, tip = contact.touches_and_tip(qa + (qb - qa) * t)
+        if hit:
+            return False
+        c = int(cells_of_xy(tip, cell, layout))
+        if c == OFF_TABLE or not layout.free[c]:
+            return False
+        u = np.clip(((tip[:2] - pa) @ d) / length2, 0.0, 1.0)
+        if np.linalg.norm(tip[:2] - (pa + u * d)) > 0.75 * cell:
+            return False
+    return True
+
+
+def _nearest_free_cell(xy, cell, layout) -> int:
+    order = _cells_by_distance(xy, cell, layout)
+    return int(order[0]) if len(order) else -1
+
+
+def _cells_by_distance(xy, cell, layout) -> np.ndarray:
+    ids = np.flatnonzero(layout.free)
+    ys, xs = np.divmod(ids, layout.width)
+    centres = np.stack([xs + layout.lo, ys + layout.lo], axis=1) * cell
+    return ids[np.argsort(np.linalg.norm(centres - np.asarray(xy)[:2], axis=1), kind="stable")]
+
+
+# --------------------------------------------------------------------------- joint lattice
+
+
+class PlanarFK:
+    """Vectorised forward kinematics of an arm whose joint axes are all vertical."""
+
+    def __init__(self, scene: ArmScene) -> None:
+        model = scene.model
+        data = mujoco.MjData(model)
+        data.qpos[:] = 0.0
+        mujoco.mj_kinematics(model, data)
+        if model.njnt != model.nq:
+            raise ArmModelError("the joint action model needs an arm with hinge joints only")
+        axes = data.xaxis[: model.njnt]
+        if np.any(np.abs(np.abs(axes[:, 2]) - 1.0) > 1e-6):
+            raise ArmModelError(
+                "the joint action model needs a planar arm (all joint axes vertical); "
+                "use the cartesian action model")
+        self.sign = np.sign(axes[:, 2])
+        order = np.argsort(model.jnt_qposadr)
+        anchors = data.xanchor[order][:, :2]
+        site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, scene.tip)
+        tip = data.site_xpos[site]
+        self.origin = anchors[0].copy()
+        self.offsets = np.diff(np.vstack([anchors, tip[:2]]), axis=0)  # [n, 2]
+        self.tip_z = float(tip[2])
+        self.sign = self.sign[order]
+
+    def angles(self, q: np.ndarray) -> np.ndarray:
+        return np.cumsum(q * self.sign, axis=-1)
+
+    def tip(self, q: np.ndarray) -> np.ndarray:
+        """Tip (x, y) for configurations q [..., n]."""
+        th = self.angles(q)
+        c, s = np.cos(th), np.sin(th)
+        ox, oy = self.offsets[:, 0], self.offsets[:, 1]
+        x = self.origin[0] + np.sum(c * ox - s * oy, axis=-1)
+        y = self.origin[1] + np.sum(s * ox + c * oy, axis=-1)
+        return np.stack([x, y], axis=-1)
+
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        """d tip / d q, shape [..., 2, n]."""
+        th = self.angles(q)
+        c, s = np.cos(th), np.sin(th)
+        ox, oy = self.offsets[:, 0], self.offsets[:, 1]
+        vx, vy = c * ox - s * oy, s * ox + c * oy  # rotated link vectors
+        # Joint i moves every link vector from i on: d/dq_i = sign_i * z x (sum_{k>=i} v_k).
+        rx = np.flip(np.cumsum(np.flip(vx, -1), -1), -1)
+        ry = np.flip(np.cumsum(np.flip(vy, -1), -1), -1)
+        return np.stack([-ry * self.sign, rx * self.sign], axis=-2)
+
+    def reach_from(self, j: int) -> float:
+        return float(np.sum(np.linalg.norm(self.offsets[j:], axis=1)))
+
+
+def _lattice_origin(scene: ArmScene, fk: PlanarFK) -> np.ndarray:
+    """Home if its tip is over a free cell, else an IK configuration over the free cell
+    nearest home's tip (the joint lattice is laid out from this configuration)."""
+    layout, cell = scene.layout, scene.cell
+    home = scene.home.astype(float)
+    c = int(cells_of_xy(fk.tip(home), cell, layout))
+    if c >= 0 and layout.free[c]:
+        return home
+    ik = TipIK(scene, False)
+    for c in _cells_by_distance(fk.tip(home), cell, layout)[:50]:
+        x, y = layout.xy(int(c))
+        res = ik.solve(np.array([x * cell, y * cell]), home)
+        if ik.ok(res):
+            return res.q
+    raise UnreachableTableError("the arm's tip cannot reach the table near its home configuration")
+
+
+def compile_joint(scene: ArmScene, step: float, progress: bool = False) -> dict:
+    layout, cell = scene.layout, scene.cell
+    fk = PlanarFK(scene)
+    contact = ContactChecker(scene)
+    free = layout.free
+    near = _near_wall_mask(layout)
+    if not -1e-3 <= fk.tip_z <= MAX_TIP_HEIGHT:
+        raise UnreachableTableError(
+            f"the arm's tip cannot reach the table: it moves {fk.tip_z:.3f} m above the "
+            f"tabletop (at most {MAX_TIP_HEIGHT} m allowed)")
+    home = _lattice_origin(scene, fk)
+    dof = len(home)
+    lo = np.where(np.isfinite(scene.lower), scene.lower, home - np.pi)
+    hi = np.where(np.isfinite(scene.upper), scene.upper, home + np.pi)
+    n_lo = np.ceil((lo - home) / step - 1e-9).astype(int)
+    n_hi = np.floor((hi - home) / step + 1e-9).astype(int)
+    dims = tuple(int(v) for v in n_hi - n_lo + 1)
+    total = int(np.prod(dims))
+    grids = np.indices(dims).reshape(dof, -1).T  # lattice indices [total, dof]
+    Q = home + (grids + n_lo) * step
+    cells = cells_of_xy(fk.tip(Q), cell, layout)
+    valid = (cells >= 0) & free[np.maximum(cells, 0)]
+    check = np.flatnonzero(valid & near[np.maximum(cells, 0)])
+    for i in check:
+        if contact.touches(Q[i]):
+            valid[i] = False
+    _progress(progress, f"  lattice {dims} = {total} points, {int(valid.sum())} over free cells")
+
+    strides = np.array([int(np.prod(dims[j + 1:])) for j in range(dof)])
+    plus = np.full((total, dof), -1, dtype=np.int64)  # neighbour along +step of joint j
+    for j in range(dof):
+        has = (grids[:, j] < dims[j] - 1) & valid
+        idx = np.flatnonzero(has)
+        idx = idx[valid[idx + strides[j]]]
+        m = max(1, int(np.ceil(2.0 * step * fk.reach_from(j) / cell)))
+        ok = np.ones(len(idx), dtype=bool)
+        near_any = np.zeros(len(idx), dtype=bool)
+        ts = np.arange(1, m + 1) / (m + 1)
+        for t in ts:
+            Qt = Q[idx].copy()
+            Qt[:, j] += t * step
+            c = cells_of_xy(fk.tip(Qt), cell, layout)
+            inside = c >= 0
+            ok &= inside & free[np.maximum(c, 0)]
+            near_any |= inside & near[np.maximum(c, 0)]
+        probe = ts[np.unique(np.linspace(0, m - 1, min(m, 3)).round().astype(int))]
+        for e in np.flatnonzero(ok & near_any):
+            for t in probe:
+                q = Q[idx[e]].copy()
+                q[j] += t * step
+                if contact.touches(q):
+                    ok[e] = False
+                    break
+        plus[idx[ok], j] = idx[ok] + strides[j]
+
+    # Breadth-first search from home over the valid edges.
+    home_flat = int(np.ravel_multi_index(tuple(-n_lo), dims))
+    if not valid[home_flat]:
+        raise UnreachableTableError("the arm's home configuration is not over a free cell of the table")
+    minus = np.full((total, dof), -1, dtype=np.int64)
+    for j in range(dof):
+        src = np.flatnonzero(plus[:, j] >= 0)
+        minus[plus[src, j], j] = src
+    seen = np.zeros(total, dtype=bool)
+    seen[home_flat] = True
+    frontier = np.array([home_flat])
+    while len(frontier):
+        nb = np.concatenate([plus[frontier].ravel(), minus[frontier].ravel()])
+        nb = np.unique(nb[nb >= 0])
+        nb = nb[~seen[nb]]
+        seen[nb] = True
+        frontier = nb
+    states = np.flatnonzero(seen)
+    n = len(states)
+    index = np.full(total, -1, dtype=np.int64)
+    index[states] = np.arange(n)
+    _progress(progress, f"  {n} lattice states reachable from home")
+
+    next_state = np.repeat(np.arange(n, dtype=np.int64)[:, None], 2 * dof, axis=1)
+    for j in range(dof):
+        for a, table in ((2 * j, plus), (2 * j + 1, minus)):
+            t = table[states, j]
+            has = t >= 0
+            next_state[has, a] = index[t[has]]
+    qpos = Q[states]
+    label = cells[states]
+    tip_xy = fk.tip(qpos)
+
+    # Wind: the state labelled with the cell to the right nearest a Jacobian step.
+    wind = np.arange(n, dtype=np.int64)
+    lx = (label % layout.width) + layout.lo
+    ly = (label // layout.width) + layout.lo
+    right = np.where(lx + 1 <= layout.hi, label + 1, -1)
+    has_right = (right >= 0) & free[np.maximum(right, 0)]
+    target = np.stack([(lx + 1) * cell, ly * cell], axis=1)
+    J = fk.jacobian(qpos)
+    dq = np.einsum("nij,nj->ni", np.linalg.pinv(J), target - tip_xy)
+    base = np.rint((qpos + dq - home) / step).astype(int) - n_lo
+    best = np.full(n, np.inf)
+    for off in itertools.product((-1, 0, 1), repeat=dof):
+        g = base + np.array(off)
+        inside = np.all((g >= 0) & (g < np.array(dims)), axis=1) & has_right
+        flat = np.where(inside, (np.clip(g, 0, np.array(dims) - 1) * strides).sum(axis=1), 0)
+        s2 = np.where(inside, index[flat], -1)
+        good = (s2 >= 0) & (label[np.maximum(s2, 0)] == right) & inside
+        dist = np.where(good, np.linalg.norm(qpos[np.maximum(s2, 0)] - qpos, axis=1), np.inf)
+        better = dist < best
+        best[better] = dist[better]
+        wind[better] = s2[better]
+
+    centres = np.stack([lx * cell, ly * cell], axis=1)
+    err = np.linalg.norm(tip_xy - centres, axis=1)
+    canonical = np.full(layout.n_cells, -1, dtype=np.int32)
+    order = np.lexsort((np.arange(n), err))  # closest to the cell centre first
+    for s in order[::-1]:
+        canonical[label[s]] = s
+    tips = np.column_stack([tip_xy, np.full(n, fk.tip_z)])
+    return dict(next_state=next_state.astype(np.int32), wind_state=wind.astype(np.int32),
+                label=label.astype(np.int32), canonical=canonical, qpos=qpos, tip=tips,
+                lattice=(grids[states] + n_lo).astype(np.int32))

@@ -1,0 +1,53 @@
+"""State labelling with mink: configuration -> tool tip position -> shared cell id.
+
+``cell_of_xy`` is the single rule every robot uses: the tip's (x, y) on the table,
+divided by the cell size and rounded, is the cell; -1 when that is off the grid.
+"""
+
+from __future__ import annotations
+
+import mink
+import numpy as np
+
+from ik.scene import ArmScene
+from tasks.layout import ROOMS, Layout
+
+OFF_TABLE = -1
+
+
+def cell_of_xy(x: float, y: float, cell: float, layout: Layout = ROOMS) -> int:
+    """The shared cell id under the point (x, y) (metres), or -1 off the grid."""
+    cx, cy = int(round(x / cell)), int(round(y / cell))
+    if not layout.in_grid(cx, cy):
+        return OFF_TABLE
+    return layout.cell(cx, cy)
+
+
+def cells_of_xy(xy: np.ndarray, cell: float, layout: Layout = ROOMS) -> np.ndarray:
+    """Vectorised ``cell_of_xy`` over points [..., 2]; -1 off the grid."""
+    c = np.rint(np.asarray(xy)[..., :2] / cell).astype(np.int64)
+    inside = np.all((c >= layout.lo) & (c <= layout.hi), axis=-1)
+    ids = (c[..., 1] - layout.lo) * layout.width + (c[..., 0] - layout.lo)
+    return np.where(inside, ids, OFF_TABLE)
+
+
+def cell_centre(cell_id: int, cell: float, layout: Layout = ROOMS) -> np.ndarray:
+    x, y = layout.xy(int(cell_id))
+    return np.array([x * cell, y * cell])
+
+
+class Labeller:
+    """mink forward kinematics of one arm scene: tip position and shared-cell label."""
+
+    def __init__(self, scene: ArmScene) -> None:
+        self.scene = scene
+        self.configuration = mink.Configuration(scene.model)
+
+    def tip(self, q: np.ndarray) -> np.ndarray:
+        self.configuration.update(np.asarray(q, dtype=float))
+        return self.configuration.get_transform_frame_to_world(self.scene.tip, "site").translation()
+
+    def label(self, q: np.ndarray) -> int:
+        """Cell id under the tip at configuration q (-1 when off the table)."""
+        p = self.tip(q)
+        return cell_of_xy(p[0], p[1], self.scene.cell, self.scene.layout)

@@ -1,0 +1,114 @@
+"""Inverse kinematics with mink: put the tool tip over a point of the table.
+
+A ``FrameTask`` on the tip site (position; for spatial arms also "tool pointing down",
+leaving the rotation about the tool axis free), a low-weight ``PostureTask`` towards the
+home configuration to pick among redundant solutions, and the joint limits
+(``ConfigurationLimit``), solved with ``mink.solve_ik(..., solver="daqp")`` and iterated
+as Gauss-Newton steps until the tip is within ``tol`` of the target.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mink
+import numpy as np
+
+from ik.scene import ArmScene
+
+TIP_HEIGHT = 0.004
+"""Height IK puts the tool tip at above the tabletop (m). Planar arms keep their own."""
+MAX_TIP_HEIGHT = 0.01
+"""A tip higher than this above the tabletop (m) is not on the table."""
+
+# Tool z axis pointing down: a rotation of pi about the world x axis.
+_DOWN = mink.SO3.from_x_radians(np.pi)
+
+
+@dataclass
+class IKResult:
+    q: np.ndarray
+    error: float
+    """Distance from the tip to the target (m)."""
+    tilt: float
+    """Angle between the tool axis and straight down (rad; 0 for planar arms)."""
+    iterations: int
+    height: float = TIP_HEIGHT
+    """Height of the tip above the tabletop (m)."""
+
+
+class TipIK:
+    def __init__(self, scene: ArmScene, tip_down: bool, posture_cost: float = 1e-3,
+                 damping: float = 1e-4, tol: float = 5e-4, tilt_tol: float = 0.05,
+                 max_iters: int = 40) -> None:
+        self.scene = scene
+        self.tip_down = tip_down
+        self.configuration = mink.Configuration(scene.model)
+        self.frame = mink.FrameTask(
+            frame_name=scene.tip, frame_type="site",
+            position_cost=np.array([1.0, 1.0, 0.0]) if scene.planar else 1.0,
+            orientation_cost=np.array([1.0, 1.0, 0.0]) if tip_down else 0.0,
+            lm_damping=1e-3,
+        )
+        self.posture = mink.PostureTask(scene.model, cost=posture_cost)
+        self.posture.set_target(scene.home)
+        self.limits = [mink.ConfigurationLimit(scene.model)]
+        self.damping = damping
+        self.tol = tol
+        self.tilt_tol = tilt_tol
+        self.max_iters = max_iters
+        self.tasks = [self.frame, self.posture]
+
+    def target_height(self, q: np.ndarray) -> float:
+        if not self.scene.planar:
+            return TIP_HEIGHT
+        self.configuration.update(q)
+        return float(self.configuration.get_transform_frame_to_world(self.scene.tip, "site").translation()[2])
+
+    def solve(self, xy: np.ndarray, q0: np.ndarray) -> IKResult:
+        """Tip over (x, y) starting from q0; returns the best configuration found."""
+        q0 = np.clip(np.asarray(q0, dtype=float), self.scene.lower + 1e-6, self.scene.upper - 1e-6)
+        target = np.array([xy[0], xy[1], self.target_height(q0)])
+        rotation = _DOWN if self.tip_down else mink.SO3.identity()
+        self.frame.set_target(mink.SE3.from_rotation_and_translation(rotation, target))
+        cfg = self.configuration
+        cfg.update(q0)
+        err = tilt = np.inf
+        it = 0
+        for it in range(1, self.max_iters + 1):
+            v = mink.solve_ik(cfg, self.tasks, 1.0, solver="daqp", damping=self.damping,
+                              limits=self.limits)
+            cfg.integrate_inplace(v, 1.0)
+            err, tilt = self._residual(target)
+            if err < self.tol * 0.2 and tilt < self.tilt_tol * 0.2:
+                break
+        height = float(cfg.get_transform_frame_to_world(self.scene.tip, "site").translation()[2])
+        return IKResult(cfg.q.copy(), float(err), float(tilt), it, height)
+
+    def solve_any(self, xy: np.ndarray, q0: np.ndarray, rng: np.random.Generator,
+                  restarts: int = 8) -> IKResult:
+        """``solve`` from q0, then from home, then from random configurations drawn with
+        ``rng`` inside the joint limits, until one succeeds; returns the best found."""
+        lo = np.maximum(self.scene.lower, -np.pi)
+        hi = np.minimum(self.scene.upper, np.pi)
+        seeds = [q0, self.scene.home] + [rng.uniform(lo, hi) for _ in range(restarts)]
+        best = None
+        for seed in seeds:
+            res = self.solve(xy, seed)
+            if self.ok(res):
+                return res
+            if best is None or res.error < best.error:
+                best = res
+        return best
+
+    def _residual(self, target: np.ndarray) -> tuple[float, float]:
+        pose = self.configuration.get_transform_frame_to_world(self.scene.tip, "site")
+        err = float(np.linalg.norm(pose.translation() - target))
+        if not self.tip_down:
+            return err, 0.0
+        z = pose.rotation().as_matrix()[:, 2]
+        return err, float(np.arccos(np.clip(-z[2], -1.0, 1.0)))
+
+    def ok(self, result: IKResult) -> bool:
+        return (result.error <= self.tol and result.tilt <= self.tilt_tol
+                and -1e-3 <= result.height <= MAX_TIP_HEIGHT)

@@ -1,0 +1,86 @@
+"""``armtransfer arms list``."""
+
+import importlib.util
+
+import pytest
+
+from armtransfer import cli
+
+
+@pytest.fixture(autouse=True)
+def setup(tmp_path_factory, monkeypatch):
+    monkeypatch.setenv("ARMTRANSFER_CACHE", str(tmp_path_factory.getbasetemp() / "armcache"))
+    # Only subcommands whose modules exist on this branch (others arrive with their issues).
+    present = {k: v for k, v in cli.COMMANDS.items()
+               if importlib.util.find_spec(f"armtransfer.commands.{v}") is not None}
+    monkeypatch.setattr(cli, "COMMANDS", present)
+
+
+def _one_line_error(capsys, argv, pattern):
+    assert cli.main(argv) == 2
+    out, err = capsys.readouterr()
+    assert err.count("\n") == 1 and err.startswith("armtransfer arms: error:"), err
+    assert "Traceback" not in err and pattern in err
+    return err
+
+
+def test_arms_list_reports_robots(capsys):
+    assert cli.main(["arms", "list", "--arm", "planar2", "--actions", "joint,cartesian"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].split()[:5] == ["robot", "dof", "actions", "states", "reach"]
+    rows = {line.split()[0]: line.split() for line in out[1:]}
+    assert set(rows) == {"planar2:joint", "planar2:cartesian"}
+    assert rows["planar2:joint"][1:3] == ["2", "4"]
+    assert rows["planar2:cartesian"][5] == "4/4"
+
+
+def test_bad_arm_xml_exits_2_with_one_line(tmp_path, capsys):
+    bad = tmp_path / "bad.xml"
+    bad.write_text("<mujoco><worldbody><body name='b'></worldbody></mujoco>")
+    _one_line_error(capsys, ["arms", "list", "--arm-xml", str(bad), "--tip-site", "tip"],
+                    "cannot load arm MJCF")
+    _one_line_error(capsys, ["arms", "list", "--arm-xml", str(tmp_path / "nope.xml"),
+                             "--tip-site", "tip"], "cannot read arm MJCF")
+
+
+def test_byo_arm_errors_exit_2(tmp_path, capsys):
+    xml = tmp_path / "slider.xml"
+    xml.write_text("""<mujoco model="slider"><worldbody><body name="b">
+      <joint name="j" type="slide" axis="1 0 0"/><geom name="g" size="0.01"/>
+      <site name="tip"/></body></worldbody></mujoco>""")
+    _one_line_error(capsys, ["arms", "list", "--arm-xml", str(xml), "--tip-site", "tip"],
+                    "no hinge joints")
+    _one_line_error(capsys, ["arms", "list", "--arm-xml", str(xml), "--tip-site", "pen"],
+                    "no site 'pen'; its sites: tip")
+
+
+def test_arms_without_list_is_not_implemented_yet(capsys):
+    _one_line_error(capsys, ["arms", "--source", "planar2:joint"], "use `armtransfer arms list`")
+
+
+def test_unknown_arm_name_lists_valid_ones(capsys):
+    _one_line_error(capsys, ["arms", "list", "--arm", "puma"], "valid arms: planar2")
+
+
+SCARA = """<mujoco model="my_scara"><worldbody>
+  <body name="upper" pos="0.05 0.02 0.15">
+    <joint name="shoulder" type="hinge" axis="0 0 1" range="-3 3"/>
+    <geom name="upper_geom" type="capsule" size="0.01" fromto="0 0 0 0.24 0 0"/>
+    <body name="fore" pos="0.24 0 -0.03">
+      <joint name="elbow" type="hinge" axis="0 0 1" range="-2.9 2.9"/>
+      <geom name="fore_geom" type="capsule" size="0.01" fromto="0 0 0 0.2 0 0"/>
+      <geom name="pen" type="cylinder" size="0.0015" fromto="0.2 0 0 0.2 0 -0.115"/>
+      <site name="pen_tip" pos="0.2 0 -0.116"/>
+    </body>
+  </body></worldbody></mujoco>"""
+
+
+def test_arms_list_includes_a_bring_your_own_arm(tmp_path, capsys):
+    xml = tmp_path / "my_scara.xml"
+    xml.write_text(SCARA)
+    argv = ["arms", "list", "--arm", "planar2", "--actions", "joint", "--arm-xml", str(xml),
+            "--tip-site", "pen_tip", "--base-pos=-0.1,0,0"]
+    assert cli.main(argv) == 0
+    rows = {line.split()[0]: line.split() for line in capsys.readouterr().out.splitlines()[1:]}
+    assert set(rows) == {"planar2:joint", "my_scara:joint"}
+    assert rows["my_scara:joint"][1] == "2"
