@@ -35,43 +35,67 @@ def run_local(
     runs: list[dict], robots: dict[str, DiscreteRobot], workers: int, on_done: Done, on_failed: Failed,
     retries: int = 2, fn: Callable = execute,
 ) -> None:
-    """A process pool over this machine's cores; a broken pool is rebuilt and its runs retried.
+    """A process pool over this machine's cores.
 
-    ``fn(run, robots) -> (result, seconds)`` is what a worker runs (tests inject faults here)."""
-    attempts = {r["key"]: 0 for r in runs}
-    pending = list(runs)
+    At most ``workers`` runs are in flight, so when a worker dies the runs that may have
+    killed it are known: each of them is then retried alone in a fresh one-worker pool,
+    where a crash is its own, and counted against it (up to ``retries`` retries).
+    ``fn(run, robots) -> (result, seconds)`` is what a worker runs (tests inject faults here).
+    """
     ctx = multiprocessing.get_context("spawn")
-    while pending:
-        needed = {r["source"] for r in pending} | {r["target"] for r in pending}
-        subset = {k: v for k, v in robots.items() if k in needed}
-        broken = False
+    queue = list(runs)
+    suspects: list[dict] = []
+    attempts = {r["key"]: 0 for r in runs}
+
+    def finish(fut, run) -> bool:
+        """Report a finished future; False when its pool broke."""
+        try:
+            result, secs = fut.result()
+        except BrokenProcessPool:
+            return False
+        except ArmTransferError as err:
+            on_failed(run, str(err), attempts[run["key"]] + 1)
+        except Exception as err:  # noqa: BLE001 - recorded, not lost
+            on_failed(run, f"{type(err).__name__}: {err}", attempts[run["key"]] + 1)
+        else:
+            on_done(run, result, secs)
+        return True
+
+    while queue or suspects:
+        if suspects:
+            run = suspects.pop(0)
+            with ProcessPoolExecutor(max_workers=1, mp_context=ctx, initializer=_worker_init) as pool:
+                fut = pool.submit(fn, run, _robots_for([run], robots))
+                wait([fut])
+                if not finish(fut, run):
+                    attempts[run["key"]] += 1
+                    if attempts[run["key"]] > retries:
+                        on_failed(run, "worker process died", attempts[run["key"]])
+                    else:
+                        suspects.append(run)
+            continue
         with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init) as pool:
-            futures = {pool.submit(fn, run, subset): run for run in pending}
-            pending = []
-            not_done = set(futures)
-            while not_done:
-                finished, not_done = wait(not_done, return_when=FIRST_COMPLETED)
+            shared = _robots_for(queue, robots)
+            in_flight: dict = {}
+            while queue or in_flight:
+                while queue and len(in_flight) < workers:
+                    run = queue.pop(0)
+                    in_flight[pool.submit(fn, run, shared)] = run
+                finished, _ = wait(list(in_flight), return_when=FIRST_COMPLETED)
+                broken = False
                 for fut in finished:
-                    run = futures[fut]
-                    try:
-                        result, secs = fut.result()
-                    except BrokenProcessPool:
+                    run = in_flight.pop(fut)
+                    if not finish(fut, run):
                         broken = True
-                        attempts[run["key"]] += 1
-                        if attempts[run["key"]] > retries:
-                            on_failed(run, "worker process died", attempts[run["key"]])
-                        else:
-                            pending.append(run)
-                        continue
-                    except ArmTransferError as err:
-                        on_failed(run, str(err), attempts[run["key"]] + 1)
-                        continue
-                    except Exception as err:  # noqa: BLE001 - recorded, not lost
-                        on_failed(run, f"{type(err).__name__}: {err}", attempts[run["key"]] + 1)
-                        continue
-                    on_done(run, result, secs)
-        if broken:
-            pending.sort(key=lambda r: r["key"])
+                        suspects.append(run)
+                if broken:  # every run still in flight may be the culprit
+                    suspects.extend(in_flight.values())
+                    break
+
+
+def _robots_for(runs: list[dict], robots: dict[str, DiscreteRobot]) -> dict[str, DiscreteRobot]:
+    needed = {r["source"] for r in runs} | {r["target"] for r in runs}
+    return {k: v for k, v in robots.items() if k in needed}
 
 
 def _import_ray():
