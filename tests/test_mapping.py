@@ -263,3 +263,67 @@ def test_run_mapping_learns_from_converged_trials_and_reports_the_fraction():
     res2, learned2 = experiment.run_mapping(fine, start, goal, t, learned, 3, 0, config)
     assert all(f is not None and 0.0 <= f <= 1.0 for f in res2.extra["mapped_fraction"])
     assert sum(e.count for e in learned2.entries.values()) > sum(e.count for e in learned.entries.values())
+
+
+# ------------------------------------------------------------------------------- CLI
+
+
+def test_rooms_method_mapping_learns_saves_and_reuses_the_mapping(tmp_path, capsys):
+    mfile = tmp_path / "maps" / "coarse-fine.json"
+    out1, out2 = tmp_path / "a.json", tmp_path / "b.json"
+    args = ["rooms", "--method", "mapping", "--mapping", str(mfile), "--trials", "2"]
+    assert main([*args, "--start", "0,0", "--goal", "6,8", "--json", str(out1)]) == 0
+    printed = capsys.readouterr().out
+    assert "no mapping was available" in printed and "equals 'pseudo'" in printed
+    first = ActionMapping.load(mfile)
+    assert (first.source, first.target) == ("coarse", "fine") and len(first) > 0
+    d1 = json.loads(out1.read_text())
+    assert d1["results"]["mapping"]["mapped_fraction"] == [None, None]
+    assert d1["mapping"]["entries_before"] == 0 and d1["mapping"]["entries_after"] == len(first)
+
+    assert main([*args, "--start", "0,0", "--goal", "8,10", "--json", str(out2)]) == 0
+    printed = capsys.readouterr().out
+    assert "macros at" in printed and "saved to" in printed
+    d2 = json.loads(out2.read_text())
+    fr = d2["results"]["mapping"]["mapped_fraction"]
+    assert len(fr) == 2 and all(f is None or 0.0 <= f <= 1.0 for f in fr)
+    assert d2["mapping"]["macro_states"] > 0
+    second = ActionMapping.load(mfile)
+    assert sum(e.count for e in second.entries.values()) > sum(e.count for e in first.entries.values())
+
+
+def test_rooms_mapping_without_a_file_says_so(capsys):
+    assert main(["rooms", "--start", "0,0", "--goal", "4,4", "--method", "pseudo", "mapping", "--trials", "1"]) == 0
+    printed = capsys.readouterr().out
+    assert "no mapping was available (no mapping file given)" in printed
+    assert "not saved" in printed
+
+
+def _one_line_exit_2(args, capsys, message):
+    code = main(args)
+    err = capsys.readouterr().err
+    assert code == 2
+    assert message in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+def test_rooms_refuses_a_mapping_for_another_robot_pair(tmp_path, capsys):
+    mfile = tmp_path / "m.json"
+    m = ActionMapping.for_robots(grid_robot("fine"), grid_robot("coarse"))
+    m.add([0, 0], [0])
+    m.save(mfile)
+    before = mfile.read_bytes()
+    _one_line_exit_2(["rooms", "--task", "1", "--method", "mapping", "--mapping", str(mfile), "--trials", "1"],
+                     capsys, "the mapping is for fine -> coarse, not coarse -> fine")
+    assert mfile.read_bytes() == before  # untouched
+
+
+def test_rooms_mapping_bad_input(tmp_path, capsys):
+    bad = tmp_path / "bad.json"
+    bad.write_text("{nope")
+    _one_line_exit_2(["rooms", "--method", "mapping", "--mapping", str(bad), "--trials", "1"], capsys, "not valid JSON")
+    _one_line_exit_2(["rooms", "--method", "pseudo", "--mapping", str(bad), "--trials", "1"], capsys,
+                     "--mapping goes with --method mapping")
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    _one_line_exit_2(["rooms", "--method", "mapping", "--mapping", str(blocker / "m.json"), "--trials", "1"],
+                     capsys, "cannot write")

@@ -301,9 +301,16 @@ class ActionMapping:
         return m
 
     def save(self, path: str | os.PathLike) -> None:
-        from transfer.io import write_json_atomic
+        """Write the JSON form atomically, one entry per line (easy to read and diff)."""
+        from transfer.io import write_text_atomic
 
-        write_json_atomic(path, self.to_json())
+        data = self.to_json()
+        entries = data.pop("entries")
+        head = ",\n".join(f"  {json.dumps(k)}: {json.dumps(v)}" for k, v in data.items())
+        lines = [json.dumps(e) for e in entries]
+        body = ",\n    ".join(lines)
+        text = "{\n" + head + ',\n  "entries": [' + ("\n    " + body + "\n  " if lines else "") + "]\n}\n"
+        write_text_atomic(path, text)
 
     @staticmethod
     def load(path: str | os.PathLike) -> "ActionMapping":
