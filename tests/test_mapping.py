@@ -327,3 +327,24 @@ def test_rooms_mapping_bad_input(tmp_path, capsys):
     blocker.write_text("x")
     _one_line_exit_2(["rooms", "--method", "mapping", "--mapping", str(blocker / "m.json"), "--trials", "1"],
                      capsys, "cannot write")
+
+
+def test_reproduce_reports_the_mapping_columns_beside_the_papers(tmp_path, capsys):
+    out = tmp_path / "rep"
+    assert main(["reproduce", "--trials", "2", "--out", str(out)]) == 0
+    report = (out / "report.md").read_text()
+    for heading in ("Table II D-F", "Table V D-E", "Table III analog: coarse -> fine",
+                    "Table III analog: fine -> coarse", "under wind 0.01", "Fig. 7 analog"):
+        assert heading in report, heading
+    assert "1,039.6" in report and "85.83" in report  # the paper's D and F for task 2
+    assert (out / "fig7_mapping.png").stat().st_size > 1000
+    res = json.loads((out / "results.json").read_text())
+    for key in ("mapping_coarse_fine", "mapping_fine_coarse", "mapping_wind"):
+        tasks = res[key]["tasks"]
+        assert tasks["1"]["entries_before"] == 0 < tasks["2"]["entries_before"] <= tasks["4"]["entries_before"]
+        assert tasks["2"]["ci95"] is not None and tasks["2"]["improvement_ci95"] is not None
+        m = ActionMapping.load(out / f"{key}.json")
+        assert len(m) == tasks["4"]["entries_after"]
+    # task 1 has no mapping yet: it is the pseudo method, bit for bit
+    assert res["mapping_coarse_fine"]["tasks"]["1"]["exploration_steps"] == \
+        res["table_ii"]["1"]["results"]["pseudo"]["exploration_steps"]

@@ -35,6 +35,18 @@ the largest position with a mapped key wins, as for pseudo rewards: the loop is 
 The kernel runs the macro with probability 1 - epsilon at such a state, each primitive step
 being an ordinary SARSA(lambda) step, and abandons it when a step is blocked.
 
+Macros are offered during the *exploration phase*, the first episode (until the goal is
+first reached; ``MacroTable(episodes=...)`` changes this). Offered in every episode they
+stop learning from converging: Q starts at 0 and every step costs, so the greedy path
+prefers untried actions; following macros 90% of the time, the robot hardly ever tries
+the other actions along the mapped path, its greedy path keeps turning into them and
+loops. On Table I tasks 2-4 (coarse -> fine, seed 0) none of 10 trials per task converged
+within 2000 episodes that way; with macros in the first episode only, every trial did.
+
+Across tasks and trials (``transfer.experiment.run_mapping``): every trial of a task uses
+the mapping of the earlier tasks only, so trials stay independent and deterministic; the
+mapping is then updated from each converged trial's greedy path, in trial order.
+
 Mapped fraction (Table II column E)
 -----------------------------------
 ``mapped_fraction`` of a converged greedy path is the fraction of its primitive steps
