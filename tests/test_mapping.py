@@ -348,3 +348,28 @@ def test_reproduce_reports_the_mapping_columns_beside_the_papers(tmp_path, capsy
     # task 1 has no mapping yet: it is the pseudo method, bit for bit
     assert res["mapping_coarse_fine"]["tasks"]["1"]["exploration_steps"] == \
         res["table_ii"]["1"]["results"]["pseudo"]["exploration_steps"]
+
+
+def test_macros_in_every_episode_keep_the_greedy_path_from_converging():
+    """Why macros are offered in the first episode only (see transfer.mapping)."""
+    from tasks.catalog import TABLE_I
+
+    coarse, fine = grid_robot("coarse"), grid_robot("fine")
+    config = LearnerConfig()
+    s1, g1 = TABLE_I[1].cells()
+    t1 = trajectories.shortest(coarse, s1, g1)
+    _, m = experiment.run_mapping(fine, s1, g1, t1, ActionMapping.for_robots(coarse, fine), 10, 0, config)
+    s2, g2 = TABLE_I[2].cells()
+    t2 = trajectories.shortest(coarse, s2, g2)
+    shaping = rewards.build("mapping", fine, t2, "auto", config.step_reward, config.gamma)
+    start = fine.start_state(s2)
+    first = MacroTable(m, t2, fine)
+    every = MacroTable(m, t2, fine, episodes=None)
+    conv_first = conv_every = 0
+    for trial in range(10):
+        rng = experiment.trial_rng(0, trial)
+        conv_first += sarsa.learn(fine, start, g2, config, rng, shaping=shaping, macros=first).converged
+        rng = experiment.trial_rng(0, trial)
+        conv_every += sarsa.learn(fine, start, g2, config, rng, shaping=shaping, macros=every).converged
+    assert conv_first == 10
+    assert conv_every == 0
