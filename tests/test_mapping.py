@@ -12,7 +12,7 @@ from tasks.layout import ROOMS, Layout
 from transfer import experiment, reference, rewards, sarsa
 from transfer import trajectory as trajectories
 from transfer.config import LearnerConfig
-from transfer.mapping import ActionMapping, MacroTable, chain, load_for, observe
+from transfer.mapping import ActionMapping, MacroTable, chain, load_for
 
 # A 7 x 7 open world (no walls) and the 7 x 7 two-room world of test_sarsa.
 OPEN = Layout(lo=-3, hi=3, walls=(), doors=())
