@@ -23,3 +23,7 @@ class InvalidTrajectoryError(ArmTransferError):
 
 class InvalidParameterError(ArmTransferError):
     """A learning parameter is out of range (e.g. a farmable K, non-positive trials)."""
+
+
+class InvalidMappingError(ArmTransferError):
+    """An action sequence mapping file is malformed or made for another robot pair."""

@@ -17,6 +17,7 @@ from tasks.robot import DiscreteRobot
 from transfer import metrics, rewards, sarsa
 from transfer import trajectory as trajectories
 from transfer.config import LearnerConfig
+from transfer.mapping import DEFAULT_MAX_SPAN, ActionMapping, MacroTable
 from transfer.trajectory import Trajectory
 
 BASE_METHODS = ("none", "pseudo", "first-visit", "potential", "progress")
@@ -95,6 +96,47 @@ def run_method(
     if shaping is not None:
         out.extra["K"] = shaping.K
     return out
+
+
+def run_mapping(
+    target: DiscreteRobot,
+    start_cell: int,
+    goal_cell: int,
+    traj: Trajectory,
+    mapping: ActionMapping,
+    trials: int,
+    seed: int,
+    config: LearnerConfig,
+    wind: float = 0.0,
+    K: float | str | None = "auto",
+    on_trial: Callable[[], None] | None = None,
+    max_span: int = DEFAULT_MAX_SPAN,
+) -> tuple[MethodResult, ActionMapping]:
+    """Method ``mapping``: pseudo rewards plus the macros ``mapping`` gives on ``traj``.
+
+    Every trial uses ``mapping`` as given (the mappings of earlier tasks only), so trials
+    stay independent and deterministic. Returns the result, with ``mapped_fraction`` per
+    trial in ``extra``, and a new mapping: ``mapping`` plus what each converged trial's
+    greedy path teaches, added in trial order.
+    """
+    table = MacroTable(mapping, traj, target)
+    res = run_method(
+        "mapping", target, start_cell, goal_cell, traj, trials, seed, config,
+        wind=wind, K=K, macros=table if len(table) else None, on_trial=on_trial,
+    )
+    learned = mapping.copy()
+    fractions = []
+    for t in res.trials:
+        fractions.append(table.mapped_fraction(target, t.greedy_path) if t.converged else None)
+        if t.converged:
+            learned.learn_from(target, t.greedy_path, traj, max_span)
+    res.extra.update(
+        mapped_fraction=fractions,
+        macro_states=len(table),
+        macro_steps_first_episode=[int(t.macro_steps[0]) if len(t.macro_steps) else 0 for t in res.trials],
+        mapping_entries_used=len(mapping),
+    )
+    return res, learned
 
 
 def summarize(results: Sequence[MethodResult], baseline: str = "none") -> dict:

@@ -69,3 +69,37 @@ def learning_curves(
     ax.legend()
     ax.grid(alpha=0.3)
     _save(fig, path)
+
+
+def mapping_paths(
+    wall_mask: np.ndarray,
+    lo: int,
+    source_cells: list[list[int]],
+    target_cells: list[list[int]],
+    segments: list[list[int]],
+    title: str,
+    path: str | os.PathLike,
+) -> None:
+    """Fig. 7 analog: the rooms map, the source robot's trajectory (dashed), the target's
+    greedy path (solid) and the target's mapped fragments (thick). ``segments`` are
+    [j0, j1) step ranges of the target path."""
+    fig, ax = plt.subplots(figsize=(6.5, 6.5))
+    hi = lo + wall_mask.shape[0] - 1
+    ax.imshow(wall_mask, origin="lower", cmap="Greys", extent=(lo - 0.5, hi + 0.5, lo - 0.5, hi + 0.5),
+              vmin=0, vmax=1.4)
+    src = np.asarray(source_cells, dtype=float)
+    tgt = np.asarray(target_cells, dtype=float)
+    ax.plot(src[:, 0], src[:, 1], "--o", color="tab:blue", ms=3, lw=1.2, label="source trajectory")
+    ax.plot(tgt[:, 0], tgt[:, 1], "-", color="tab:orange", lw=1.2, label="target greedy path")
+    for k, (j0, j1) in enumerate(segments):
+        seg = tgt[j0 : j1 + 1]
+        ax.plot(seg[:, 0], seg[:, 1], "-", color="tab:red", lw=4, alpha=0.6,
+                label="mapped fragment" if k == 0 else None)
+    ax.plot(*src[0], "s", color="green", ms=8, label="start")
+    ax.plot(*src[-1], "*", color="black", ms=12, label="goal")
+    ax.set_xlim(lo - 0.5, hi + 0.5)
+    ax.set_ylim(lo - 0.5, hi + 0.5)
+    ax.set_aspect("equal")
+    ax.set_title(title)
+    ax.legend(loc="lower right", fontsize=8)
+    _save(fig, path)

@@ -46,8 +46,32 @@ def learn(
     traj: Trajectory | None = None,
     K: float = 0.0,
     wind: float = 0.0,
+    macros=None,
 ) -> tuple[np.ndarray, list[int]]:
-    """Run ``episodes`` episodes; returns (Q, steps per episode)."""
+    """Run ``episodes`` episodes; returns (Q, steps per episode).
+
+    ``macros`` (a ``transfer.mapping.MacroTable``): at a state with a macro, when none is
+    running, one draw u and the macro's target sequence runs when u < 1 - epsilon; its
+    steps are ordinary steps; it is abandoned when a step is blocked, and then the next
+    action is epsilon-greedy without a macro draw.
+    """
+    seq_at: dict[int, list[int]] = {}
+    if macros is not None:
+        m_start, m_len, m_actions = macros.arrays(robot)
+        for s in range(robot.n_states):
+            if m_len[s] > 0:
+                seq_at[s] = [int(x) for x in m_actions[m_start[s] : m_start[s] + m_len[s]]]
+
+    def choose(s: int, pending: list[int], may_start: bool) -> tuple[int, list[int], bool]:
+        """The next action, what remains of the running macro, and whether the action is
+        a macro's."""
+        if pending:
+            return pending[0], pending[1:], True
+        if may_start and s in seq_at and rng.random() < 1.0 - config.epsilon:
+            seq = seq_at[s]
+            return seq[0], seq[1:], True
+        return _egreedy(Q[s], config.epsilon, rng), [], False
+
     alpha, gamma = config.alpha, config.gamma
     decay = gamma * config.lam
     Q = np.zeros((robot.n_states, robot.n_actions))
@@ -55,11 +79,12 @@ def learn(
     for _ in range(episodes):
         e = np.zeros_like(Q)  # Initialize e(s, a) = 0 for all s, a
         s = start_state  # Initialize s, a
-        a = _egreedy(Q[s], config.epsilon, rng)
+        a, pending, from_macro = choose(s, [], True)
         steps = 0
         while True:  # repeat
             # Take action a and observe next state s' and reward r
             s2 = int(robot.next_state[s, a])
+            blocked = s2 == s
             if wind > 0.0 and rng.random() < wind:
                 s2 = int(robot.wind_state[s2])
             steps += 1
@@ -69,7 +94,10 @@ def learn(
             if terminal:
                 a2, q_next = 0, 0.0
             else:
-                a2 = _egreedy(Q[s2], config.epsilon, rng)
+                abandoned = from_macro and blocked
+                if abandoned:
+                    pending = []
+                a2, pending, from_macro = choose(s2, pending, not abandoned)
                 q_next = Q[s2, a2]
             # delta <- r' + r + gamma Q(s', a') - Q(s, a)  (r' = 0 off the trajectory)
             r_prime = pseudo_reward(robot, traj, K, s2)

@@ -19,8 +19,13 @@ to 0, and the result is bit-for-bit the dense Algorithm 1 (``transfer.reference`
 test checks.
 
 The random stream, in the order it is drawn (the dense reference draws the same):
-  1. choosing an action at a state with a macro (``transfer.mapping``): one draw u,
-     the macro runs when u < 1 - epsilon;
+  1. choosing an action at a state with a macro (``transfer.mapping``), when no macro is
+     running: one draw u, the macro runs when u < 1 - epsilon. A running macro supplies
+     its next action without a draw; it ends after its last action, or is abandoned when
+     a step is blocked (s' == s before wind). Right after an abandoned macro the next
+     action is Algorithm 1's (no draw for a macro), so a macro blocked at its first step
+     is not retried at once; after a macro that ran to its end, a macro at the state
+     reached may start (macros chain);
   2. epsilon-greedy: one draw u; if u < epsilon one more draw picks the action as
      floor(u2 * n_actions); otherwise, when k > 1 actions tie for the largest Q, one more
      draw picks the floor(u2 * k)-th of them in index order;
@@ -133,6 +138,7 @@ def _run_trial(
     macro_start,
     macro_len,
     macro_actions,
+    macro_episodes,
     alpha,
     gamma,
     lam,
@@ -169,8 +175,9 @@ def _run_trial(
     stable = 0
     converged_episode = -1
     episodes = 0
-    use_macros = macro_actions.shape[0] > 0
+    has_macros = macro_actions.shape[0] > 0
     for ep in range(max_episodes):
+        use_macros = has_macros and ep < macro_episodes
         # reset traces
         for k in range(n_tr):
             pos[tr_sa[k]] = -1
@@ -215,13 +222,15 @@ def _run_trial(
                 q_next = 0.0
                 a2 = 0
             else:
+                abandoned = False
                 if in_macro and (blocked or m_pos >= m_end):
+                    abandoned = blocked
                     in_macro = False
                 if in_macro:
                     a2 = macro_actions[m_pos]
                     m_pos += 1
                     macro_used += 1
-                elif use_macros and macro_len[s2] > 0 and rng.random() < 1.0 - eps:
+                elif use_macros and not abandoned and macro_len[s2] > 0 and rng.random() < 1.0 - eps:
                     m_pos = macro_start[s2]
                     m_end = m_pos + macro_len[s2]
                     a2 = macro_actions[m_pos]
@@ -330,19 +339,22 @@ def learn(
     """Run one trial of SARSA(lambda) on ``robot`` from ``start_state`` to ``goal_cell``.
 
     ``shaping`` is a :class:`transfer.rewards.Shaping` (None: no transfer); ``macros`` a
-    :class:`transfer.mapping.MacroTable` (None: no action sequence mapping). ``rng`` is the
-    only source of randomness.
+    :class:`transfer.mapping.MacroTable` (None: no action sequence mapping); its attribute
+    ``episodes`` (None: all) says in how many first episodes macros are offered. ``rng`` is
+    the only source of randomness.
     """
     from transfer.rewards import Shaping
 
     n = robot.n_states
     sh = shaping if shaping is not None else Shaping.none(n)
+    m_episodes = None
     if macros is None:
         m_start = np.zeros(n, np.int64)
         m_len = np.zeros(n, np.int64)
         m_actions = np.zeros(0, np.int64)
     else:
         m_start, m_len, m_actions = macros.arrays(robot)
+        m_episodes = getattr(macros, "episodes", None)
     Q = np.zeros((n, robot.n_actions)) if q_init is None else np.array(q_init, dtype=np.float64)
     E = config.max_episodes
     episode_steps = np.zeros(E, np.int64)
@@ -353,7 +365,7 @@ def learn(
     episodes, conv_ep, path_n = _run_trial(
         robot.next_state, robot.wind_state, robot.label, int(start_state), int(goal_cell),
         sh.mode, sh.bonus, sh.traj_index, sh.phi,
-        m_start, m_len, m_actions,
+        m_start, m_len, m_actions, config.max_episodes if m_episodes is None else int(m_episodes),
         config.alpha, config.gamma, config.lam, config.epsilon,
         config.step_reward, config.goal_reward, float(wind), config.trace_cutoff,
         config.max_episodes, config.max_total_steps, config.max_episode_steps, config.patience,

@@ -1,4 +1,4 @@
-"""armtransfer reproduce: the paper's Tables II, IV, V and Fig. 4-6 on our rooms world."""
+"""armtransfer reproduce: the paper's Tables II-V and Fig. 4-7 on our rooms world."""
 
 from __future__ import annotations
 
@@ -9,7 +9,9 @@ from pathlib import Path
 from armtransfer.commands import common
 from transfer import figures
 from transfer import reproduce as rep
+from tasks.layout import ROOMS
 from transfer.config import LearnerConfig
+from transfer.mapping import ActionMapping
 from transfer.io import check_writable, write_json_atomic, write_text_atomic
 
 HELP = "Reproduce the paper's tables and figures on the rooms world; writes report.md."
@@ -41,16 +43,26 @@ def run(args: argparse.Namespace) -> int:
     with common.progress_bar(rep.plan(args.trials), "reproduce") as bar:
         res = rep.run_all(args.trials, args.seed, config, tick=bar.update)
     groups = [f"task {t}" for t in rep.TASKS]
-    names = {"fig4": "fig4_coarse_to_fine.png", "fig5": "fig5_fine_to_coarse.png", "fig6": "fig6_wind.png"}
+    names = {"fig4": "fig4_coarse_to_fine.png", "fig5": "fig5_fine_to_coarse.png", "fig6": "fig6_wind.png",
+             "fig7": "fig7_mapping.png"}
     figures.bar_chart(groups, _bars(res["table_ii"], "table_ii"),
                       "Fig. 4 analog: coarse -> fine", "exploration steps to the goal", out / names["fig4"])
     figures.bar_chart(groups, _bars(res["table_v"], "table_v"),
                       "Fig. 5 analog: fine -> coarse", "exploration steps to the goal", out / names["fig5"])
     figures.bar_chart(groups, _bars(res["wind"], "wind"),
                       "Fig. 6 analog: coarse -> fine, wind 0.01", "exploration steps to the goal", out / names["fig6"])
+    fig = res["mapping_coarse_fine"]["figure"]
+    if fig is not None:
+        figures.mapping_paths(ROOMS.wall_mask, ROOMS.lo, fig["source_cells"], fig["target_cells"], fig["segments"],
+                              f"Fig. 7 analog: task {fig['task']}, coarse -> fine, mapped fragments",
+                              out / names["fig7"])
+    for key in ("mapping_coarse_fine", "mapping_fine_coarse", "mapping_wind"):
+        ActionMapping.from_json(res[key]["mapping"]).save(out / f"{key}.json")
     write_json_atomic(out / "results.json", res)
     # report.md last: its presence means everything else was written
     write_text_atomic(out / "report.md", rep.report_markdown(res, names))
     print(f"wrote {out / 'report.md'} ({time.perf_counter() - t0:.0f} s)")
     print(rep.table_ii_markdown(res["table_ii"], rep.paper.TABLE_II, "Table II A-C: coarse -> fine"))
+    print()
+    print(rep.table_ii_mapping_markdown(res))
     return 0
