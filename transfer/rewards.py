@@ -38,6 +38,13 @@ class Shaping:
     K: float = 0.0
 
     @staticmethod
+    def potential(phi: np.ndarray, K: float = 0.0) -> "Shaping":
+        """Potential-based shaping F = gamma * phi(s') - phi(s) with the given potential."""
+        n = len(phi)
+        return Shaping(sarsa.MODE_POTENTIAL, np.zeros(n), np.full(n, -1, np.int64),
+                       np.asarray(phi, dtype=np.float64), K)
+
+    @staticmethod
     def none(n_states: int) -> "Shaping":
         return Shaping(
             sarsa.MODE_NONE, np.zeros(n_states), np.full(n_states, -1, np.int64), np.zeros(n_states)
