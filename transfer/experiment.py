@@ -20,7 +20,10 @@ from transfer.config import LearnerConfig
 from transfer.mapping import DEFAULT_MAX_SPAN, ActionMapping, MacroTable
 from transfer.trajectory import Trajectory
 
-BASE_METHODS = ("none", "pseudo", "first-visit", "potential", "progress")
+SHAPING_METHODS = ("pseudo", "first-visit", "potential", "progress", "dense")
+METHODS = ("none", *SHAPING_METHODS, "mapping")
+"""Every method: ``none`` (Algorithm 1 without transfer), the paper's ``pseudo`` and
+``mapping``, and the methods new here (see ``transfer.rewards`` and ``transfer.potentials``)."""
 
 
 def trial_rng(seed: int, trial: int, stream: int = 0) -> np.random.Generator:
@@ -66,7 +69,7 @@ def run_method(
     target: DiscreteRobot,
     start_cell: int,
     goal_cell: int,
-    traj: Trajectory | None,
+    traj: Trajectory | Sequence[Trajectory] | None,
     trials: int,
     seed: int,
     config: LearnerConfig,
@@ -74,6 +77,8 @@ def run_method(
     K: float | str | None = "auto",
     macros=None,
     on_trial: Callable[[], None] | None = None,
+    beta: float = rewards.potentials.DENSE_BETA,
+    label: str | None = None,
 ) -> MethodResult:
     """``trials`` independent trials of one method on the target robot."""
     if trials < 1:
@@ -82,9 +87,9 @@ def run_method(
     if method != "none":
         if traj is None:
             raise InvalidParameterError(f"method {method!r} needs a trajectory")
-        shaping = rewards.build(method, target, traj, K, config.step_reward, config.gamma)
+        shaping = rewards.build(method, target, traj, K, config.step_reward, config.gamma, beta=beta)
     start_state = target.start_state(start_cell)
-    out = MethodResult(method)
+    out = MethodResult(label or method)
     for trial in range(trials):
         res = sarsa.learn(
             target, start_state, goal_cell, config, trial_rng(seed, trial),
@@ -172,3 +177,99 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none") -> dict:
         entry.update(r.extra)
         out[r.method] = entry
     return out
+
+
+def control_trajectories(
+    kind: str, source: DiscreteRobot, trajs: Sequence[Trajectory], seed: int
+) -> list[Trajectory]:
+    """``shuffled`` or ``random`` stand-ins for the real trajectories, seeded by ``seed``."""
+    from transfer import controls
+
+    rng = np.random.default_rng(np.random.SeedSequence([int(seed), 2, controls.CONTROLS.index(kind)]))
+    if kind == "shuffled":
+        return [controls.shuffled(t, rng) for t in trajs]
+    return [controls.random_walk(source, t, rng) for t in trajs]
+
+
+def add_transfer_metrics(summary: dict, optimal: int, baseline: str = "none") -> None:
+    """Add Taylor and Stone's metrics (``transfer.learning_metrics``) to every method."""
+    from transfer import learning_metrics as lm
+
+    base = summary.get(baseline)
+    if base is None:
+        return
+    ref_first, ref_area = lm.baseline_reference(list(zip(base["episode_steps"], base["greedy_steps"])))
+    for entry in summary.values():
+        per_trial = [
+            lm.trial_metrics(ep, g, optimal, ref_first, ref_area)
+            for ep, g in zip(entry["episode_steps"], entry["greedy_steps"])
+        ]
+        block = {}
+        for name in ("jumpstart", "time_to_threshold", "area", "transfer_ratio", "asymptotic"):
+            values = [m[name] for m in per_trial]
+            mean, ci = metrics.mean_ci(values)
+            block[name] = {"per_trial": values, "mean": mean, "ci95": ci}
+        block["threshold"] = f"episode <= {lm.THRESHOLD:g} x optimal ({optimal})"
+        block["horizon_episodes"] = lm.HORIZON
+        entry["transfer_metrics"] = block
+
+
+def run_transfer(
+    source: DiscreteRobot,
+    target: DiscreteRobot,
+    start_cell: int,
+    goal_cell: int,
+    methods: Sequence[str],
+    trajs: Sequence[Trajectory],
+    trials: int,
+    seed: int,
+    config: LearnerConfig,
+    wind: float = 0.0,
+    K: float | str | None = "auto",
+    beta: float = rewards.potentials.DENSE_BETA,
+    mapping: ActionMapping | None = None,
+    max_span: int = DEFAULT_MAX_SPAN,
+    controls: bool = True,
+    tick: Callable[[], None] | None = None,
+) -> tuple[dict, ActionMapping | None]:
+    """Every method on one task, plus the controls, summarised: the ``results`` block of
+    the JSON that ``armtransfer rooms`` and ``armtransfer arms`` write. Returns it and,
+    for ``mapping``, the mapping updated from this task's converged trials."""
+    for m in methods:
+        if m not in METHODS:
+            raise InvalidParameterError(f"unknown method {m!r}; valid methods: {', '.join(METHODS)}")
+    if any(m != "none" for m in methods) and not trajs:
+        raise InvalidParameterError("the transfer methods need a trajectory")
+    if "mapping" in methods and len(trajs) != 1:
+        raise InvalidParameterError("method 'mapping' takes exactly one trajectory")
+    results: list[MethodResult] = []
+    learned = None
+    kw = dict(wind=wind, K=K, on_trial=tick)
+    for method in methods:
+        if method == "mapping":
+            if mapping is None:
+                mapping = ActionMapping.for_robots(source, target)
+            res, learned = run_mapping(target, start_cell, goal_cell, trajs[0], mapping, trials, seed,
+                                       config, max_span=max_span, **kw)
+            results.append(res)
+        else:
+            results.append(run_method(method, target, start_cell, goal_cell, trajs if method != "none" else None,
+                                      trials, seed, config, beta=beta, **kw))
+    if controls:
+        for kind in ("shuffled", "random"):
+            fake = control_trajectories(kind, source, trajs, seed)
+            for method in methods:
+                if method in SHAPING_METHODS:
+                    results.append(run_method(method, target, start_cell, goal_cell, fake, trials, seed, config,
+                                              beta=beta, label=f"{method} [{kind}]", **kw))
+    summary = summarize(results, baseline="none" if "none" in methods else "")
+    path = target.shortest_path(target.start_state(start_cell), goal_cell)
+    if path is not None:
+        add_transfer_metrics(summary, len(path) - 1)
+    return summary, learned
+
+
+def count_trials(methods: Sequence[str], trials: int, controls: bool) -> int:
+    """How many trials ``run_transfer`` runs (for progress bars)."""
+    shaped = sum(m in SHAPING_METHODS for m in methods)
+    return trials * (len(methods) + (2 * shaped if controls else 0))

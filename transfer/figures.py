@@ -29,9 +29,10 @@ def bar_chart(
     title: str,
     ylabel: str,
     path: str | os.PathLike,
+    log: bool = False,
 ) -> None:
     """Grouped bars: ``series`` maps a label to (means per group, 95% CIs per group)."""
-    fig, ax = plt.subplots(figsize=(7, 4))
+    fig, ax = plt.subplots(figsize=(7 if len(series) < 4 else 9, 4))
     n = len(series)
     width = 0.8 / max(n, 1)
     x = np.arange(len(groups))
@@ -41,6 +42,8 @@ def bar_chart(
         hi = np.array([np.nan if c is None else c[1] - v for v, c in zip(m, cis)])
         ax.bar(x + (k - (n - 1) / 2) * width, m, width, yerr=np.vstack([lo, hi]), capsize=3, label=label)
     ax.set_xticks(x, groups)
+    if log:
+        ax.set_yscale("log")
     ax.set_ylabel(ylabel)
     ax.set_title(title)
     ax.legend()

@@ -18,7 +18,7 @@ from pathlib import Path
 from tasks.catalog import TABLE_I
 from tasks.grid_robots import grid_robot
 from tasks.layout import ROOMS
-from transfer import experiment, metrics, paper
+from transfer import beyond, experiment, metrics, paper
 from transfer.mapping import ActionMapping, MacroTable
 from transfer import trajectory as trajectories
 from transfer.config import LearnerConfig
@@ -64,7 +64,7 @@ def _compare(
 
 def plan(trials: int) -> int:
     """How many trials ``run_all`` runs (for progress bars)."""
-    return trials * (2 * len(TASKS) * 3 + len(paper.TABLE_IV_WAYPOINTS) + 1 + 3 * len(TASKS))
+    return trials * (2 * len(TASKS) * 3 + len(paper.TABLE_IV_WAYPOINTS) + 1 + 3 * len(TASKS)) + beyond.plan(trials)
 
 
 TOP_ENTRIES = 12
@@ -154,6 +154,9 @@ def run_all(
     _add_improvement(out["mapping_fine_coarse"], out["table_v"])
     out["mapping_wind"] = mapping_protocol("coarse", "fine", trials, seed, config, wind=paper.WIND, tick=tick)
     _add_improvement(out["mapping_wind"], out["wind"])
+    fine = grid_robot("fine")
+    out["methods"] = beyond.run_methods(coarse, fine, trials, seed, config, tick=tick)
+    out["oracle_text"], out["oracle"] = beyond.oracle_markdown(coarse, fine, trials, seed, config)
     return out
 
 
@@ -447,6 +450,18 @@ def report_markdown(res: dict, figures: dict[str, str]) -> str:
         fig7_caption(res["mapping_coarse_fine"]["figure"]),
         "",
         wind_mapping_markdown(res),
+        "",
+        "## Beyond the paper",
+        "",
+        beyond.methods_markdown(res["methods"]),
+        "",
+        res["oracle_text"],
+        "",
+        f"![All methods]({figures['methods']})",
+        "",
+        beyond.controls_markdown(res["methods"]),
+        "",
+        beyond.metrics_markdown(res["methods"]),
         "",
         "## Where we differ from the paper, and why",
         "",

@@ -14,13 +14,14 @@ paper's; see ``transfer.methods`` for what each does.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from tasks.errors import InvalidParameterError
 from tasks.robot import DiscreteRobot
-from transfer import sarsa
+from transfer import potentials, sarsa
 from transfer.trajectory import Trajectory
 
 K_FRACTION = 0.5
@@ -51,19 +52,39 @@ class Shaping:
         )
 
 
-def farming_bound(step_reward: float, traj: Trajectory) -> float:
-    """The K at and above which ``pseudo`` can be farmed: -step_reward / n."""
-    n = max(traj.n, 1)
-    return -step_reward / n
+# K='auto', per method, in units of -step_reward. Chosen on held-out start/goal pairs, not on
+# the Table I tasks (scripts/select_defaults.py prints the comparison).
+AUTO_K = {"first-visit": 10.0, "progress": 30.0, "potential": 3.0, "dense": potentials.DENSE_K}
 
 
-def resolve_k(K: float | str | None, step_reward: float, traj: Trajectory) -> float:
+def _as_list(trajs: Trajectory | Sequence[Trajectory]) -> list[Trajectory]:
+    out = [trajs] if isinstance(trajs, Trajectory) else list(trajs)
+    if not out:
+        raise InvalidParameterError("a transfer method needs at least one trajectory")
+    return out
+
+
+def longest_n(trajs: Trajectory | Sequence[Trajectory]) -> int:
+    """N, the largest index n over the trajectories: pseudo rewards go up to N*K."""
+    return max(max(t.n, 1) for t in _as_list(trajs))
+
+
+def farming_bound(step_reward: float, trajs: Trajectory | Sequence[Trajectory]) -> float:
+    """The K at and above which ``pseudo`` can be farmed: -step_reward / N."""
+    return -step_reward / longest_n(trajs)
+
+
+def resolve_k(
+    K: float | str | None, step_reward: float, trajs: Trajectory | Sequence[Trajectory], method: str = "pseudo"
+) -> float:
     if K is None or K == "auto":
         if step_reward >= 0:
             raise InvalidParameterError(
-                "K='auto' needs a negative step reward (it is a fraction of -step_reward/n)"
+                "K='auto' needs a negative step reward (it is scaled by -step_reward)"
             )
-        return K_FRACTION * farming_bound(step_reward, traj)
+        if method in AUTO_K:
+            return AUTO_K[method] * -step_reward
+        return K_FRACTION * farming_bound(step_reward, trajs)
     K = float(K)
     if not np.isfinite(K) or K < 0:
         raise InvalidParameterError(f"K must be a non-negative number, got {K}")
@@ -82,31 +103,59 @@ def trajectory_index(robot: DiscreteRobot, traj: Trajectory) -> np.ndarray:
     return index
 
 
+def union_index(robot: DiscreteRobot, trajs: Sequence[Trajectory]) -> tuple[np.ndarray, np.ndarray]:
+    """(effective index, cell id) of every state over several trajectories.
+
+    Each trajectory's index is taken as a fraction of its length, i/n, and scaled by the
+    longest N, so one trajectory gives exactly its own i. A state on several trajectories
+    takes the largest. The id numbers the distinct trajectory cells 1, 2, ... (-1: none),
+    for methods that pay each cell once."""
+    N = longest_n(trajs)
+    eff = np.zeros(robot.n_states)
+    for traj in trajs:
+        idx = trajectory_index(robot, traj)
+        eff = np.maximum(eff, np.where(idx > 0, idx * (N / max(traj.n, 1)), 0.0))
+    on = eff > 0
+    ids = np.full(robot.n_states, -1, np.int64)
+    _, inverse = np.unique(robot.label[on], return_inverse=True)
+    ids[on] = inverse + 1
+    return eff, ids
+
+
 def build(
     method: str,
     robot: DiscreteRobot,
-    traj: Trajectory,
+    traj: Trajectory | Sequence[Trajectory],
     K: float | str | None,
     step_reward: float,
     gamma: float,
+    beta: float = potentials.DENSE_BETA,
 ) -> Shaping:
-    """The shaping arrays of ``method`` for ``robot`` from trajectory ``traj``."""
-    k = resolve_k(K, step_reward, traj)
-    index = trajectory_index(robot, traj)
-    bonus = np.where(index > 0, index * k, 0.0).astype(np.float64)
+    """The shaping arrays of ``method`` for ``robot`` from one or several trajectories."""
+    trajs = _as_list(traj)
+    k = resolve_k(K, step_reward, trajs, method)
+    eff, ids = union_index(robot, trajs)
+    bonus = (eff * k).astype(np.float64)
     zeros = np.zeros(robot.n_states)
     if method in ("pseudo", "mapping"):
-        if step_reward + traj.n * k >= 0:
+        N = longest_n(trajs)
+        if step_reward + N * k >= 0:
             raise InvalidParameterError(
                 f"K={k:g} can be farmed: step reward {step_reward:g} + largest pseudo reward "
-                f"n*K = {traj.n}*{k:g} >= 0; use K < {farming_bound(step_reward, traj):.6g} "
+                f"n*K = {N}*{k:g} >= 0; use K < {farming_bound(step_reward, trajs):.6g} "
                 f"(-step_reward/n) or the method 'first-visit'"
             )
-        return Shaping(sarsa.MODE_PSEUDO, bonus, index, zeros, k)
+        return Shaping(sarsa.MODE_PSEUDO, bonus, ids, zeros, k)
     if method == "first-visit":
-        return Shaping(sarsa.MODE_FIRST_VISIT, bonus, index, zeros, k)
+        return Shaping(sarsa.MODE_FIRST_VISIT, bonus, ids, zeros, k)
     if method == "progress":
-        return Shaping(sarsa.MODE_PROGRESS, bonus, index, zeros, k)
+        return Shaping(sarsa.MODE_PROGRESS, bonus, ids, zeros, k)
     if method == "potential":
-        return Shaping(sarsa.MODE_POTENTIAL, zeros, index, bonus.copy(), k)
+        return Shaping(sarsa.MODE_POTENTIAL, zeros, ids, bonus.copy(), k)
+    if method == "dense":
+        if not (np.isfinite(beta) and beta >= 0):
+            raise InvalidParameterError(f"beta must be a non-negative number, got {beta}")
+        phi = np.max([potentials.dense(robot, t, k * longest_n(trajs) / max(t.n, 1), beta * max(t.n, 1) / longest_n(trajs))
+                      for t in trajs], axis=0)
+        return Shaping(sarsa.MODE_POTENTIAL, zeros, ids, phi, k)
     raise InvalidParameterError(f"no shaping for method {method!r}")

@@ -103,7 +103,7 @@ def _greedy_path(Q, next_state, label, start, goal, stamp, stamp_id, path_out):
 
 @numba.njit(cache=True)
 def _shaping(mode, s, s2, terminal, bonus, traj_index, phi, gamma, paid_stamp, episode, best):
-    """The shaping term for the move s -> s2; returns (term, new best index)."""
+    """The shaping term for the move s -> s2; returns (term, the best bonus so far)."""
     if mode == MODE_PSEUDO:
         return bonus[s2], best
     if mode == MODE_FIRST_VISIT:
@@ -112,6 +112,15 @@ def _shaping(mode, s, s2, terminal, bonus, traj_index, phi, gamma, paid_stamp, e
             paid_stamp[i] = episode
             return bonus[s2], best
         return 0.0, best
+    if mode == MODE_POTENTIAL:
+        phi2 = 0.0 if terminal else phi[s2]
+        return gamma * phi2 - phi[s], best
+    if mode == MODE_PROGRESS:
+        # pay only the part of the bonus beyond the best reached so far this episode
+        if bonus[s2] > best:
+            return bonus[s2] - best, bonus[s2]
+        return 0.0, best
+    return 0.0, best
     if mode == MODE_POTENTIAL:
         phi2 = 0.0 if terminal else phi[s2]
         return gamma * phi2 - phi[s], best
@@ -183,7 +192,7 @@ def _run_trial(
             pos[tr_sa[k]] = -1
         n_tr = 0
         s = start
-        best = 0
+        best = 0.0
         m_pos = 0  # position in the running macro, m_end its end (exclusive)
         m_end = 0
         macro_used = 0

@@ -42,6 +42,69 @@ def k_value(text: str) -> float | str:
     return value
 
 
+def add_method_arguments(p: argparse.ArgumentParser) -> None:
+    from transfer import mapping as mappings
+    from transfer import potentials
+    from transfer.experiment import METHODS
+
+    p.add_argument("--method", nargs="+", default=["none", "pseudo"], metavar="METHOD",
+                   help=f"one or more of: {', '.join(METHODS)} (default: none pseudo)")
+    p.add_argument("--trajectory", action="append", default=None, metavar="KIND|PATH",
+                   help="the transferred trajectory: optimal (the source's shortest path; default), "
+                        "learned (its greedy path after learning), shuffled or random (controls), or a "
+                        "JSON file; give it more than once to transfer several trajectories")
+    p.add_argument("--no-controls", action="store_true",
+                   help="skip the control runs (each transfer method again with a shuffled and a "
+                        "random trajectory)")
+    p.add_argument("--beta", type=float, default=potentials.DENSE_BETA,
+                   help=f"method dense: indices lost per cell from the trajectory (default {potentials.DENSE_BETA})")
+    p.add_argument("--mapping", default=None, metavar="PATH",
+                   help="with --method mapping: the action sequence mapping to reuse (created when "
+                        "absent) and to update, after the run, from every converged trial")
+    p.add_argument("--max-span", type=positive_int, default=mappings.DEFAULT_MAX_SPAN,
+                   help="longest source key learned from non-consecutive matches "
+                        f"(default {mappings.DEFAULT_MAX_SPAN})")
+
+
+TRAJECTORY_KINDS = ("optimal", "learned", "shuffled", "random")
+
+
+def trajectory_specs(args: argparse.Namespace) -> list[str]:
+    return args.trajectory or ["optimal"]
+
+
+def task_for(args: argparse.Namespace) -> Task:
+    """The task from --task/--start/--goal; a trajectory file alone also names its task."""
+    from tasks.layout import ROOMS
+    from transfer import trajectory as trajectories
+
+    files = [s for s in trajectory_specs(args) if s not in TRAJECTORY_KINDS]
+    if args.task is None and args.start is None and args.goal is None and files:
+        traj = trajectories.load(files[0])
+        return Task("trajectory file", ROOMS.xy(traj.start), ROOMS.xy(traj.goal))
+    return task_from_args(args)
+
+
+def resolve_trajectories(specs: list[str] | None, source, task: Task, config, seed: int) -> list:
+    """Each --trajectory: a kind made from the source robot, or a JSON file for this task."""
+    from transfer import experiment
+    from transfer import trajectory as trajectories
+
+    start, goal = task.cells()
+    out = []
+    for spec in specs or ["optimal"]:
+        if spec in ("optimal", "learned"):
+            out.append(experiment.source_trajectory(spec, source, start, goal, config, seed))
+        elif spec in ("shuffled", "random"):
+            real = experiment.source_trajectory("optimal", source, start, goal, config, seed)
+            out.extend(experiment.control_trajectories(spec, source, [real], seed))
+        else:
+            traj = trajectories.load(spec)
+            trajectories.check_task(traj, start, goal)
+            out.append(traj)
+    return out
+
+
 def add_task_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--task", type=int, default=None, help="Table I task 1-4 (default 1)")
     p.add_argument("--start", default=None, metavar="X,Y", help="start cell (with --goal)")

@@ -7,7 +7,7 @@ import time
 from pathlib import Path
 
 from armtransfer.commands import common
-from transfer import figures
+from transfer import beyond, figures
 from transfer import reproduce as rep
 from tasks.layout import ROOMS
 from transfer.config import LearnerConfig
@@ -44,13 +44,19 @@ def run(args: argparse.Namespace) -> int:
         res = rep.run_all(args.trials, args.seed, config, tick=bar.update)
     groups = [f"task {t}" for t in rep.TASKS]
     names = {"fig4": "fig4_coarse_to_fine.png", "fig5": "fig5_fine_to_coarse.png", "fig6": "fig6_wind.png",
-             "fig7": "fig7_mapping.png"}
+             "fig7": "fig7_mapping.png", "methods": "fig_methods.png"}
     figures.bar_chart(groups, _bars(res["table_ii"], "table_ii"),
                       "Fig. 4 analog: coarse -> fine", "exploration steps to the goal", out / names["fig4"])
     figures.bar_chart(groups, _bars(res["table_v"], "table_v"),
                       "Fig. 5 analog: fine -> coarse", "exploration steps to the goal", out / names["fig5"])
     figures.bar_chart(groups, _bars(res["wind"], "wind"),
                       "Fig. 6 analog: coarse -> fine, wind 0.01", "exploration steps to the goal", out / names["fig6"])
+    methods = res["methods"]
+    figures.bar_chart(groups, {m: ([methods[t]["results"][m]["mean"] for t in rep.TASKS],
+                                   [methods[t]["results"][m]["ci95"] for t in rep.TASKS])
+                               for m in beyond.METHODS},
+                      "All methods, coarse -> fine", "exploration steps to the goal (log)",
+                      out / names["methods"], log=True)
     fig = res["mapping_coarse_fine"]["figure"]
     if fig is not None:
         figures.mapping_paths(ROOMS.wall_mask, ROOMS.lo, fig["source_cells"], fig["target_cells"], fig["segments"],
@@ -65,4 +71,6 @@ def run(args: argparse.Namespace) -> int:
     print(rep.table_ii_markdown(res["table_ii"], rep.paper.TABLE_II, "Table II A-C: coarse -> fine"))
     print()
     print(rep.table_ii_mapping_markdown(res))
+    print()
+    print(beyond.methods_markdown(methods))
     return 0
