@@ -14,8 +14,8 @@ replay holds its last frame. Frames are streamed to the encoder, one at a time: 
 (Pillow). The video is written to a temporary file beside the destination and renamed
 over it only when complete, so a failed or interrupted render leaves nothing behind.
 
-Shadows are off by default: on a CPU renderer the 4096² shadow map costs about ten
-times the rest of a 320x240 frame (see BENCHMARKS.md, "Rendering").
+Shadows are off by default: on a CPU renderer MuJoCo's 4096² shadow map more than
+halves the frame rate (see BENCHMARKS.md, "Rendering"); ``shadows=True`` turns them on.
 
 Typical use (the ``armtransfer`` command does this)::
 
