@@ -32,6 +32,7 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 
 import copy  # noqa: E402
 import math  # noqa: E402
+import numbers  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
 from dataclasses import dataclass, field  # noqa: E402
@@ -271,9 +272,9 @@ def render_rollouts(panels: Sequence[RolloutPanel] | RolloutPanel, path: str | o
     if not panels:
         raise RenderError("nothing to render: no panels")
     for name, v in (("width", width), ("height", height)):
-        if not (isinstance(v, (int, np.integer)) and 16 <= v <= MAX_SIZE):
+        if not (isinstance(v, numbers.Integral) and 16 <= v <= MAX_SIZE):
             raise RenderError(f"{name} must be an integer in 16..{MAX_SIZE}, got {v!r}")
-    if not (isinstance(fps, (int, float)) and math.isfinite(fps) and 0 < fps <= 240):
+    if not (isinstance(fps, numbers.Real) and math.isfinite(fps) and 0 < fps <= 240):
         raise RenderError(f"fps must be in (0, 240], got {fps!r}")
     dest = Path(path)
     check_writable(dest)

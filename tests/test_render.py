@@ -185,3 +185,11 @@ def test_failed_render_leaves_no_temp_file(replays, tmp_path, monkeypatch):
         render_rollouts([RolloutPanel(replays["planar2:cartesian"])], tmp_path / "v.mp4",
                         width=32, height=32)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("kwargs", [{"fps": 0}, {"fps": float("nan")}, {"width": 8},
+                                    {"height": 10.5}])
+def test_bad_size_or_fps_is_render_error(replays, tmp_path, kwargs):
+    with pytest.raises(RenderError):
+        render_rollouts([RolloutPanel(replays["planar2:cartesian"])], tmp_path / "v.mp4", **kwargs)
+    assert list(tmp_path.iterdir()) == []
