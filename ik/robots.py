@@ -4,7 +4,9 @@ A robot name is ``ARM:ACTIONS``. The result is a ``tasks.robot.DiscreteRobot`` w
 labels are the shared rooms-world cells, so every learner runs on it unchanged. Its
 ``meta`` holds ``qpos`` [n_states, nq] (the joint configuration of every state, to replay
 paths with the position actuators), ``tip`` [n_states, 3], ``reach`` (fraction of free
-cells reached), ``cache`` ("hit", "miss", "stale", "corrupt") and the compile settings.
+cells reached), ``cache`` ("hit", "miss", "stale", "corrupt") and the compile settings
+(``xml_path``, ``tip_site``, ``mount``, ``yaw``, ``cell_size``, ``layout``: enough to rebuild
+the exact MuJoCo scene, as ``armtransfer.replay`` does).
 """
 
 from __future__ import annotations
@@ -132,7 +134,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
         "qpos": arrays["qpos"], "tip": arrays["tip"], "reach": reach, "cache": status,
         "key": key, "seconds": seconds, "cell_size": cell_size, "mount": mount, "yaw": yaw,
         "xml_path": str(path), "tip_site": tip,
-        "joint_step": step if model.kind == "joint" else None,
+        "joint_step": step if model.kind == "joint" else None, "layout": layout,
     }
     if "lattice" in arrays:
         meta["lattice"] = arrays["lattice"]

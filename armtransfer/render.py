@@ -1,0 +1,358 @@
+"""Offscreen video of physics replays: arms side by side over the rooms table.
+
+Rendering is MuJoCo's offscreen OpenGL; ``MUJOCO_GL`` must name the backend before
+``mujoco`` is first imported (this module sets ``egl`` unless the user chose one), which
+works without a display and without a GPU through Mesa's EGL (llvmpipe).
+
+Each panel is one ``Replay`` (``armtransfer.replay``) rendered with its own model and
+``mujoco.Renderer`` from a fixed free camera that shows the whole table and its walls.
+Markers are drawn as MuJoCo user geoms added to the renderer's scene (they are not part
+of the model, so they never collide): the transferred trajectory's cells as orange
+tiles, the goal cell as a green disc. Panels are concatenated left to right; a shorter
+replay holds its last frame. Frames are streamed to the encoder, one at a time: MP4
+(H.264 through imageio's ffmpeg plugin, the binary from ``imageio-ffmpeg``) or GIF
+(Pillow). The video is written to a temporary file beside the destination and renamed
+over it only when complete, so a failed or interrupted render leaves nothing behind.
+
+Shadows are off by default: on a CPU renderer MuJoCo's 4096² shadow map more than
+halves the frame rate (see BENCHMARKS.md, "Rendering"); ``shadows=True`` turns them on.
+
+Typical use (the ``armtransfer`` command does this)::
+
+    from armtransfer.render import rollout_video
+    report = rollout_video([(src_robot, src_states), (tgt_robot, tgt_states)], "out.mp4",
+                           trajectory_cells=traj.cells, goal_cell=traj.goal)
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+import copy  # noqa: E402
+import math  # noqa: E402
+import numbers  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+from dataclasses import dataclass, field  # noqa: E402
+from pathlib import Path  # noqa: E402
+from typing import Sequence  # noqa: E402
+
+import mujoco  # noqa: E402
+import numpy as np  # noqa: E402
+
+from armtransfer.replay import Replay, replay  # noqa: E402
+from tasks.errors import ArmTransferError  # noqa: E402
+from tasks.robot import DiscreteRobot  # noqa: E402
+from tasks.workspace import WALL_HEIGHT  # noqa: E402
+from transfer.io import OutputError, check_writable  # noqa: E402
+
+FORMATS = {".mp4": "mp4", ".gif": "gif"}
+TRAJECTORY_RGBA = (1.0, 0.55, 0.1, 1.0)
+GOAL_RGBA = (0.1, 0.75, 0.2, 1.0)
+START_RGBA = (0.15, 0.35, 0.9, 1.0)
+MAX_SIZE = 4096
+
+
+class RenderError(ArmTransferError):
+    """A video cannot be made as asked (unknown format, bad size or fps)."""
+
+
+@dataclass
+class RolloutPanel:
+    """One replay to draw, with its markers."""
+
+    replay: Replay
+    trajectory_cells: Sequence[int] = ()
+    """The transferred trajectory's shared cells (orange tiles); none by default."""
+    goal_cell: int | None = None
+    """The goal cell (green disc); defaults to the replay's goal."""
+    show_start: bool = True
+    """A blue tile under the first planned cell."""
+
+
+@dataclass
+class RenderStats:
+    path: str
+    format: str
+    frames: int
+    width: int
+    height: int
+    """Size of the whole video frame (panels side by side)."""
+    fps: float
+    """Playback rate written into the file."""
+    seconds: float
+    """Wall-clock time of rendering plus encoding (not the replays)."""
+    render_seconds: float
+    encode_seconds: float
+    panels: int = 1
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def fps_achieved(self) -> float:
+        return self.frames / self.seconds if self.seconds > 0 else math.inf
+
+    def report(self) -> dict:
+        return {"video": self.path, "format": self.format, "frames": self.frames,
+                "width": self.width, "height": self.height, "panels": self.panels,
+                "fps": self.fps, "seconds": round(self.seconds, 4),
+                "fps_achieved": round(self.fps_achieved, 2),
+                "render_seconds": round(self.render_seconds, 4),
+                "encode_seconds": round(self.encode_seconds, 4), **self.extra}
+
+
+def video_format(path: str | os.PathLike, format: str | None = None) -> str:
+    """'mp4' or 'gif', from ``format`` or else the path's suffix; RenderError otherwise."""
+    if format is not None:
+        fmt = str(format).lower().lstrip(".")
+        if fmt not in FORMATS.values():
+            raise RenderError(f"unknown video format {format!r}; valid formats: mp4, gif")
+        return fmt
+    suffix = Path(path).suffix.lower()
+    if suffix not in FORMATS:
+        shown = suffix or "no suffix"
+        raise RenderError(f"unknown video format for {str(path)!r} ({shown}); use a .mp4 or .gif path")
+    return FORMATS[suffix]
+
+
+ELEVATION = -70.0
+"""Degrees below the horizon: nearly top-down, so cells keep their shape, tilted enough
+that the arms' links stand out from the table."""
+
+
+def table_camera(replay_or_scene, width: int = 320, height: int = 240, *,
+                 elevation: float = ELEVATION) -> mujoco.MjvCamera:
+    """A fixed free camera over the table's centre, from the front (-y side), ``elevation``
+    degrees down. Used with an orthographic projection (``view_extent``) so the table keeps
+    its scale however high an arm's links rise towards the camera."""
+    scene = getattr(replay_or_scene, "scene", replay_or_scene)
+    half = scene.layout.width * scene.cell / 2
+    cam = mujoco.MjvCamera()
+    cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+    cam.lookat[:] = (0.0, 0.0, 0.0)
+    cam.distance = 4 * half + 1.0  # beyond the tallest arm; orthographic, so no zoom effect
+    cam.azimuth = 90.0
+    cam.elevation = elevation
+    return cam
+
+
+def view_extent(scene, width: int, height: int, elevation: float = ELEVATION) -> float:
+    """Vertical extent (m) of the orthographic view that shows the whole table and its walls
+    with a small margin at aspect ``width / height``."""
+    half = scene.layout.width * scene.cell / 2
+    el = math.radians(abs(elevation))
+    vertical = 2 * half * math.sin(el) + 2 * WALL_HEIGHT * math.cos(el)
+    horizontal_as_vertical = 2 * half * height / width
+    return 1.12 * max(vertical, horizontal_as_vertical)
+
+
+class PanelRenderer:
+    """Renders one replay's configurations with its markers (close it, or use ``with``)."""
+
+    def __init__(self, panel: RolloutPanel, width: int = 320, height: int = 240, *,
+                 shadows: bool = False, samples: int = 4,
+                 camera: mujoco.MjvCamera | None = None) -> None:
+        self.panel = panel
+        rp = panel.replay
+        model = copy.copy(rp.scene.model)
+        model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), width)
+        model.vis.global_.offheight = max(int(model.vis.global_.offheight), height)
+        model.vis.quality.offsamples = int(samples)
+        model.vis.global_.orthographic = 1
+        model.vis.global_.fovy = view_extent(rp.scene, width, height)
+        self.model = model
+        self.data = mujoco.MjData(model)
+        self.camera = camera or table_camera(rp, width, height)
+        self.shadows = shadows
+        self._markers = _markers(panel)
+        self.renderer = mujoco.Renderer(model, height, width, max_geom=model.ngeom + len(self._markers) + 100)
+
+    def render(self, qpos: np.ndarray) -> np.ndarray:
+        """[height, width, 3] uint8 image of the arm at ``qpos``."""
+        self.data.qpos[:] = qpos
+        mujoco.mj_kinematics(self.model, self.data)
+        r = self.renderer
+        r.update_scene(self.data, self.camera)
+        scn = r.scene
+        scn.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = self.shadows
+        for gtype, size, pos, rgba in self._markers:
+            if scn.ngeom >= scn.maxgeom:
+                break
+            g = scn.geoms[scn.ngeom]
+            mujoco.mjv_initGeom(g, gtype, size, pos, np.eye(3).reshape(-1), rgba)
+            g.category = mujoco.mjtCatBit.mjCAT_DECOR
+            scn.ngeom += 1
+        return r.render()
+
+    def close(self) -> None:
+        self.renderer.close()
+
+    def __enter__(self) -> "PanelRenderer":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def _markers(panel: RolloutPanel) -> list[tuple[int, np.ndarray, np.ndarray, np.ndarray]]:
+    rp = panel.replay
+    cell, layout = rp.cell, rp.scene.layout
+    thin = cell * 0.05
+
+    def centre(c: int, z: float) -> np.ndarray:
+        x, y = layout.xy(int(c))
+        return np.array([x * cell, y * cell, z])
+
+    box = int(mujoco.mjtGeom.mjGEOM_BOX)
+    out = []
+    if panel.show_start and len(rp.planned_xy):
+        x, y = rp.planned_xy[0]
+        out.append((box, np.array([0.45 * cell, 0.45 * cell, thin]), np.array([x, y, thin]),
+                    np.array(START_RGBA)))
+    for c in dict.fromkeys(int(c) for c in panel.trajectory_cells):
+        out.append((box, np.array([0.35 * cell, 0.35 * cell, thin]), centre(c, 2 * thin),
+                    np.array(TRAJECTORY_RGBA)))
+    goal = rp.goal_cell if panel.goal_cell is None else panel.goal_cell
+    out.append((int(mujoco.mjtGeom.mjGEOM_CYLINDER), np.array([1.2 * cell, thin, 0.0]),
+                centre(goal, thin), np.array(GOAL_RGBA)))
+    return out
+
+
+def _pad_even(frame: np.ndarray) -> np.ndarray:
+    """H.264 in yuv420p needs even sizes: repeat the last row/column when odd."""
+    h, w = frame.shape[:2]
+    if h % 2 == 0 and w % 2 == 0:
+        return frame
+    return np.pad(frame, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge")
+
+
+class _Writer:
+    def __init__(self, tmp: str, fmt: str, fps: float, quality: int | None) -> None:
+        import imageio
+
+        self.fmt = fmt
+        if fmt == "mp4":
+            self._w = imageio.v2.get_writer(
+                tmp, format="FFMPEG", mode="I", fps=fps, codec="libx264",
+                pixelformat="yuv420p", macro_block_size=1, quality=quality or 7,
+                ffmpeg_log_level="error", output_params=["-preset", "veryfast"])
+        else:
+            import imageio.v3 as iio
+
+            self._w = iio.imopen(tmp, "w", plugin="pillow", extension=".gif")
+            self._duration = 1000.0 / fps
+
+    def append(self, frame: np.ndarray) -> None:
+        if self.fmt == "mp4":
+            self._w.append_data(_pad_even(frame))
+        else:
+            self._w.write(frame, duration=self._duration, loop=0)
+
+    def close(self) -> None:
+        self._w.close()
+
+
+def render_rollouts(panels: Sequence[RolloutPanel] | RolloutPanel, path: str | os.PathLike, *,
+                    width: int = 320, height: int = 240, fps: float = 30.0,
+                    format: str | None = None, shadows: bool = False, samples: int = 4,
+                    quality: int | None = None) -> RenderStats:
+    """Render the panels side by side into a video at ``path`` and return its stats.
+
+    ``width`` x ``height`` is the size of one panel; the video is ``len(panels) * width``
+    wide. Playback is real time: frame k shows simulation time k / ``fps``. The format
+    comes from ``format`` or the suffix (.mp4, .gif). Bad format, size, fps or an
+    unwritable path raise an ``ArmTransferError`` subclass before anything is rendered;
+    the file appears only complete (temporary file, then ``os.replace``).
+    """
+    if isinstance(panels, RolloutPanel):
+        panels = [panels]
+    panels = list(panels)
+    fmt = video_format(path, format)
+    if not panels:
+        raise RenderError("nothing to render: no panels")
+    for name, v in (("width", width), ("height", height)):
+        if not (isinstance(v, numbers.Integral) and 16 <= v <= MAX_SIZE):
+            raise RenderError(f"{name} must be an integer in 16..{MAX_SIZE}, got {v!r}")
+    if not (isinstance(fps, numbers.Real) and math.isfinite(fps) and 0 < fps <= 240):
+        raise RenderError(f"fps must be in (0, 240], got {fps!r}")
+    dest = Path(path)
+    check_writable(dest)
+    try:
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=f".tmp.{fmt}", dir=dest.parent)
+        os.close(fd)
+    except OSError as err:
+        raise OutputError(f"cannot write {str(dest)!r}: {err.strerror}") from None
+
+    start = time.perf_counter()
+    render_s = encode_s = 0.0
+    n_frames = 0
+    renderers: list[PanelRenderer] = []
+    writer = None
+    try:
+        frames_q = [p.replay.frames_qpos(fps) for p in panels]
+        n_frames = max(len(q) for q in frames_q)
+        for p in panels:
+            renderers.append(PanelRenderer(p, width, height, shadows=shadows, samples=samples))
+        writer = _Writer(tmp, fmt, fps, quality)
+        for k in range(n_frames):
+            t0 = time.perf_counter()
+            images = [r.render(q[min(k, len(q) - 1)]) for r, q in zip(renderers, frames_q)]
+            frame = images[0] if len(images) == 1 else np.concatenate(images, axis=1)
+            t1 = time.perf_counter()
+            writer.append(frame)
+            render_s += t1 - t0
+            encode_s += time.perf_counter() - t1
+        t1 = time.perf_counter()
+        w, writer = writer, None
+        w.close()
+        encode_s += time.perf_counter() - t1
+        os.chmod(tmp, 0o666 & ~_umask())
+        os.replace(tmp, dest)
+    except OSError as err:
+        raise OutputError(f"cannot write {str(dest)!r}: {err.strerror or err}") from None
+    finally:
+        if writer is not None:
+            try:
+                writer.close()
+            except Exception:  # noqa: BLE001 - already failing; the temp file goes anyway
+                pass
+        for r in renderers:
+            r.close()
+        Path(tmp).unlink(missing_ok=True)
+    seconds = time.perf_counter() - start
+    return RenderStats(path=str(dest), format=fmt, frames=n_frames, width=width * len(panels),
+                       height=height, fps=float(fps), seconds=seconds, render_seconds=render_s,
+                       encode_seconds=encode_s, panels=len(panels))
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def rollout_video(rollouts: Sequence[tuple[DiscreteRobot, Sequence[int]]],
+                  path: str | os.PathLike, *, trajectory_cells: Sequence[int] = (),
+                  goal_cell: int | None = None, width: int = 320, height: int = 240,
+                  fps: float = 30.0, format: str | None = None, shadows: bool = False,
+                  replay_options: dict | None = None) -> dict:
+    """Replay each (robot, path states) in MuJoCo and render them side by side to ``path``.
+
+    ``trajectory_cells`` (the transferred trajectory) and ``goal_cell`` are marked in every
+    panel. Returns a JSON-able report: the video's stats and, per panel, the replay's
+    ``max_deviation_cells``, ``reached_goal`` and friends (``Replay.report()``).
+    """
+    video_format(path, format)  # fail on bad input before the replays
+    check_writable(path)
+    replays = [replay(robot, states, goal_cell=goal_cell, **(replay_options or {}))
+               for robot, states in rollouts]
+    panels = [RolloutPanel(rp, trajectory_cells, goal_cell) for rp in replays]
+    stats = render_rollouts(panels, path, width=width, height=height, fps=fps, format=format,
+                            shadows=shadows)
+    return {**stats.report(), "replays": [rp.report() for rp in replays]}
+
+
+__all__ = ["PanelRenderer", "RenderError", "RenderStats", "RolloutPanel", "render_rollouts",
+           "rollout_video", "table_camera", "video_format"]

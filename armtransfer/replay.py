@@ -1,0 +1,317 @@
+"""Physics replay of an arm robot's path: position actuators track the joint waypoints.
+
+A path of a discrete arm robot (``ik.robots``) is a list of its states; every state has a
+joint configuration (``robot.meta["qpos"]``). ``replay`` rebuilds the exact MuJoCo scene the
+robot was compiled in (arm on the table with the rooms walls, from ``robot.meta``), puts the
+arm at the first waypoint and then *simulates* the move: for each next waypoint the
+position actuators' controls ramp linearly from the previous waypoint to it over
+``segment_seconds`` and ``mj_step`` integrates the dynamics, then the controls hold the
+goal configuration for ``settle_seconds``. Nothing is set kinematically after the first
+waypoint, so what is recorded (tip position and qpos at every physics step) is what the
+arm really did, lag, overshoot and contacts included.
+
+Tracking controller (set on a copy of the model at replay time; the MJCF files keep their
+own gains):
+
+- Position-actuator gains are retuned per joint to a critically damped servo of natural
+  frequency ``bandwidth_hz``: ``kp = I * w**2`` and ``kv = 2 * I * w`` with ``I`` the
+  joint's diagonal of the mass matrix (armature included) at the first waypoint.
+- Feed-forward forces through ``qfrc_applied``: gravity and Coriolis compensation
+  (``qfrc_bias`` of the current state, split ``mj_step1``/``mj_step2`` so it is exact for
+  the step) plus the ramp's velocity times (joint damping + kv), which removes the
+  steady lag of a PD servo on a ramp. A real arm controller does the same; without it a
+  UR5e-like arm sags by several cells under gravity.
+
+The report (``Replay.report()``) gives the largest distance of the tip from the polyline
+through the planned cells' centres, in cells, and whether the tip ends in the goal cell.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+from typing import Sequence
+
+import mujoco
+import numpy as np
+
+from ik.labels import OFF_TABLE, cells_of_xy
+from ik.scene import ArmScene, build_scene
+from tasks.errors import ArmTransferError
+from tasks.layout import ROOMS, Layout
+from tasks.robot import DiscreteRobot
+
+SEGMENT_SECONDS = 0.1
+SETTLE_SECONDS = 0.3
+BANDWIDTH_HZ = 8.0
+
+
+class ReplayError(ArmTransferError):
+    """A path cannot be replayed (not an arm robot, empty path, unknown state)."""
+
+
+@dataclass(frozen=True, eq=False)
+class Replay:
+    """What the arm did in a physics replay of a path (arrays per physics step)."""
+
+    robot: str
+    scene: ArmScene
+    path_states: tuple[int, ...]
+    goal_cell: int
+    planned_xy: np.ndarray
+    """[n_cells, 2] centres (m) of the planned cells: the path's labels, repeats removed."""
+    planned_tip: np.ndarray
+    """[n_waypoints, 3] the compiled tip position of each path state."""
+    time: np.ndarray
+    """[n_steps + 1] simulation time (s) of each sample; sample 0 is the start."""
+    qpos: np.ndarray
+    """[n_steps + 1, nq] joint configuration at each sample."""
+    tip: np.ndarray
+    """[n_steps + 1, 3] tip site position (m) at each sample."""
+    waypoint_index: np.ndarray
+    """[n_waypoints] the sample at which each waypoint's ramp ends."""
+    settings: dict = field(default_factory=dict)
+
+    @property
+    def tip_xy(self) -> np.ndarray:
+        return self.tip[:, :2]
+
+    @property
+    def cell(self) -> float:
+        return self.scene.cell
+
+    @property
+    def duration(self) -> float:
+        return float(self.time[-1])
+
+    @property
+    def tip_cells(self) -> np.ndarray:
+        """The shared cell under the tip at each sample (-1 off the table)."""
+        return cells_of_xy(self.tip_xy, self.cell, self.scene.layout)
+
+    @property
+    def final_cell(self) -> int:
+        return int(self.tip_cells[-1])
+
+    @property
+    def reached_goal(self) -> bool:
+        """The tip ends the replay over the goal cell."""
+        return self.final_cell == self.goal_cell != OFF_TABLE
+
+    @property
+    def max_deviation_cells(self) -> float:
+        """Largest distance (cells) of the tip from the polyline of the planned cells."""
+        return float(polyline_distance(self.tip_xy, self.planned_xy).max() / self.cell)
+
+    @property
+    def max_tracking_error_cells(self) -> float:
+        """Largest distance (cells) of the tip from the polyline of the planned tip positions
+        (the compiled states' tips): the controller's error alone, without the offset of a
+        state's tip from its cell's centre."""
+        return float(polyline_distance(self.tip_xy, self.planned_tip[:, :2]).max() / self.cell)
+
+    @property
+    def final_error_cells(self) -> float:
+        """Distance (cells) of the final tip from the last waypoint's compiled tip."""
+        return float(np.linalg.norm(self.tip_xy[-1] - self.planned_tip[-1, :2]) / self.cell)
+
+    def frame_indices(self, fps: float) -> np.ndarray:
+        """Sample index for each video frame at ``fps`` (frames at t = k / fps, last at the end)."""
+        if not fps > 0:
+            raise ReplayError(f"fps must be positive, got {fps}")
+        n = int(np.floor(self.duration * fps + 1e-9)) + 1
+        times = np.arange(n) / fps
+        idx = np.searchsorted(self.time, times - 1e-9)
+        idx = np.minimum(idx, len(self.time) - 1)
+        if idx[-1] != len(self.time) - 1:  # always show the final pose
+            idx = np.append(idx, len(self.time) - 1)
+        return idx
+
+    def frames_qpos(self, fps: float) -> np.ndarray:
+        """[n_frames, nq] configurations to render at ``fps`` (real-time playback)."""
+        return self.qpos[self.frame_indices(fps)]
+
+    def report(self) -> dict:
+        """JSON-able summary."""
+        return {
+            "robot": self.robot,
+            "waypoints": len(self.path_states),
+            "goal_cell": list(self.scene.layout.xy(self.goal_cell)),
+            "final_cell": (list(self.scene.layout.xy(self.final_cell))
+                           if self.final_cell != OFF_TABLE else None),
+            "reached_goal": self.reached_goal,
+            "max_deviation_cells": round(self.max_deviation_cells, 4),
+            "max_tracking_error_cells": round(self.max_tracking_error_cells, 4),
+            "final_error_cells": round(self.final_error_cells, 4),
+            "seconds_simulated": round(self.duration, 4),
+            "physics_steps": len(self.time) - 1,
+            **self.settings,
+        }
+
+
+def polyline_distance(points: np.ndarray, vertices: np.ndarray) -> np.ndarray:
+    """Distance of each point [n, 2] from the polyline through ``vertices`` [m, 2]."""
+    p = np.asarray(points, dtype=float)[:, None, :2]
+    v = np.asarray(vertices, dtype=float)[:, :2]
+    if len(v) == 1:
+        return np.linalg.norm(p[:, 0] - v[0], axis=-1)
+    a, b = v[:-1][None], v[1:][None]
+    ab = b - a
+    denom = np.maximum(np.sum(ab * ab, axis=-1), 1e-18)
+    t = np.clip(np.sum((p - a) * ab, axis=-1) / denom, 0.0, 1.0)
+    closest = a + t[..., None] * ab
+    return np.linalg.norm(p - closest, axis=-1).min(axis=1)
+
+
+def robot_scene(robot: DiscreteRobot, layout: Layout | None = None) -> ArmScene:
+    """The MuJoCo scene ``robot`` was compiled in, rebuilt from its ``meta``."""
+    meta = robot.meta
+    needed = ("xml_path", "tip_site", "mount", "yaw", "cell_size", "qpos")
+    missing = [k for k in needed if k not in meta]
+    if missing:
+        raise ReplayError(f"robot {robot.name} is not an arm robot (no {', '.join(missing)} in its "
+                          "meta); only ARM:ACTIONS robots can be replayed in MuJoCo")
+    layout = layout or meta.get("layout") or ROOMS
+    return build_scene(meta["xml_path"], meta["tip_site"], meta["mount"], meta["yaw"],
+                       meta["cell_size"], layout)
+
+
+def _dedupe(cells: Sequence[int]) -> list[int]:
+    out: list[int] = []
+    for c in cells:
+        if not out or out[-1] != c:
+            out.append(int(c))
+    return out
+
+
+def replay(robot: DiscreteRobot, path_states: Sequence[int], *, goal_cell: int | None = None,
+           segment_seconds: float = SEGMENT_SECONDS, settle_seconds: float = SETTLE_SECONDS,
+           bandwidth_hz: float = BANDWIDTH_HZ, feedforward: bool = True,
+           scene: ArmScene | None = None) -> Replay:
+    """Simulate the arm of ``robot`` following ``path_states`` with its position actuators.
+
+    ``path_states``: the robot's states in order (e.g. ``[s for s, _ in
+    robot.shortest_path(start, goal)]``). ``goal_cell`` defaults to the last state's label.
+    Each segment between waypoints lasts ``segment_seconds``; the goal is then held for
+    ``settle_seconds``. ``scene`` may be passed to skip rebuilding it (it must be the
+    robot's own scene). Deterministic: no randomness anywhere.
+    """
+    states = [int(s) for s in path_states]
+    if not states:
+        raise ReplayError("a replay needs at least one path state")
+    qtable = robot.meta.get("qpos")
+    scene = scene or robot_scene(robot)
+    if any(not 0 <= s < len(qtable) for s in states):
+        bad = next(s for s in states if not 0 <= s < len(qtable))
+        raise ReplayError(f"state {bad} is not a state of {robot.name} (0..{len(qtable) - 1})")
+    if not (segment_seconds > 0 and settle_seconds >= 0 and bandwidth_hz > 0):
+        raise ReplayError("segment_seconds and bandwidth_hz must be positive, settle_seconds >= 0")
+    goal = int(robot.label[states[-1]]) if goal_cell is None else int(goal_cell)
+
+    model = copy.copy(scene.model)  # the gains are retuned on this copy only
+    data = mujoco.MjData(model)
+    tip_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, scene.tip)
+    way = np.asarray(qtable[states], dtype=float)
+    planned_tip = np.asarray(robot.meta["tip"][states], dtype=float) if "tip" in robot.meta else None
+
+    data.qpos[:] = way[0]
+    data.ctrl[:] = _ctrl_of(model, way[0])
+    mujoco.mj_forward(model, data)
+    if planned_tip is not None and np.linalg.norm(data.site_xpos[tip_id] - planned_tip[0]) > 1e-5:
+        raise ReplayError(f"the rebuilt scene of {robot.name} does not match its compiled tips; "
+                          "recompile the robot")
+    if planned_tip is None:
+        planned_tip = np.array([_fk(model, data, q, tip_id) for q in way])
+        data.qpos[:] = way[0]
+        mujoco.mj_forward(model, data)
+
+    kv = _tune_gains(model, data, bandwidth_hz)
+    joint_of = model.actuator_trnid[:, 0]
+    dof_of = model.jnt_dofadr[joint_of]
+    qadr_of = model.jnt_qposadr[joint_of]
+    damping = model.dof_damping[dof_of] + kv
+
+    dt = float(model.opt.timestep)
+    seg_steps = max(1, int(round(segment_seconds / dt)))
+    settle_steps = int(round(settle_seconds / dt))
+    n_steps = seg_steps * (len(way) - 1) + settle_steps
+    qpos = np.empty((n_steps + 1, model.nq))
+    tip = np.empty((n_steps + 1, 3))
+    qpos[0], tip[0] = data.qpos, data.site_xpos[tip_id]
+    waypoint_index = np.zeros(len(way), dtype=np.int64)
+    k = 0
+
+    def step(ctrl_q: np.ndarray, vel_q: np.ndarray) -> None:
+        nonlocal k
+        data.ctrl[:] = ctrl_q[qadr_of]
+        mujoco.mj_step1(model, data)
+        if feedforward:
+            data.qfrc_applied[:] = data.qfrc_bias
+            data.qfrc_applied[dof_of] += damping * vel_q[qadr_of]
+        mujoco.mj_step2(model, data)
+        k += 1
+        qpos[k] = data.qpos
+        tip[k] = data.site_xpos[tip_id]
+
+    for i in range(1, len(way)):
+        q0, q1 = way[i - 1], way[i]
+        vel = (q1 - q0) / (seg_steps * dt)
+        for j in range(1, seg_steps + 1):
+            step(q0 + (q1 - q0) * (j / seg_steps), vel)
+        waypoint_index[i] = k
+    zero = np.zeros(model.nq)
+    for _ in range(settle_steps):
+        step(way[-1], zero)
+    # site_xpos after mj_step2 is from the step's start; refresh the last sample exactly.
+    mujoco.mj_kinematics(model, data)
+    tip[k] = data.site_xpos[tip_id]
+    # Likewise every recorded tip lags its qpos by one step: recompute them from qpos.
+    tip[1:k] = _tips_of(model, qpos[1:k], tip_id)
+
+    layout = scene.layout
+    planned_cells = _dedupe(robot.label[states].tolist())
+    planned_xy = np.array([np.array(layout.xy(c), dtype=float) * scene.cell for c in planned_cells])
+    settings = {"segment_seconds": seg_steps * dt, "settle_seconds": settle_steps * dt,
+                "bandwidth_hz": bandwidth_hz, "feedforward": feedforward, "timestep": dt}
+    return Replay(robot=robot.name, scene=scene, path_states=tuple(states), goal_cell=goal,
+                  planned_xy=planned_xy, planned_tip=planned_tip, time=np.arange(k + 1) * dt,
+                  qpos=qpos, tip=tip, waypoint_index=waypoint_index, settings=settings)
+
+
+def _ctrl_of(model: mujoco.MjModel, q: np.ndarray) -> np.ndarray:
+    return np.asarray(q)[model.jnt_qposadr[model.actuator_trnid[:, 0]]]
+
+
+def _fk(model, data, q, tip_id) -> np.ndarray:
+    data.qpos[:] = q
+    mujoco.mj_kinematics(model, data)
+    return data.site_xpos[tip_id].copy()
+
+
+def _tips_of(model, qs: np.ndarray, tip_id: int) -> np.ndarray:
+    d = mujoco.MjData(model)
+    out = np.empty((len(qs), 3))
+    for i, q in enumerate(qs):
+        out[i] = _fk(model, d, q, tip_id)
+    return out
+
+
+def _tune_gains(model: mujoco.MjModel, data: mujoco.MjData, bandwidth_hz: float) -> np.ndarray:
+    """Critically damped position servos per joint; returns each actuator's kv."""
+    if not np.all(model.actuator_trntype == mujoco.mjtTrn.mjTRN_JOINT):
+        raise ReplayError("every actuator must drive a joint to replay a path")
+    w = 2 * np.pi * bandwidth_hz
+    mujoco.mj_forward(model, data)
+    dense = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, dense)
+    dofs = model.jnt_dofadr[model.actuator_trnid[:, 0]]
+    inertia = np.diag(dense)[dofs]
+    kp, kv = inertia * w * w, 2 * inertia * w
+    model.actuator_gainprm[:, 0] = kp
+    model.actuator_biasprm[:, 0] = 0.0
+    model.actuator_biasprm[:, 1] = -kp
+    model.actuator_biasprm[:, 2] = -kv
+    return kv
+
+
+__all__ = ["Replay", "ReplayError", "polyline_distance", "replay", "robot_scene"]
