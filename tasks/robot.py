@@ -80,7 +80,10 @@ class DiscreteRobot:
                 return s
         states = self.states_at(cell)
         if len(states) == 0:
-            raise InvalidCellError(f"robot {self.name} cannot reach the {what} cell {cell}")
+            from tasks.layout import ROOMS
+
+            where = ROOMS.xy(cell) if 0 <= cell < ROOMS.n_cells else cell
+            raise InvalidCellError(f"robot {self.name} cannot reach the {what} cell {where}")
         return int(states[0])
 
     def reachable_from(self, state: int) -> np.ndarray:

@@ -173,6 +173,7 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none") -> dict:
             "converged": r.column("converged"),
             "episodes": r.column("episodes"),
             "episode_steps": [t.episode_steps.tolist() for t in r.trials],
+            "greedy_path_states": [[int(s) for s, _ in t.greedy_path] for t in r.trials],
         }
         entry.update(r.extra)
         out[r.method] = entry

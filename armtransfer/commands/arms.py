@@ -1,15 +1,18 @@
-"""``armtransfer arms``: the arm robots (``arms list``); transfer between arms comes later."""
+"""``armtransfer arms``: transfer between arms (see ``armtransfer.arm_transfer``), and
+``armtransfer arms list``: the arm robots, their DOF, action models and reachability."""
 
 from __future__ import annotations
 
 import argparse
 
-HELP = "list the arm robots: arms, DOF, action models, states and reachability"
+HELP = ("transfer a trajectory from one arm to another (default: planar2:joint -> ur5e_like:cartesian, "
+        "task 1); 'arms list' lists the arm robots")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("action", nargs="?", choices=["list"],
-                        help="'list': compile (or load) every arm robot and report it")
+                        help="'list': compile (or load) every arm robot and report it; without it, "
+                             "run a transfer")
     parser.add_argument("--arm-xml", metavar="PATH",
                         help="also list a bring-your-own MJCF serial arm with hinge joints")
     parser.add_argument("--tip-site", metavar="NAME", default="tip",
@@ -26,8 +29,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="only these action models, comma-separated (e.g. joint,cartesian)")
     parser.add_argument("--cell-size", type=float, default=0.01, help="cell size in metres")
     parser.add_argument("--no-cache", action="store_true", help="compile without the cache")
-    parser.add_argument("--source", help=argparse.SUPPRESS)
-    parser.add_argument("--target", help=argparse.SUPPRESS)
+    from armtransfer import arm_transfer
+
+    arm_transfer.add_arguments(parser)
 
 
 def _base_pos(text: str | None):
@@ -50,7 +54,9 @@ def run(args: argparse.Namespace) -> int:
     from tasks.errors import ArmTransferError
 
     if args.action != "list":
-        raise ArmTransferError("not implemented yet: use `armtransfer arms list`")
+        from armtransfer import arm_transfer
+
+        return arm_transfer.run(args)
     from ik.robots import arm_robot, robot_specs
     from tasks.catalog import TABLE_I
 

@@ -42,13 +42,14 @@ def k_value(text: str) -> float | str:
     return value
 
 
-def add_method_arguments(p: argparse.ArgumentParser) -> None:
+def add_method_arguments(p: argparse.ArgumentParser, default: list[str] | None = None) -> None:
     from transfer import mapping as mappings
     from transfer import potentials
     from transfer.experiment import METHODS
 
-    p.add_argument("--method", nargs="+", default=["none", "pseudo"], metavar="METHOD",
-                   help=f"one or more of: {', '.join(METHODS)} (default: none pseudo)")
+    default = default or ["none", "pseudo"]
+    p.add_argument("--method", nargs="+", default=default, metavar="METHOD",
+                   help=f"one or more of: {', '.join(METHODS)} (default: {' '.join(default)})")
     p.add_argument("--trajectory", action="append", default=None, metavar="KIND|PATH",
                    help="the transferred trajectory: optimal (the source's shortest path; default), "
                         "learned (its greedy path after learning), shuffled or random (controls), or a "
@@ -151,6 +152,29 @@ def config_from_args(args: argparse.Namespace) -> LearnerConfig:
         max_episodes=args.max_episodes,
         patience=args.patience,
     )
+
+
+def interactive() -> bool:
+    """Progress output only on a terminal."""
+    return sys.stderr.isatty()
+
+
+class phase:
+    """A progress bar for one step of unknown length (compiling, rendering): it shows the
+    step and, when done, how long it took; silent when not on a terminal."""
+
+    def __init__(self, desc: str) -> None:
+        self.desc = desc
+
+    def __enter__(self):
+        self.bar = progress_bar(1, self.desc)
+        self.bar.__enter__()
+        return self.bar
+
+    def __exit__(self, *exc):
+        if exc[0] is None:
+            self.bar.update()
+        return self.bar.__exit__(*exc)
 
 
 def progress_bar(total: int, desc: str):

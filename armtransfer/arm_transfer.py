@@ -1,0 +1,237 @@
+"""Arm-to-arm transfer end to end: ``armtransfer arms --source ... --target ...``.
+
+The source arm solves the task (it learns with SARSA(lambda), or plans with breadth-first
+search), its trajectory of (cell, action index) is transferred, the target arm learns with
+each method; then the results, a Table II-style table, learning curves, a top-down map and
+a physics-replay video of both arms go into one output directory.
+
+Nothing half-written is left as if complete: every output is first written into a hidden
+temporary directory beside ``--out``, which is renamed into place only when all of them are.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as _dt
+import os
+import shutil
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from armtransfer.commands import common
+from armtransfer.commands.rooms import print_results, run_experiment
+from tasks.errors import ArmTransferError, InvalidParameterError, UnknownRobotError
+from tasks.layout import ROOMS
+from tasks.robot import DiscreteRobot
+from transfer import experiment, figures, report
+from transfer.io import OutputError, check_writable, write_json_atomic, write_text_atomic
+
+DEFAULT_SOURCE = "planar2:joint"
+DEFAULT_TARGET = "ur5e_like:cartesian"
+CUSTOM = "custom"
+DEFAULT_METHODS = ["none", "pseudo", "dense"]
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    common.add_task_arguments(p)
+    p.add_argument("--source", default=DEFAULT_SOURCE, metavar="ARM[:ACTIONS]",
+                   help=f"the arm that solves the task (default {DEFAULT_SOURCE}); "
+                        f"'{CUSTOM}[:ACTIONS]' is the arm of --arm-xml")
+    p.add_argument("--target", default=DEFAULT_TARGET, metavar="ARM[:ACTIONS]",
+                   help=f"the arm that learns (default {DEFAULT_TARGET})")
+    p.add_argument("--source-planner", choices=["learn", "bfs"], default="learn",
+                   help="how the source solves the task: SARSA(lambda) without transfer (default) or "
+                        "breadth-first search")
+    common.add_method_arguments(p, default=DEFAULT_METHODS)
+    common.add_learning_arguments(p)
+    p.add_argument("--json", default=None, metavar="PATH", help="also write the results JSON here")
+    p.add_argument("--render", default=None, metavar="PATH",
+                   help="also write the rollout video here (.mp4, or .gif)")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="output directory (default runs/<timestamp>); must not exist or be empty")
+    p.add_argument("--no-video", action="store_true", help="skip the rollout video in --out")
+    p.add_argument("--fast", action="store_true",
+                   help="a quick smoke run: 2 trials, convergence after 5 unchanged episodes, no controls, "
+                        "a small low-rate video")
+
+
+def _custom_options(args: argparse.Namespace) -> dict:
+    if not getattr(args, "arm_xml", None):
+        raise UnknownRobotError(f"robot '{CUSTOM}' needs --arm-xml PATH (and --tip-site NAME)")
+    from armtransfer.commands.arms import _base_pos
+
+    return dict(xml_path=args.arm_xml, tip_site=args.tip_site, base_pos=_base_pos(args.base_pos),
+                base_yaw=args.base_yaw)
+
+
+def resolve_arm(spec: str, args: argparse.Namespace) -> DiscreteRobot:
+    """An arm robot from ``ARM[:ACTIONS]`` (``custom`` = the --arm-xml arm)."""
+    from armtransfer.robots import resolve
+    from ik.robots import arm_robot
+
+    arm, _, actions = spec.partition(":")
+    if arm == CUSTOM:
+        return arm_robot(CUSTOM, actions or "cartesian", progress=common.interactive(), **_custom_options(args))
+    if arm in ("fine", "coarse"):
+        return resolve(spec)
+    from ik.robots import parse_robot_spec
+
+    arm, actions = parse_robot_spec(spec)
+    return arm_robot(arm, actions, progress=common.interactive())
+
+
+def _prepare_out(out: Path) -> Path:
+    """A hidden temporary directory beside ``out`` (which must be absent or empty)."""
+    if out.exists() and (not out.is_dir() or any(out.iterdir())):
+        raise OutputError(f"output directory {str(out)!r} exists and is not empty; choose a new --out")
+    check_writable(out / "results.json")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    return Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
+
+
+def _commit_out(tmp: Path, out: Path) -> None:
+    if out.exists():
+        out.rmdir()  # empty, checked before
+    os.replace(tmp, out)
+
+
+def _apply_fast(args: argparse.Namespace) -> None:
+    if args.fast:
+        args.trials = min(args.trials, 2)
+        args.patience = min(args.patience, 5)
+        args.no_controls = True
+
+
+def run(args: argparse.Namespace) -> int:
+    _apply_fast(args)
+    t0 = time.perf_counter()
+    out = Path(args.out) if args.out else Path("runs") / _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    for extra in (args.json, args.render):
+        if extra:
+            check_writable(extra)
+    if args.render:
+        from armtransfer.render import video_format
+
+        video_format(args.render, None)
+    tmp = _prepare_out(out)
+    try:
+        result = _run_into(args, tmp)
+        if args.json:
+            write_json_atomic(args.json, result["json"])
+        if args.render and result["video"]:
+            tmp_video = tmp / result["video"]
+            target = Path(args.render)
+            if target.suffix.lower() == tmp_video.suffix.lower():
+                shutil.copyfile(tmp_video, target.with_name(f".{target.name}.tmp"))
+                os.replace(target.with_name(f".{target.name}.tmp"), target)
+            else:
+                _video(result, args, target)
+        _commit_out(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    print(f"wrote {out}/ ({', '.join(sorted(p.name for p in out.iterdir()))}) in {time.perf_counter() - t0:.0f} s")
+    return 0
+
+
+def _run_into(args: argparse.Namespace, tmp: Path) -> dict:
+    with common.phase("compiling arms"):
+        source = resolve_arm(args.source, args)
+        target = resolve_arm(args.target, args)
+    if args.source_planner == "learn" and not args.trajectory:
+        args.trajectory = ["learned"]
+    out_json, learned = run_experiment(args, source=source, target=target)
+    print_results(out_json)
+    if out_json["mapping"] is not None and out_json["mapping"]["saved"]:
+        learned.save(args.mapping)
+    write_json_atomic(tmp / "results.json", out_json)
+    write_text_atomic(tmp / "table.md", _table_md(out_json))
+    curves = {m: r["episode_steps"] for m, r in out_json["results"].items() if "[" not in m}
+    figures.learning_curves(curves, f"{source.name} -> {target.name}: steps per episode", tmp / "learning_curves.png")
+    paths = _paths(out_json, source, target, args)
+    traj_xy = [list(ROOMS.xy(c)) for c in paths["trajectory_cells"]] + [list(out_json["task"]["goal"])]
+    figures.mapping_paths(ROOMS.wall_mask, ROOMS.lo, traj_xy, paths["target_xy"] or traj_xy, [],
+                          f"{source.name} (dashed) -> {target.name} (solid)", tmp / "map.png")
+    video = None
+    if not args.no_video:
+        video = "rollout.mp4"
+        stats = _video({"paths": paths, "source": source, "target": target}, args, tmp / video)
+        out_json["rollout"] = stats
+        write_json_atomic(tmp / "results.json", out_json)
+        for label, rp in zip(("source", "target"), stats["replays"]):
+            print(f"replay {label}: largest tip deviation {rp['max_deviation_cells']:.2f} cell, "
+                  f"reached the goal cell: {'yes' if rp['reached_goal'] else 'no'}")
+    return {"json": out_json, "video": video, "paths": paths, "source": source, "target": target}
+
+
+def _paths(out_json: dict, source: DiscreteRobot, target: DiscreteRobot, args) -> dict:
+    """The source's transferred path and the target's converged greedy path (first
+    converged trial of the first transfer method), as states and cells."""
+    start = ROOMS.cell(*out_json["task"]["start"])
+    goal = ROOMS.cell(*out_json["task"]["goal"])
+    steps = out_json["trajectory"]["steps"] if out_json["trajectory"] else []
+    traj_cells = [ROOMS.cell(*s["cell"]) for s in steps]
+    source_states = _states_along(source, start, steps, goal) if steps else [source.start_state(start)]
+    target_states = None
+    for method, r in out_json["results"].items():
+        if method != "none" and "[" not in method:
+            for states in r.get("greedy_path_states", []):
+                if states:
+                    target_states = states
+                    break
+        if target_states:
+            break
+    if target_states is None:
+        path = target.shortest_path(target.start_state(start), goal)
+        target_states = [s for s, _ in path]
+    return {
+        "trajectory_cells": traj_cells,
+        "goal": goal,
+        "source_states": source_states,
+        "target_states": target_states,
+        "target_xy": [list(ROOMS.xy(int(target.label[s]))) for s in target_states],
+    }
+
+
+def _states_along(robot: DiscreteRobot, start: int, steps: list[dict], goal: int) -> list[int]:
+    """Re-trace the transferred trajectory in the source's own states: the source is
+    deterministic, so its actions from the start state give its states back."""
+    s = robot.start_state(start)
+    states = [s]
+    for k, step in enumerate(steps):
+        if ROOMS.cell(*step["cell"]) != robot.label[s] or not 0 <= step["action"] < robot.n_actions:
+            raise InvalidParameterError(
+                f"the trajectory's step {k} is not a move of {robot.name}; cannot replay the source")
+        s = int(robot.next_state[s, step["action"]])
+        states.append(s)
+    if robot.label[s] != goal:
+        raise InvalidParameterError(f"the trajectory does not take {robot.name} to the goal; cannot replay it")
+    return states
+
+
+def _video(result: dict, args, path: Path) -> dict:
+    from armtransfer.render import rollout_video
+
+    paths = result["paths"]
+    fps = 10.0 if args.fast else 30.0
+    size = (160, 120) if args.fast else (320, 240)
+    with common.phase("rendering the rollout"):
+        return rollout_video(
+            [(result["source"], paths["source_states"]), (result["target"], paths["target_states"])],
+            path, trajectory_cells=paths["trajectory_cells"], goal_cell=paths["goal"],
+            width=size[0], height=size[1], fps=fps,
+        )
+
+
+def _table_md(out_json: dict) -> str:
+    t = out_json["task"]
+    return (
+        f"# {out_json['source']} -> {out_json['target']}\n\n"
+        f"{t['name']}: {tuple(t['start'])} -> {tuple(t['goal'])}; target's optimal distance "
+        f"{out_json['distance']}; {out_json['trials']} trials, seed {out_json['seed']}"
+        + (f", wind {out_json['wind']}" if out_json["wind"] else "")
+        + "\n\n" + report.method_table(out_json["results"]) + "\n"
+    )
