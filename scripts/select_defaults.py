@@ -29,7 +29,7 @@ CANDIDATES = {
     "first-visit": [{"K": k} for k in (0.3, 1, 3, 10, 30)],
     "progress": [{"K": k} for k in (1, 3, 10, 30)],
     "potential": [{"K": k} for k in (0.3, 1, 3, 10)],
-    "dense": [{"K": k, "beta": b} for k, b in itertools.product((1, 2, 3, 4), (0.5, 1, 1.5, 2))],
+    "dense": [{"K": k, "beta": b} for k, b in itertools.product((1, 2, 3, 4, 6), (0.5, 1, 1.5, 2))],
 }
 
 
@@ -74,10 +74,13 @@ def main() -> None:
     p.add_argument("--pairs", type=int, default=8)
     p.add_argument("--trials", type=int, default=20)
     p.add_argument("--seed", type=int, default=2026)
+    p.add_argument("--method", nargs="*", default=None, help="only these methods")
     args = p.parse_args()
     pairs = held_out_pairs(args.pairs, args.seed)
     print("held-out pairs:", [(ROOMS.xy(s), ROOMS.xy(g)) for s, g in pairs])
     for method, cands in CANDIDATES.items():
+        if args.method and method not in args.method:
+            continue
         scores = [(score(method, c, pairs, args.trials), c) for c in cands]
         for sc, c in scores:
             print(f"{method:12s} {c}: {sc:.1f} x optimal")

@@ -52,4 +52,5 @@ def grid_robot(name: str, layout: Layout = ROOMS) -> DiscreteRobot:
         action_names=action_names,
         cell_step=k,
         canonical=index,
+        meta={"layout": layout},
     )

@@ -61,6 +61,14 @@ class DiscreteRobot:
             object.__setattr__(self, "canonical", can)
 
     @property
+    def layout(self):
+        """The layout whose cells the labels number (``meta['layout']``, else the rooms world)."""
+        from tasks.layout import ROOMS, Layout
+
+        layout = self.meta.get("layout")
+        return layout if isinstance(layout, Layout) else ROOMS
+
+    @property
     def n_states(self) -> int:
         return int(self.next_state.shape[0])
 

@@ -54,10 +54,6 @@ def test_byo_arm_errors_exit_2(tmp_path, capsys):
                     "no site 'pen'; its sites: tip")
 
 
-def test_arms_without_list_is_not_implemented_yet(capsys):
-    _one_line_error(capsys, ["arms", "--source", "planar2:joint"], "use `armtransfer arms list`")
-
-
 def test_unknown_arm_name_lists_valid_ones(capsys):
     _one_line_error(capsys, ["arms", "list", "--arm", "puma"], "valid arms: planar2")
 

@@ -139,14 +139,17 @@ def test_bench_fast_mode_writes_its_figures(tmp_path):
         data["median_steps_per_second"] / data["baseline_median_steps_per_second"])
 
 
-def test_reproduce_fast_mode_writes_report_figures_and_results(tmp_path):
-    out = tmp_path / "rep"
-    assert main(["reproduce", "--out", str(out), "--trials", "2"]) == 0
+def test_reproduce_fast_mode_writes_report_figures_and_results(reproduce_fast):
+    code, out = reproduce_fast
+    assert code == 0
     report = (out / "report.md").read_text()
     for needle in ("Table II", "Table IV", "Table V", "Wind"):
         assert needle in report
     assert "9,777.8" in report  # the paper's Table II A, task 1, beside ours
     data = json.loads((out / "results.json").read_text())
     assert set(data["table_ii"]) == {"1", "2", "3", "4"}
-    for name in ("fig4_coarse_to_fine.png", "fig5_fine_to_coarse.png", "fig6_wind.png"):
+    for section in ("All methods, coarse -> fine", "Controls:", "Transfer metrics", "`oracle`"):
+        assert section in report, section
+    assert set(data["methods"]["1"]["results"]) >= {"none", "pseudo", "dense", "dense [shuffled]", "dense [random]"}
+    for name in ("fig4_coarse_to_fine.png", "fig5_fine_to_coarse.png", "fig6_wind.png", "fig_methods.png"):
         assert (out / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

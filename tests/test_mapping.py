@@ -329,9 +329,9 @@ def test_rooms_mapping_bad_input(tmp_path, capsys):
                      capsys, "cannot write")
 
 
-def test_reproduce_reports_the_mapping_columns_beside_the_papers(tmp_path, capsys):
-    out = tmp_path / "rep"
-    assert main(["reproduce", "--trials", "2", "--out", str(out)]) == 0
+def test_reproduce_reports_the_mapping_columns_beside_the_papers(reproduce_fast):
+    code, out = reproduce_fast
+    assert code == 0
     report = (out / "report.md").read_text()
     for heading in ("Table II D-F", "Table V D-E", "Table III analog: coarse -> fine",
                     "Table III analog: fine -> coarse", "under wind 0.01", "Fig. 7 analog"):

@@ -7,15 +7,19 @@ as starting from Q(s, a) = Phi(s) (Wiewiora, 2003).
 
 ``dense`` (new here): a potential over the shared workspace the robot perceives,
 
-    Phi(s) = K * (i*(s) - n) - K * beta * d(s)
+    Phi(s) = K * (P * (i*(s) / n - 1) - beta * d(s)),   P = 20
 
 where d(s) is the Euclidean distance, in cells, between the robot's label and the nearest
 trajectory cell, i*(s) the largest index among the trajectory cells at that distance, and n
-the index of the last trajectory state. Two parameters: ``K``, the potential gained per
-trajectory index, and ``beta``, the indices lost per cell of distance from the trajectory.
-Phi <= 0 and rises towards the goal, so standing still (a blocked move) earns nothing.
-It uses distances between labels only, never the map's walls or connectivity, which the
-robot does not know; so across a wall it can point the wrong way.
+the index of the last trajectory state, so i*/n is the fraction of the trajectory done. Two
+parameters: ``K``, the scale, and ``beta``, the progress units lost per cell of distance
+from the trajectory. P fixes the range of the progress term whatever the trajectory's
+length: with K per *index* instead, a long wandering trajectory (an arm's learned path of a
+hundred steps) makes the potential so steep that a cell across a wall from the end of the
+trajectory becomes a trap the learner needs millions of steps to leave. Phi <= 0 and rises
+towards the goal. It uses distances between labels only, never the map's walls or
+connectivity, which the robot does not know; so across a wall it can still point the wrong
+way, only less steeply.
 
 ``oracle`` (a control, not a transfer method): Phi(s) = -K * (the robot's true
 shortest-path distance to the goal). It uses the map, which no robot has; it bounds what
@@ -30,8 +34,10 @@ from tasks.layout import ROOMS, Layout
 from tasks.robot import DiscreteRobot
 from transfer.trajectory import Trajectory
 
-DENSE_K = 3.0
+DENSE_K = 4.0
 DENSE_BETA = 1.5
+PROGRESS_RANGE = 20.0
+"""P: the progress term of ``dense`` spans P * K whatever the trajectory's length."""
 
 
 def _label_xy(robot: DiscreteRobot, layout: Layout) -> np.ndarray:
@@ -45,9 +51,10 @@ def dense(
     traj: Trajectory,
     K: float = DENSE_K,
     beta: float = DENSE_BETA,
-    layout: Layout = ROOMS,
+    layout: Layout | None = None,
 ) -> np.ndarray:
     """The ``dense`` potential of every robot state (float64 [n_states])."""
+    layout = layout or robot.layout
     p = _label_xy(robot, layout)
     t = np.array([layout.xy(c) for c in traj.cells], dtype=np.float64)
     n = len(t) - 1
@@ -59,7 +66,7 @@ def dense(
         tie = np.abs(d - best_d) <= 1e-9
         best_i = np.where(closer | tie, i, best_i)
         best_d = np.where(closer, d, best_d)
-    return K * (best_i - n) - K * beta * best_d
+    return K * (PROGRESS_RANGE * (best_i / max(n, 1) - 1.0) - beta * best_d)
 
 
 def oracle(robot: DiscreteRobot, goal_cell: int, K: float = 2.0) -> np.ndarray:

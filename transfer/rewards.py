@@ -155,7 +155,6 @@ def build(
     if method == "dense":
         if not (np.isfinite(beta) and beta >= 0):
             raise InvalidParameterError(f"beta must be a non-negative number, got {beta}")
-        phi = np.max([potentials.dense(robot, t, k * longest_n(trajs) / max(t.n, 1), beta * max(t.n, 1) / longest_n(trajs))
-                      for t in trajs], axis=0)
+        phi = np.max([potentials.dense(robot, t, k, beta) for t in trajs], axis=0)
         return Shaping(sarsa.MODE_POTENTIAL, zeros, ids, phi, k)
     raise InvalidParameterError(f"no shaping for method {method!r}")

@@ -95,7 +95,8 @@ def shortest(robot: DiscreteRobot, start_cell: int, goal_cell: int) -> Trajector
     path = robot.shortest_path(robot.start_state(start_cell), goal_cell)
     if path is None:
         raise InvalidTrajectoryError(
-            f"robot {robot.name} cannot reach the goal cell {ROOMS.xy(goal_cell)} from {ROOMS.xy(start_cell)}"
+            f"robot {robot.name} cannot reach the goal cell {robot.layout.xy(goal_cell)} "
+            f"from {robot.layout.xy(start_cell)}"
         )
     return from_path(robot, path)
 
@@ -110,7 +111,7 @@ def via(robot: DiscreteRobot, start_cell: int, goal_cell: int, waypoints: list[i
     for cell in [*waypoints, goal_cell]:
         leg = robot.shortest_path(state, cell)
         if leg is None:
-            raise InvalidTrajectoryError(f"robot {robot.name} cannot reach waypoint {ROOMS.xy(cell)}")
+            raise InvalidTrajectoryError(f"robot {robot.name} cannot reach waypoint {robot.layout.xy(cell)}")
         full.extend(leg[:-1])
         state = leg[-1][0]
     full.append((state, -1))
