@@ -19,7 +19,8 @@ def markdown_table(header: list[str], rows: list[list[str]]) -> str:
 
 
 def method_table(results: dict) -> str:
-    """One row per method: exploration steps (mean, 95% CI), improvement, greedy, total."""
+    """One row per method: exploration steps (mean, 95% CI, over the trials that reached the
+    goal), improvement, greedy steps, total steps, and how many trials reached and converged."""
     header = [
         "method",
         "exploration steps",
@@ -28,11 +29,13 @@ def method_table(results: dict) -> str:
         "improvement 95% CI",
         "greedy steps",
         "steps to converge",
+        "reached",
         "converged",
     ]
     rows = []
     for method, r in results.items():
         conv = r.get("converged", [])
+        ex = r.get("exploration_steps", [])
         rows.append(
             [
                 method,
@@ -42,6 +45,7 @@ def method_table(results: dict) -> str:
                 fmt_ci(r.get("improvement_ci95")),
                 fmt_num(r.get("greedy_mean")),
                 fmt_num(r.get("total_mean"), 0),
+                f"{sum(x is not None for x in ex)}/{len(ex)}",
                 f"{sum(bool(c) for c in conv)}/{len(conv)}",
             ]
         )

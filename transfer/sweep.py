@@ -39,7 +39,9 @@ from tasks.errors import ArmTransferError
 from transfer.config import LearnerConfig
 
 RUN_FORMAT = "armtransfer-run/1"
-METHODS = ("none", "pseudo", "first-visit", "potential", "progress")
+METHODS = ("none", "pseudo", "first-visit", "potential", "progress", "dense")
+"""Every method but `mapping`, whose protocol (tasks in order, one mapping carried from task
+to task) is not a grid of independent runs: use `armtransfer rooms --method mapping --mapping PATH`."""
 
 # key -> (default, is a list axis)
 _AXES = {
