@@ -66,3 +66,17 @@ def check_writable(path: str | os.PathLike) -> None:
         raise OutputError(f"cannot write {str(p)!r}: {str(probe)!r} is not a writable directory")
     if p.is_dir():
         raise OutputError(f"cannot write {str(p)!r}: it is a directory")
+
+
+def read_json(path: str | os.PathLike, what: str, error: type[ArmTransferError]) -> object:
+    """Parse a JSON file; an unreadable or malformed one raises ``error`` with one line
+    naming ``what`` ("trajectory file", "mapping file", ...) and the problem."""
+    p = Path(path)
+    try:
+        text = p.read_text()
+    except OSError as err:
+        raise error(f"cannot read {what} {str(p)!r}: {err.strerror}") from None
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as err:
+        raise error(f"{what} {str(p)!r} is not valid JSON (line {err.lineno}: {err.msg})") from None

@@ -326,18 +326,10 @@ class ActionMapping:
 
     @staticmethod
     def load(path: str | os.PathLike) -> "ActionMapping":
-        p = Path(path)
-        try:
-            text = p.read_text()
-        except OSError as err:
-            raise InvalidMappingError(f"cannot read mapping file {str(p)!r}: {err.strerror}") from None
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as err:
-            raise InvalidMappingError(
-                f"mapping file {str(p)!r} is not valid JSON (line {err.lineno}: {err.msg})"
-            ) from None
-        return ActionMapping.from_json(data, where=f"mapping file {str(p)!r}")
+        from transfer.io import read_json
+
+        data = read_json(path, "mapping file", InvalidMappingError)
+        return ActionMapping.from_json(data, where=f"mapping file {str(Path(path))!r}")
 
 
 def load_for(path: str | os.PathLike, source: DiscreteRobot, target: DiscreteRobot) -> ActionMapping:

@@ -16,7 +16,6 @@ Action indices are 0-based (the paper's coarse actions 1-4 are 0-3 here).
 
 from __future__ import annotations
 
-import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -160,18 +159,10 @@ def parse(data: object, layout: Layout = ROOMS, where: str = "trajectory") -> Tr
 
 
 def load(path: str | os.PathLike, layout: Layout = ROOMS) -> Trajectory:
-    p = Path(path)
-    try:
-        text = p.read_text()
-    except OSError as err:
-        raise InvalidTrajectoryError(f"cannot read trajectory file {str(p)!r}: {err.strerror}") from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as err:
-        raise InvalidTrajectoryError(
-            f"trajectory file {str(p)!r} is not valid JSON (line {err.lineno}: {err.msg})"
-        ) from None
-    return parse(data, layout, where=f"trajectory file {str(p)!r}")
+    from transfer.io import read_json
+
+    data = read_json(path, "trajectory file", InvalidTrajectoryError)
+    return parse(data, layout, where=f"trajectory file {str(Path(path))!r}")
 
 
 def check_task(traj: Trajectory, start_cell: int, goal_cell: int, layout: Layout = ROOMS) -> None:
