@@ -492,6 +492,7 @@ def report_markdown(res: dict, figures: dict[str, str]) -> str:
         "order of moves. The paper does not define its E precisely.",
         "- The paper reports means of 10 trials without intervals; with 10 trials our own intervals are "
         "often +-30-50% of the mean, so single-digit differences between our numbers and the paper's "
-        "mean little.",
+        "mean little. For a tighter estimate of one task, run `armtransfer rooms --task N --trials 300 "
+        "--no-controls`.",
     ]
     return "\n".join(lines) + "\n"
