@@ -19,14 +19,13 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
 
 from armtransfer.commands import common
 from armtransfer.commands.rooms import print_results, run_experiment
-from tasks.errors import ArmTransferError, InvalidParameterError, UnknownRobotError
+from tasks.errors import InvalidParameterError, UnknownRobotError
 from tasks.layout import ROOMS
 from tasks.robot import DiscreteRobot
-from transfer import experiment, figures, report
+from transfer import figures, report
 from transfer.io import OutputError, check_writable, write_json_atomic, write_text_atomic
 
 DEFAULT_SOURCE = "planar2:joint"

@@ -12,7 +12,6 @@ from __future__ import annotations
 from typing import Any
 
 import gymnasium as gym
-import numpy as np
 from gymnasium import spaces
 
 from tasks.catalog import Task, custom_task, table_task

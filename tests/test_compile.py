@@ -1,6 +1,5 @@
 """Compiling arms into discrete robots: Table I solvability, walls, wind, cache, BYO arms."""
 
-import mujoco
 import numpy as np
 import pytest
 

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tasks.layout import ROOMS, Layout
+from tasks.layout import Layout
 from tasks.robot import DiscreteRobot
 from transfer.trajectory import Trajectory
 

@@ -13,7 +13,6 @@ What runs (every number with a 95% confidence interval over ``trials`` trials):
 from __future__ import annotations
 
 from collections.abc import Callable
-from pathlib import Path
 
 from tasks.catalog import TABLE_I
 from tasks.grid_robots import grid_robot

@@ -51,7 +51,6 @@ def _base_pos(text: str | None):
 def run(args: argparse.Namespace) -> int:
     from ik.actions import ACTION_MODELS
     from ik.errors import ArmModelError
-    from tasks.errors import ArmTransferError
 
     if args.action != "list":
         from armtransfer import arm_transfer
