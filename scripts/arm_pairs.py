@@ -24,7 +24,7 @@ PAIRS = [
     ("planar2:joint", "panda_like:cartesian"),
     ("ur5e_like:cartesian", "planar2:joint"),
 ]
-METHODS = ("none", "pseudo", "dense")
+DEFAULT_METHODS = ("none", "pseudo", "dense")
 
 
 def main() -> None:
@@ -32,7 +32,10 @@ def main() -> None:
     p.add_argument("--trials", type=int, default=20)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", default=None, help="also write the markdown table here")
+    p.add_argument("--methods", nargs="+", default=list(DEFAULT_METHODS),
+                   help=f"methods, the first being the baseline (default: {' '.join(DEFAULT_METHODS)})")
     args = p.parse_args()
+    METHODS = tuple(args.methods)
     config = LearnerConfig()
     rows = []
     t0 = time.perf_counter()
