@@ -133,7 +133,7 @@ def _steps(entry: dict, digits: int = 0) -> str:
     return f"{fmt_num(entry['mean'], digits)} {fmt_ci(entry['ci95'], digits)}{tail}"
 
 
-def controls_markdown(res: dict) -> str:
+def controls_markdown(res: dict, max_steps: int) -> str:
     header = ["task", "method", "real trajectory", "[shuffled]", "[random]"]
     rows = []
     for t in TASKS:
@@ -146,8 +146,8 @@ def controls_markdown(res: dict) -> str:
         + "\n\n[shuffled]: the trajectory's cells in a random order (start kept first); [random]: a random "
         "walk of the coarse robot of the same length. A speed-up that the random walk also gives does not "
         "come from the transferred knowledge; one that the shuffled cells keep comes from where the cells "
-        "are, not from their order. (r/N reached): only r of N trials reached the goal within the learner's "
-        "20 million steps; the mean is over those r. `dense` given a wrong trajectory is far worse than no "
+        "are, not from their order. (r/N reached): only r of N trials reached the goal within the "
+        f"trial's cap of {max_steps:,} steps; the mean is over those r. `dense` given a wrong trajectory is far worse than no "
         "transfer: its potential then pulls steadily the wrong way, and the learner must unlearn it."
     )
 

@@ -458,7 +458,7 @@ def report_markdown(res: dict, figures: dict[str, str]) -> str:
         "",
         f"![All methods]({figures['methods']})",
         "",
-        beyond.controls_markdown(res["methods"]),
+        beyond.controls_markdown(res["methods"], res["config"]["max_total_steps"]),
         "",
         beyond.metrics_markdown(res["methods"]),
         "",

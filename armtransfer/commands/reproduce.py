@@ -22,6 +22,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--trials", type=common.positive_int, default=30,
                    help="trials per table cell (default 30; the paper used 10)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--max-total-steps", type=common.positive_int, default=LearnerConfig.max_total_steps,
+                   help="steps per trial at most, over all its episodes; a trial that has not reached "
+                        f"the goal by then counts as not reached (default {LearnerConfig.max_total_steps:,})")
 
 
 def _bars(res: dict, key: str) -> dict:
@@ -38,7 +41,7 @@ def _bars(res: dict, key: str) -> dict:
 def run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     check_writable(out / "report.md")
-    config = LearnerConfig()
+    config = LearnerConfig(max_total_steps=args.max_total_steps)
     t0 = time.perf_counter()
     with common.progress_bar(rep.plan(args.trials), "reproduce") as bar:
         res = rep.run_all(args.trials, args.seed, config, tick=bar.update)
