@@ -5,6 +5,35 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 
 import pytest  # noqa: E402
 
+SCARA_XML = """<mujoco model="my_scara"><worldbody>
+  <body name="upper" pos="0.05 0.02 0.15">
+    <joint name="shoulder" type="hinge" axis="0 0 1" range="-3 3"/>
+    <geom name="upper_geom" type="capsule" size="0.01" fromto="0 0 0 0.24 0 0"/>
+    <body name="fore" pos="0.24 0 -0.03">
+      <joint name="elbow" type="hinge" axis="0 0 1" range="-2.9 2.9"/>
+      <geom name="fore_geom" type="capsule" size="0.01" fromto="0 0 0 0.2 0 0"/>
+      <geom name="pen" type="cylinder" size="0.0015" fromto="0.2 0 0 0.2 0 -0.115"/>
+      <site name="pen_tip" pos="0.2 0 -0.116"/>
+    </body>
+  </body></worldbody></mujoco>"""
+"""A bring-your-own 2-joint SCARA with its tip site named ``pen_tip``."""
+
+
+@pytest.fixture(scope="session", autouse=True)
+def arm_cache(tmp_path_factory):
+    """Compiled arm robots go to one cache for the session, never the user's own."""
+    mp = pytest.MonkeyPatch()
+    mp.setenv("ARMTRANSFER_CACHE", str(tmp_path_factory.getbasetemp() / "armcache"))
+    yield
+    mp.undo()
+
+
+@pytest.fixture
+def scara_xml(tmp_path):
+    path = tmp_path / "my_scara.xml"
+    path.write_text(SCARA_XML)
+    return path
+
 
 @pytest.fixture(scope="session")
 def reproduce_fast(tmp_path_factory):

@@ -8,14 +8,6 @@ import tasks  # noqa: F401 - registers the environments
 from tasks.errors import ArmTransferError
 
 
-@pytest.fixture(scope="module", autouse=True)
-def arm_cache(tmp_path_factory):
-    mp = pytest.MonkeyPatch()
-    mp.setenv("ARMTRANSFER_CACHE", str(tmp_path_factory.getbasetemp() / "armcache"))
-    yield
-    mp.undo()
-
-
 @pytest.mark.parametrize("arm, actions", [("planar2", "joint"), ("ur5e_like", "cartesian")])
 def test_arm_env_passes_check_env_and_reaches_the_goal(arm, actions):
     env = gym.make("armtransfer/ArmRooms-v0", arm=arm, actions=actions, task=1)

@@ -92,24 +92,10 @@ def test_unwritable_output_path(tmp_path, capsys):
     assert "is not empty" in capsys.readouterr().err
 
 
-SCARA = """<mujoco model="my_scara"><worldbody>
-  <body name="upper" pos="0.05 0.02 0.15">
-    <joint name="shoulder" type="hinge" axis="0 0 1" range="-3 3"/>
-    <geom name="upper_geom" type="capsule" size="0.01" fromto="0 0 0 0.24 0 0"/>
-    <body name="fore" pos="0.24 0 -0.03">
-      <joint name="elbow" type="hinge" axis="0 0 1" range="-2.9 2.9"/>
-      <geom name="fore_geom" type="capsule" size="0.01" fromto="0 0 0 0.2 0 0"/>
-      <geom name="pen" type="cylinder" size="0.0015" fromto="0.2 0 0 0.2 0 -0.115"/>
-      <site name="pen_tip" pos="0.2 0 -0.116"/>
-    </body>
-  </body></worldbody></mujoco>"""
-
-
 @pytest.mark.parametrize("side", ["--source", "--target"])
-def test_a_bring_your_own_arm_on_either_side(tmp_path, side):
+def test_a_bring_your_own_arm_on_either_side(tmp_path, scara_xml, side):
     """Task 4: this SCARA cannot reach the cells round its own shoulder, where task 1 starts."""
-    xml = tmp_path / "scara.xml"
-    xml.write_text(SCARA)
+    xml = scara_xml
     out = tmp_path / "run"
     other = "--target" if side == "--source" else "--source"
     code = main(["arms", "--fast", "--no-video", "--out", str(out), side, "custom:cartesian",

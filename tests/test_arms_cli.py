@@ -58,22 +58,8 @@ def test_unknown_arm_name_lists_valid_ones(capsys):
     _one_line_error(capsys, ["arms", "list", "--arm", "puma"], "valid arms: planar2")
 
 
-SCARA = """<mujoco model="my_scara"><worldbody>
-  <body name="upper" pos="0.05 0.02 0.15">
-    <joint name="shoulder" type="hinge" axis="0 0 1" range="-3 3"/>
-    <geom name="upper_geom" type="capsule" size="0.01" fromto="0 0 0 0.24 0 0"/>
-    <body name="fore" pos="0.24 0 -0.03">
-      <joint name="elbow" type="hinge" axis="0 0 1" range="-2.9 2.9"/>
-      <geom name="fore_geom" type="capsule" size="0.01" fromto="0 0 0 0.2 0 0"/>
-      <geom name="pen" type="cylinder" size="0.0015" fromto="0.2 0 0 0.2 0 -0.115"/>
-      <site name="pen_tip" pos="0.2 0 -0.116"/>
-    </body>
-  </body></worldbody></mujoco>"""
-
-
-def test_arms_list_includes_a_bring_your_own_arm(tmp_path, capsys):
-    xml = tmp_path / "my_scara.xml"
-    xml.write_text(SCARA)
+def test_arms_list_includes_a_bring_your_own_arm(scara_xml, capsys):
+    xml = scara_xml
     argv = ["arms", "list", "--arm", "planar2", "--actions", "joint", "--arm-xml", str(xml),
             "--tip-site", "pen_tip", "--base-pos=-0.1,0,0"]
     assert cli.main(argv) == 0

@@ -17,14 +17,6 @@ DEFAULT_ROBOTS = [("planar2", "joint"), ("planar2", "cartesian"), ("ur5e_like", 
                   ("panda_like", "cartesian")]
 
 
-@pytest.fixture(scope="module", autouse=True)
-def arm_cache(tmp_path_factory):
-    mp = pytest.MonkeyPatch()
-    mp.setenv("ARMTRANSFER_CACHE", str(tmp_path_factory.getbasetemp() / "armcache"))
-    yield
-    mp.undo()
-
-
 @pytest.fixture(scope="module")
 def robots():
     return {f"{a}:{m}": arm_robot(a, m) for a, m in DEFAULT_ROBOTS}

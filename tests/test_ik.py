@@ -15,14 +15,6 @@ from tasks.errors import ArmTransferError
 from tasks.layout import ROOMS
 
 
-@pytest.fixture(scope="module", autouse=True)
-def arm_cache(tmp_path_factory):
-    mp = pytest.MonkeyPatch()
-    mp.setenv("ARMTRANSFER_CACHE", str(tmp_path_factory.getbasetemp() / "armcache"))
-    yield
-    mp.undo()
-
-
 @pytest.fixture(scope="module")
 def scenes():
     return {arm: arm_scene(arm) for arm in ARMS}
