@@ -76,6 +76,19 @@ def _egreedy(Q, s, n_actions, eps, rng):
     return n_actions - 1  # unreachable
 
 
+@numba.njit(cache=True, inline="always")
+def _choose(Q, s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start, macro_len, macro_actions):
+    """The next action at s: the running macro's next step; else a new macro starting at s
+    (one draw, runs when < 1 - epsilon); else epsilon-greedy. Returns (action, in_macro,
+    m_pos, m_end, 1 for a macro step else 0); m_pos/m_end index the flat macro actions."""
+    if in_macro:
+        return macro_actions[m_pos], True, m_pos + 1, m_end, 1
+    if may_start and macro_len[s] > 0 and rng.random() < 1.0 - eps:
+        m_pos = macro_start[s]
+        return macro_actions[m_pos], True, m_pos + 1, m_pos + macro_len[s], 1
+    return _egreedy(Q, s, Q.shape[1], eps, rng), False, m_pos, m_end, 0
+
+
 @numba.njit(cache=True)
 def _greedy_path(Q, next_state, label, start, goal, stamp, stamp_id, path_out):
     """Follow argmax Q (lowest index on ties, no wind) from start. Returns the number of
@@ -193,20 +206,10 @@ def _run_trial(
         n_tr = 0
         s = start
         best = 0.0
-        m_pos = 0  # position in the running macro, m_end its end (exclusive)
-        m_end = 0
-        macro_used = 0
-        # choose the first action
-        if use_macros and macro_len[s] > 0 and rng.random() < 1.0 - eps:
-            m_pos = macro_start[s]
-            m_end = m_pos + macro_len[s]
-            a = macro_actions[m_pos]
-            m_pos += 1
-            macro_used += 1
-            in_macro = True
-        else:
-            a = _egreedy(Q, s, n_actions, eps, rng)
-            in_macro = False
+        # choose the first action (m_pos: position in the running macro, m_end: its end)
+        a, in_macro, m_pos, m_end, macro_used = _choose(
+            Q, s, eps, rng, False, 0, 0, use_macros, macro_start, macro_len, macro_actions
+        )
         steps = 0
         reached = False
         limit = max_total_steps - total
@@ -235,19 +238,12 @@ def _run_trial(
                 if in_macro and (blocked or m_pos >= m_end):
                     abandoned = blocked
                     in_macro = False
-                if in_macro:
-                    a2 = macro_actions[m_pos]
-                    m_pos += 1
-                    macro_used += 1
-                elif use_macros and not abandoned and macro_len[s2] > 0 and rng.random() < 1.0 - eps:
-                    m_pos = macro_start[s2]
-                    m_end = m_pos + macro_len[s2]
-                    a2 = macro_actions[m_pos]
-                    m_pos += 1
-                    macro_used += 1
-                    in_macro = True
-                else:
-                    a2 = _egreedy(Q, s2, n_actions, eps, rng)
+                # right after an abandoned macro, Algorithm 1 chooses (no immediate retry)
+                a2, in_macro, m_pos, m_end, used = _choose(
+                    Q, s2, eps, rng, in_macro, m_pos, m_end, use_macros and not abandoned,
+                    macro_start, macro_len, macro_actions,
+                )
+                macro_used += used
                 q_next = Q[s2, a2]
             sa = s * n_actions + a
             delta = r + gamma * q_next - Q[s, a]
