@@ -179,3 +179,14 @@ def test_ray_executor_without_ray_says_how_to_install_it(sweep_file, tmp_path, c
     err = capsys.readouterr().err
     assert 'pip install -e ".[cluster]"' in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("path", sorted((Path(__file__).resolve().parents[1] / "scripts" / "sweeps").glob("*.toml")),
+                         ids=lambda p: p.name)
+def test_every_example_sweep_file_is_valid(path):
+    sw = sweeps.load(path)
+    assert sw.runs and len({r["key"] for r in sw.runs}) == len(sw.runs)
+    if path.name == "paper.toml":  # the paper's whole protocol: 4 tasks x 2 directions x 2 winds
+        assert {r["task"] for r in sw.runs} == {1, 2, 3, 4}
+        assert {(r["source"], r["target"]) for r in sw.runs} == {("coarse", "fine"), ("fine", "coarse")}
+        assert {r["wind"] for r in sw.runs} == {0.0, 0.01}
