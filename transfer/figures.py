@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import warnings
 
 import matplotlib
 
@@ -53,7 +54,11 @@ def bar_chart(
 def learning_curves(
     curves: dict[str, list[list[int]]], title: str, path: str | os.PathLike, max_episodes: int = 200
 ) -> None:
-    """Steps per episode: the median over trials and the band between quartiles, log scale."""
+    """Steps per episode: the mean over trials and its 95% confidence band, log scale.
+
+    A trial that has converged stops contributing after its last episode."""
+    from transfer.metrics import t95
+
     fig, ax = plt.subplots(figsize=(7, 4))
     for label, trials in curves.items():
         n = min(max_episodes, max(len(t) for t in trials))
@@ -62,11 +67,17 @@ def learning_curves(
             t = np.abs(np.asarray(t[:n], dtype=float))
             arr[i, : len(t)] = t
         eps = np.arange(1, n + 1)
-        ax.plot(eps, np.nanmedian(arr, axis=0), label=label)
-        ax.fill_between(eps, np.nanpercentile(arr, 25, axis=0), np.nanpercentile(arr, 75, axis=0), alpha=0.25)
+        count = np.sum(~np.isnan(arr), axis=0)
+        mean = np.nanmean(arr, axis=0)
+        with warnings.catch_warnings():  # an episode only one trial reached has no spread
+            warnings.simplefilter("ignore", RuntimeWarning)
+            sd = np.nan_to_num(np.nanstd(arr, axis=0, ddof=1)) if len(trials) > 1 else np.zeros(n)
+        half = np.array([t95(int(c) - 1) * s / np.sqrt(c) if c > 1 else 0.0 for c, s in zip(count, sd)])
+        ax.plot(eps, mean, label=f"{label} (mean of {len(trials)})")
+        ax.fill_between(eps, np.maximum(mean - half, 1.0), mean + half, alpha=0.25)
     ax.set_yscale("log")
     ax.set_xlabel("episode")
-    ax.set_ylabel("steps per episode")
+    ax.set_ylabel("steps per episode (mean, 95% CI)")
     ax.set_title(title)
     ax.legend()
     ax.grid(alpha=0.3)
