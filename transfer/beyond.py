@@ -54,10 +54,7 @@ def run_methods(
             coarse, fine, start, goal, METHODS, [traj], trials, seed, config, controls=True, tick=tick,
         )
         for entry in summary.values():
-            entry.pop("episode_steps", None)
-            for m in entry.get("transfer_metrics", {}).values():
-                if isinstance(m, dict):
-                    m.pop("per_trial", None)
+            experiment.compact(entry)
         optimal = len(fine.shortest_path(fine.start_state(start), goal)) - 1
         out[t] = {"distance": optimal, "results": summary}
     return out

@@ -180,6 +180,21 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none") -> dict:
     return out
 
 
+BULKY = ("episode_steps", "greedy_path_states")
+"""Per-trial lists in a summary entry that a report's JSON can do without."""
+
+
+def compact(entry: dict) -> dict:
+    """Drop an entry's per-episode and per-path lists (and per-trial transfer metrics), keeping
+    every per-trial number the tables use; ``rooms --json`` and ``arms`` keep everything."""
+    for key in BULKY:
+        entry.pop(key, None)
+    for m in entry.get("transfer_metrics", {}).values():
+        if isinstance(m, dict):
+            m.pop("per_trial", None)
+    return entry
+
+
 def control_trajectories(
     kind: str, source: DiscreteRobot, trajs: Sequence[Trajectory], seed: int
 ) -> list[Trajectory]:

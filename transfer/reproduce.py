@@ -48,7 +48,7 @@ def _compare(
     ]
     summary = experiment.summarize(results)
     for entry in summary.values():
-        entry.pop("episode_steps", None)  # keep report.json small; `rooms --json` has them
+        experiment.compact(entry)  # keep results.json small; `rooms --json` has everything
     return {
         "task": task,
         "source": source,
@@ -90,7 +90,7 @@ def mapping_protocol(
         res, learned = experiment.run_mapping(tgt, start, goal, traj, mapping, trials, seed, config,
                                               wind=wind, on_trial=tick)
         summary = experiment.summarize([res], baseline="")["mapping"]
-        summary.pop("episode_steps", None)
+        experiment.compact(summary)
         percent = [None if f is None else 100.0 * f for f in res.extra["mapped_fraction"]]
         e_mean, e_ci = metrics.mean_ci(percent)
         summary.update(mapped_percent_mean=e_mean, mapped_percent_ci95=e_ci,
