@@ -1,11 +1,52 @@
 """armtransfer: transfer learning between robots that cannot imitate each other.
 
-The packages, in the one direction data flows:
-  models/    MJCF arms, one folder each
-  ik/        mink kinematics: labels, IK, action models, compiling arms into robots
-  tasks/     the rooms layout, the workspace, discrete robots and start/goal tasks
-  transfer/  trajectories, pseudo rewards, SARSA(lambda), mapping, metrics, experiments
-  armtransfer/  the ``armtransfer`` command
+The library, in the one direction its imports follow (``tests/test_architecture.py``):
+
+  armtransfer.errors, armtransfer.io   every error a user can cause; atomic writes
+  armtransfer.models    (models/)      MJCF arms, one folder each
+  armtransfer.ik        (ik/)          all MuJoCo code: scenes, mink labels and IK, compile,
+                                       physics replay, offscreen rendering
+  armtransfer.tasks     (tasks/)       the rooms layout, discrete robots, tasks, environments
+  armtransfer.learning  (transfer/)    trajectories, methods, SARSA(lambda), mapping,
+                                       metrics, experiments, sweeps; never imports MuJoCo
+  armtransfer           (armtransfer/) the Python API, Gymnasium wrappers, the command
+
+The public names below are loaded on first use, so importing any part stays cheap:
+
+    import armtransfer
+    result = armtransfer.transfer(source="coarse", target="fine", task=1,
+                                  methods=["none", "pseudo"], trials=3, seed=1)
 """
 
+from __future__ import annotations
+
+import importlib
+
 __version__ = "0.1.0"
+
+_LAZY = {
+    "transfer": "armtransfer.api",
+    "TransferResult": "armtransfer.results",
+    "MethodResult": "armtransfer.results",
+    "TrialResult": "armtransfer.results",
+    "LearnerConfig": "armtransfer.learning.config",
+    "METHODS": "armtransfer.learning.methods",
+    "resolve_robot": "armtransfer.robots",
+    "register_envs": "armtransfer.tasks.envs",
+    "ArmTransferError": "armtransfer.errors",
+}
+
+__all__ = sorted(_LAZY)
+
+
+def __getattr__(name: str):
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'armtransfer' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), "resolve" if name == "resolve_robot" else name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

@@ -22,11 +22,11 @@ from pathlib import Path
 
 from armtransfer.commands import common
 from armtransfer.commands.rooms import print_results, run_experiment
-from tasks.errors import InvalidParameterError, UnknownRobotError
-from tasks.layout import ROOMS
-from tasks.robot import DiscreteRobot
-from transfer import figures, report
-from transfer.io import OutputError, check_writable, write_json_atomic, write_text_atomic
+from armtransfer.errors import InvalidParameterError, UnknownRobotError
+from armtransfer.tasks.layout import ROOMS
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.learning import figures, report
+from armtransfer.io import OutputError, check_writable, write_json_atomic, write_text_atomic
 
 DEFAULT_SOURCE = "planar2:joint"
 DEFAULT_TARGET = "ur5e_like:cartesian"
@@ -60,23 +60,21 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def _custom_options(args: argparse.Namespace) -> dict:
     if not getattr(args, "arm_xml", None):
         raise UnknownRobotError(f"robot '{CUSTOM}' needs --arm-xml PATH (and --tip-site NAME)")
-    from armtransfer.commands.arms import _base_pos
-
-    return dict(xml_path=args.arm_xml, tip_site=args.tip_site, base_pos=_base_pos(args.base_pos),
+    return dict(xml_path=args.arm_xml, tip_site=args.tip_site, base_pos=common.parse_base_pos(args.base_pos),
                 base_yaw=args.base_yaw)
 
 
 def resolve_arm(spec: str, args: argparse.Namespace) -> DiscreteRobot:
     """An arm robot from ``ARM[:ACTIONS]`` (``custom`` = the --arm-xml arm)."""
     from armtransfer.robots import resolve
-    from ik.robots import arm_robot
+    from armtransfer.tasks.arms import arm_robot
 
     arm, _, actions = spec.partition(":")
     if arm == CUSTOM:
         return arm_robot(CUSTOM, actions or "cartesian", progress=common.interactive(), **_custom_options(args))
     if arm in ("fine", "coarse"):
         return resolve(spec)
-    from ik.robots import parse_robot_spec
+    from armtransfer.tasks.arms import parse_robot_spec
 
     arm, actions = parse_robot_spec(spec)
     return arm_robot(arm, actions, progress=common.interactive())
@@ -112,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
         if extra:
             check_writable(extra)
     if args.render:
-        from armtransfer.render import video_format
+        from armtransfer.ik.render import video_format
 
         video_format(args.render, None)
     tmp = _prepare_out(out)
@@ -212,7 +210,7 @@ def _states_along(robot: DiscreteRobot, start: int, steps: list[dict], goal: int
 
 
 def _video(result: dict, args, path: Path) -> dict:
-    from armtransfer.render import rollout_video
+    from armtransfer.ik.render import rollout_video
 
     paths = result["paths"]
     fps = 10.0 if args.fast else 30.0

@@ -62,7 +62,7 @@ def _join_xy_values(argv: list[str]) -> list[str]:
 def main(argv: list[str] | None = None) -> int:
     # Offscreen rendering needs the GL backend chosen before mujoco is first imported.
     os.environ.setdefault("MUJOCO_GL", "egl")
-    from tasks.errors import ArmTransferError
+    from armtransfer.errors import ArmTransferError
 
     parser = build_parser()
     args = parser.parse_args(_join_xy_values(sys.argv[1:] if argv is None else list(argv)))

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import time
 
-from tasks.catalog import custom_task
-from tasks.robot import DiscreteRobot
-from transfer import experiment
-from transfer.config import LearnerConfig
+from armtransfer.tasks.catalog import custom_task
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.learning import experiment
+from armtransfer.learning.config import LearnerConfig
 
 
 def learner_config(run: dict) -> LearnerConfig:

@@ -14,8 +14,8 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 
 from armtransfer.execute import execute
-from tasks.errors import ArmTransferError
-from tasks.robot import DiscreteRobot
+from armtransfer.errors import ArmTransferError
+from armtransfer.tasks.robot import DiscreteRobot
 
 Done = Callable[[dict, dict, float], None]  # (run, result, seconds)
 Failed = Callable[[dict, str, int], None]  # (run, error, attempts)

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from tasks.errors import UnknownRobotError
-from tasks.grid_robots import GRID_ROBOTS, grid_robot
-from tasks.robot import DiscreteRobot
+from armtransfer.errors import UnknownRobotError
+from armtransfer.tasks.grid_robots import GRID_ROBOTS, grid_robot
+from armtransfer.tasks.robot import DiscreteRobot
 
 
 def resolve(spec: str, **arm_options) -> DiscreteRobot:
@@ -12,7 +12,7 @@ def resolve(spec: str, **arm_options) -> DiscreteRobot:
     if spec in GRID_ROBOTS:
         return grid_robot(spec)
     if ":" in spec or arm_options.get("xml_path"):
-        from ik.robots import arm_robot, parse_robot_spec
+        from armtransfer.tasks.arms import arm_robot, parse_robot_spec
 
         arm, actions = parse_robot_spec(spec)
         return arm_robot(arm, actions, **arm_options)

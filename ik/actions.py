@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ik.errors import UnknownArmError
+from armtransfer.errors import UnknownArmError
 
 CARTESIAN_DIRECTIONS = ((0, 1), (0, -1), (1, 0), (-1, 0))
 CARTESIAN_NAMES = ("F", "B", "R", "L")

@@ -32,10 +32,10 @@ from collections import deque
 import mujoco
 import numpy as np
 
-from ik.errors import ArmModelError, UnreachableTableError
-from ik.labels import OFF_TABLE, cells_of_xy
-from ik.scene import ArmScene, ContactChecker
-from ik.solve import MAX_TIP_HEIGHT, TipIK
+from armtransfer.errors import ArmModelError, UnreachableTableError
+from armtransfer.ik.labels import OFF_TABLE, cells_of_xy
+from armtransfer.ik.scene import ArmScene, ContactChecker
+from armtransfer.ik.solve import MAX_TIP_HEIGHT, TipIK
 
 
 def _near_wall_mask(layout) -> np.ndarray:

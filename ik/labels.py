@@ -9,13 +9,17 @@ from __future__ import annotations
 import mink
 import numpy as np
 
-from ik.scene import ArmScene
-from tasks.layout import ROOMS, Layout
+from armtransfer.ik.scene import ArmScene
+
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never imported
+    from armtransfer.tasks.layout import Layout
 
 OFF_TABLE = -1
 
 
-def cell_of_xy(x: float, y: float, cell: float, layout: Layout = ROOMS) -> int:
+def cell_of_xy(x: float, y: float, cell: float, layout: Layout) -> int:
     """The shared cell id under the point (x, y) (metres), or -1 off the grid."""
     cx, cy = int(round(x / cell)), int(round(y / cell))
     if not layout.in_grid(cx, cy):
@@ -23,7 +27,7 @@ def cell_of_xy(x: float, y: float, cell: float, layout: Layout = ROOMS) -> int:
     return layout.cell(cx, cy)
 
 
-def cells_of_xy(xy: np.ndarray, cell: float, layout: Layout = ROOMS) -> np.ndarray:
+def cells_of_xy(xy: np.ndarray, cell: float, layout: Layout) -> np.ndarray:
     """Vectorised ``cell_of_xy`` over points [..., 2]; -1 off the grid."""
     c = np.rint(np.asarray(xy)[..., :2] / cell).astype(np.int64)
     inside = np.all((c >= layout.lo) & (c <= layout.hi), axis=-1)
@@ -31,7 +35,7 @@ def cells_of_xy(xy: np.ndarray, cell: float, layout: Layout = ROOMS) -> np.ndarr
     return np.where(inside, ids, OFF_TABLE)
 
 
-def cell_centre(cell_id: int, cell: float, layout: Layout = ROOMS) -> np.ndarray:
+def cell_centre(cell_id: int, cell: float, layout: Layout) -> np.ndarray:
     x, y = layout.xy(int(cell_id))
     return np.array([x * cell, y * cell])
 

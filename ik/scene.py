@@ -15,9 +15,13 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from ik.errors import ArmModelError
-from tasks.layout import ROOMS, Layout
-from tasks.workspace import DEFAULT_CELL, WALL_HEIGHT, build_workspace
+from armtransfer.errors import ArmModelError
+from armtransfer.ik.workspace import DEFAULT_CELL, WALL_HEIGHT, build_workspace
+
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never imported
+    from armtransfer.tasks.layout import Layout
 
 PREFIX = "arm/"
 
@@ -76,7 +80,7 @@ def arm_home(xml_path: Path) -> np.ndarray:
 
 
 def build_scene(xml_path: Path, tip_site: str = "tip", mount_pos=(0.0, 0.0, 0.0),
-                mount_yaw: float = 0.0, cell: float = DEFAULT_CELL, layout: Layout = ROOMS,
+                mount_yaw: float = 0.0, cell: float = DEFAULT_CELL, *, layout: Layout,
                 wall_height: float = WALL_HEIGHT) -> ArmScene:
     """Attach the arm at ``xml_path`` to the workspace; validate it is a hinge-joint arm."""
     arm = _load_arm(xml_path)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import mink
 import numpy as np
 
-from ik.scene import ArmScene
+from armtransfer.ik.scene import ArmScene
 
 TIP_HEIGHT = 0.004
 """Height IK puts the tool tip at above the tabletop (m). Planar arms keep their own."""

@@ -13,11 +13,11 @@ import argparse
 import time
 
 from armtransfer.robots import resolve
-from tasks.catalog import TABLE_I
-from transfer import experiment
-from transfer.config import LearnerConfig
-from transfer.io import write_text_atomic
-from transfer.report import fmt_ci, fmt_num, markdown_table
+from armtransfer.tasks.catalog import TABLE_I
+from armtransfer.learning import experiment
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.io import write_text_atomic
+from armtransfer.learning.report import fmt_ci, fmt_num, markdown_table
 
 PAIRS = [
     ("planar2:joint", "ur5e_like:cartesian"),

@@ -25,10 +25,10 @@ sys.path.insert(0, str(ROOT))
 CHILD = r"""
 import json, sys, time
 t0 = time.perf_counter()
-from ik.robots import robot
+from armtransfer.tasks.arms import robot
 r = robot(sys.argv[1])
 print(json.dumps({"seconds": time.perf_counter() - t0, "states": r.n_states,
-                  "reach": r.meta["reach"], "cache": r.meta["cache"]}))
+                  "reach": r.arm.reach, "cache": r.arm.cache}))
 """
 
 
@@ -40,7 +40,7 @@ def _run(spec: str, cache: str) -> dict:
 
 
 def main() -> None:
-    from ik.robots import robot_specs
+    from armtransfer.tasks.arms import robot_specs
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("robots", nargs="*", default=robot_specs())

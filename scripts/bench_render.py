@@ -32,8 +32,8 @@ sys.path.insert(0, str(ROOT))
 
 
 def pipeline(rollouts, out: Path, width: int, height: int, shadows: bool = False) -> dict:
-    from armtransfer.render import RolloutPanel, render_rollouts
-    from armtransfer.replay import replay
+    from armtransfer.ik.render import RolloutPanel, render_rollouts
+    from armtransfer.ik.replay import replay
 
     t0 = time.perf_counter()
     replays = [replay(r, states) for r, states in rollouts]
@@ -56,8 +56,8 @@ def main() -> int:
     parser.add_argument("--target", default="ur5e_like:cartesian")
     args = parser.parse_args()
 
-    from ik.robots import robot
-    from tasks.catalog import table_task
+    from armtransfer.tasks.arms import robot
+    from armtransfer.tasks.catalog import table_task
 
     s, g = table_task(args.task).cells()
     rollouts = []

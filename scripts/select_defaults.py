@@ -16,14 +16,14 @@ import itertools
 
 import numpy as np
 
-from tasks.catalog import TABLE_I
-from tasks.grid_robots import grid_robot
-from tasks.layout import ROOMS
-from transfer import potentials, rewards, sarsa
-from transfer import trajectory as trajectories
-from transfer.config import LearnerConfig
-from transfer.experiment import trial_rng
-from transfer.rewards import Shaping
+from armtransfer.tasks.catalog import TABLE_I
+from armtransfer.tasks.grid_robots import grid_robot
+from armtransfer.tasks.layout import ROOMS
+from armtransfer.learning import potentials, rewards, sarsa
+from armtransfer.learning import trajectory as trajectories
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.experiment import trial_rng
+from armtransfer.learning.shaping import Shaping
 
 CANDIDATES = {
     "first-visit": [{"K": k} for k in (0.3, 1, 3, 10, 30)],

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from tasks.errors import InvalidTaskError
-from tasks.layout import ROOMS, Layout
+from armtransfer.errors import InvalidTaskError
+from armtransfer.tasks.layout import ROOMS, Layout
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,8 @@
 """Gymnasium environments over any discrete robot (rooms-world grid robots and arms).
 
-``gymnasium.make("armtransfer/Rooms-v0", task=1, robot="fine")`` (after ``import tasks``,
-or ``gymnasium.make("tasks:armtransfer/Rooms-v0", ...)``). The observation is the robot's
+``armtransfer.register_envs()`` registers ``armtransfer/Rooms-v0`` (a grid robot) and
+``armtransfer/ArmRooms-v0`` (an arm robot); then ``gymnasium.make("armtransfer/Rooms-v0",
+task=1, robot="fine")``. Registering is explicit: importing never registers. The observation is the robot's
 own state index, the action an index into its action model; each step costs
 ``step_reward`` and reaching the goal cell pays ``goal_reward`` and terminates. With
 ``wind=p`` the robot is pushed one cell towards +x with probability p after its move.
@@ -14,9 +15,9 @@ from typing import Any
 import gymnasium as gym
 from gymnasium import spaces
 
-from tasks.catalog import Task, custom_task, table_task
-from tasks.errors import InvalidParameterError
-from tasks.robot import DiscreteRobot
+from armtransfer.tasks.catalog import Task, custom_task, table_task
+from armtransfer.errors import InvalidParameterError
+from armtransfer.tasks.robot import DiscreteRobot
 
 
 class RobotRoomsEnv(gym.Env):
@@ -65,7 +66,7 @@ class RobotRoomsEnv(gym.Env):
 
     def render(self):
         if self.render_mode == "ansi":
-            from tasks.layout import ROOMS
+            from armtransfer.tasks.layout import ROOMS
 
             x, y = ROOMS.xy(int(self.robot.label[self.state]))
             gx, gy = ROOMS.xy(self.goal_cell)
@@ -81,10 +82,27 @@ def make_rooms_env(
     **kwargs: Any,
 ) -> RobotRoomsEnv:
     """Entry point of ``armtransfer/Rooms-v0``: a grid robot on a Table I or custom task."""
-    from tasks.grid_robots import grid_robot
+    from armtransfer.tasks.grid_robots import grid_robot
 
     the_task = custom_task(start, goal) if start is not None and goal is not None else table_task(task)
     return RobotRoomsEnv(grid_robot(robot), the_task, **kwargs)
+
+
+_ARM_OPTIONS = ("cell_size", "xml_path", "tip_site", "base_pos", "base_yaw", "joint_step", "cache")
+
+
+def make_arm_rooms_env(arm: str = "planar2", actions: str = "joint", task: int | None = 1,
+                       start: tuple[int, int] | None = None,
+                       goal: tuple[int, int] | None = None, **kwargs: Any) -> RobotRoomsEnv:
+    """Entry point of ``armtransfer/ArmRooms-v0``: an arm robot (compiled or loaded from the
+    cache) on a Table I or custom task. Bring-your-own arms: ``xml_path=`` and ``tip_site=``."""
+    from armtransfer.tasks.arms import arm_robot, parse_robot_spec
+
+    robot_kwargs = {k: kwargs.pop(k) for k in _ARM_OPTIONS if k in kwargs}
+    if robot_kwargs.get("xml_path") is None:
+        arm, actions = parse_robot_spec(f"{arm}:{actions}")
+    the_task = custom_task(start, goal) if start is not None and goal is not None else table_task(task)
+    return RobotRoomsEnv(arm_robot(arm, actions, **robot_kwargs), the_task, **kwargs)
 
 
 def register_envs() -> None:
@@ -92,12 +110,12 @@ def register_envs() -> None:
     if "armtransfer/Rooms-v0" not in gym.registry:
         gym.register(
             id="armtransfer/Rooms-v0",
-            entry_point="tasks.envs:make_rooms_env",
+            entry_point="armtransfer.tasks.envs:make_rooms_env",
             max_episode_steps=100_000,
         )
     if "armtransfer/ArmRooms-v0" not in gym.registry:
         gym.register(
             id="armtransfer/ArmRooms-v0",
-            entry_point="ik.envs:make_arm_rooms_env",
+            entry_point="armtransfer.tasks.envs:make_arm_rooms_env",
             max_episode_steps=100_000,
         )

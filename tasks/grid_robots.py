@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from tasks.errors import UnknownRobotError
-from tasks.layout import ROOMS, Layout
-from tasks.robot import DiscreteRobot
+from armtransfer.errors import UnknownRobotError
+from armtransfer.tasks.layout import ROOMS, Layout
+from armtransfer.tasks.robot import DiscreteRobot
 
 DIRECTIONS = ((0, 1), (0, -1), (1, 0), (-1, 0))
 GRID_ROBOTS = {"fine": (1, ("F", "B", "R", "L")), "coarse": (2, ("1", "2", "3", "4"))}
@@ -52,5 +52,5 @@ def grid_robot(name: str, layout: Layout = ROOMS) -> DiscreteRobot:
         action_names=action_names,
         cell_step=k,
         canonical=index,
-        meta={"layout": layout},
+        layout=layout,
     )

@@ -23,7 +23,7 @@ from functools import cached_property
 
 import numpy as np
 
-from tasks.errors import InvalidCellError
+from armtransfer.errors import InvalidCellError
 
 # A wall is a straight segment of cells; a door is one free cell in it.
 # ((x0, y0), (x1, y1)) with x0 == x1 or y0 == y1, both ends included.

@@ -15,11 +15,13 @@ goal is reached when ``label[s] == goal``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from tasks.errors import InvalidCellError
+from armtransfer.errors import InvalidCellError
+from armtransfer.ik.description import ArmDescription
+from armtransfer.tasks.layout import ROOMS, Layout
 
 
 @dataclass(frozen=True, eq=False)
@@ -34,8 +36,11 @@ class DiscreteRobot:
     canonical: np.ndarray | None = None
     """Optional int32 [n_cells]: the state a robot placed at a cell starts in (-1: none).
     When absent, the first state with that label is used."""
-    meta: dict = field(default_factory=dict)
-    """Anything else a builder wants to keep (joint configurations, IK residuals, ...)."""
+    layout: Layout = ROOMS
+    """The layout whose cells the labels number."""
+    arm: ArmDescription | None = None
+    """For arm robots: the arm, its mount and every state's joint configuration (what a
+    physics replay needs); None for grid robots."""
 
     def __post_init__(self) -> None:
         ns = np.ascontiguousarray(self.next_state, dtype=np.int32)
@@ -61,14 +66,6 @@ class DiscreteRobot:
             object.__setattr__(self, "canonical", can)
 
     @property
-    def layout(self):
-        """The layout whose cells the labels number (``meta['layout']``, else the rooms world)."""
-        from tasks.layout import ROOMS, Layout
-
-        layout = self.meta.get("layout")
-        return layout if isinstance(layout, Layout) else ROOMS
-
-    @property
     def n_states(self) -> int:
         return int(self.next_state.shape[0])
 
@@ -88,9 +85,7 @@ class DiscreteRobot:
                 return s
         states = self.states_at(cell)
         if len(states) == 0:
-            from tasks.layout import ROOMS
-
-            where = ROOMS.xy(cell) if 0 <= cell < ROOMS.n_cells else cell
+            where = self.layout.xy(cell) if 0 <= cell < self.layout.n_cells else cell
             raise InvalidCellError(f"robot {self.name} cannot reach the {what} cell {where}")
         return int(states[0])
 

@@ -4,8 +4,10 @@ import gymnasium as gym
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-import tasks  # noqa: F401 - registers the environments
-from tasks.errors import ArmTransferError
+from armtransfer.tasks.envs import register_envs
+
+register_envs()
+from armtransfer.errors import ArmTransferError
 
 
 @pytest.mark.parametrize("arm, actions", [("planar2", "joint"), ("ur5e_like", "cartesian")])

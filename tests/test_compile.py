@@ -3,15 +3,15 @@
 import numpy as np
 import pytest
 
-from ik import cache
-from ik.compile import PlanarFK
-from ik.errors import ArmModelError, UnreachableTableError
-from ik.labels import Labeller, cells_of_xy
-from ik.robots import arm_robot, arm_scene
-from ik.scene import ContactChecker
-from tasks.catalog import TABLE_I
-from tasks.errors import ArmTransferError
-from tasks.layout import ROOMS
+from armtransfer.ik import cache
+from armtransfer.ik.compile import PlanarFK
+from armtransfer.errors import ArmModelError, UnreachableTableError
+from armtransfer.ik.labels import Labeller, cells_of_xy
+from armtransfer.tasks.arms import arm_robot, arm_scene
+from armtransfer.ik.scene import ContactChecker
+from armtransfer.tasks.catalog import TABLE_I
+from armtransfer.errors import ArmTransferError
+from armtransfer.tasks.layout import ROOMS
 
 DEFAULT_ROBOTS = [("planar2", "joint"), ("planar2", "cartesian"), ("ur5e_like", "cartesian"),
                   ("panda_like", "cartesian")]
@@ -37,12 +37,12 @@ def test_default_robots_solve_every_table_i_task(spec, robots):
 def test_states_are_free_cells_and_mink_agrees_with_their_labels(spec, robots):
     robot = robots[spec]
     assert ROOMS.free[robot.label].all()
-    assert robot.meta["qpos"].shape == (robot.n_states, robot.meta["dof"])
-    assert 0.5 < robot.meta["reach"] <= 1.0
-    labeller = Labeller(arm_scene(robot.meta["arm"]))
+    assert robot.arm.qpos.shape == (robot.n_states, robot.arm.dof)
+    assert 0.5 < robot.arm.reach <= 1.0
+    labeller = Labeller(arm_scene(robot.arm.name))
     rng = np.random.default_rng(2)
     for s in rng.choice(robot.n_states, 40, replace=False):
-        assert labeller.label(robot.meta["qpos"][s]) == robot.label[s]
+        assert labeller.label(robot.arm.qpos[s]) == robot.label[s]
     can = robot.canonical[robot.canonical >= 0]
     assert np.array_equal(np.sort(robot.label[can]), np.unique(robot.label))
 
@@ -70,7 +70,7 @@ def test_no_joint_move_passes_over_a_wall(robots):
     robot = robots["planar2:joint"]
     scene = arm_scene("planar2")
     fk = PlanarFK(scene)
-    q = robot.meta["qpos"]
+    q = robot.arm.qpos
     for a in range(robot.n_actions):
         moved = robot.next_state[:, a] != np.arange(robot.n_states)
         qa, qb = q[moved], q[robot.next_state[moved, a]]
@@ -80,7 +80,7 @@ def test_no_joint_move_passes_over_a_wall(robots):
     # and MuJoCo sees the stylus in a wall: the lattice point over wall cell (-3, 0)
     contact = ContactChecker(scene)
     labeller = Labeller(scene)
-    from ik.solve import TipIK
+    from armtransfer.ik.solve import TipIK
 
     res = TipIK(scene, False).solve(np.array([-0.03, -0.05]), scene.home)
     assert ROOMS.wall_mask[-5 - ROOMS.lo, -3 - ROOMS.lo] and labeller.label(res.q) == ROOMS.cell(-3, -5)
@@ -99,33 +99,33 @@ def test_wind_pushes_one_cell_towards_plus_x(robots):
 def test_cache_hits_misses_and_rebuilds(tmp_path, monkeypatch):
     monkeypatch.setenv("ARMTRANSFER_CACHE", str(tmp_path))
     first = arm_robot("planar2", "joint")
-    assert first.meta["cache"] == "miss"
+    assert first.arm.cache == "miss"
     second = arm_robot("planar2", "joint")
-    assert second.meta["cache"] == "hit"
+    assert second.arm.cache == "hit"
     assert np.array_equal(first.next_state, second.next_state)
-    assert np.array_equal(first.meta["qpos"], second.meta["qpos"])
+    assert np.array_equal(first.arm.qpos, second.arm.qpos)
     (entry,) = list(tmp_path.glob("*.npz"))
     # a flipped byte is a corrupt entry: detected and rebuilt
     data = bytearray(entry.read_bytes())
     data[len(data) // 2] ^= 0xFF
     entry.write_bytes(bytes(data))
     rebuilt = arm_robot("planar2", "joint")
-    assert rebuilt.meta["cache"] == "corrupt"
+    assert rebuilt.arm.cache == "corrupt"
     assert np.array_equal(rebuilt.next_state, first.next_state)
-    assert arm_robot("planar2", "joint").meta["cache"] == "hit"
+    assert arm_robot("planar2", "joint").arm.cache == "hit"
     # a truncated entry too
     entry.write_bytes(entry.read_bytes()[:100])
-    assert arm_robot("planar2", "joint").meta["cache"] == "corrupt"
+    assert arm_robot("planar2", "joint").arm.cache == "corrupt"
     # an entry written for other inputs (stale) is detected by its stored key
-    arrays, status = cache.load("planar2:joint", first.meta["key"])
+    arrays, status = cache.load("planar2:joint", first.arm.key)
     assert status == "hit"
-    cache.save("planar2:joint", first.meta["key"], {**arrays})
+    cache.save("planar2:joint", first.arm.key, {**arrays})
     other = "0" * 64
     np.savez(entry, **arrays, __key__=np.array(other), __checksum__=np.array("x"))
-    assert arm_robot("planar2", "joint").meta["cache"] == "stale"
+    assert arm_robot("planar2", "joint").arm.cache == "stale"
     # a different workspace (cell size) is a different key: a miss, not a hit
-    assert arm_robot("planar2", "joint", cell_size=0.02).meta["cache"] == "miss"
-    assert arm_robot("planar2", "joint", cache=False).meta["cache"] == "off"
+    assert arm_robot("planar2", "joint", cell_size=0.02).arm.cache == "miss"
+    assert arm_robot("planar2", "joint", cache=False).arm.cache == "off"
 
 
 BYO_ARM = """
@@ -158,7 +158,7 @@ def test_a_bring_your_own_arm_compiles_into_a_working_robot(tmp_path):
     xml.write_text(BYO_ARM)
     robot = arm_robot(None, "cartesian", xml_path=xml, tip_site="pen_tip", base_pos=(-0.1, 0.0, 0.0))
     assert robot.name == "my_scara:cartesian"
-    assert robot.n_states > 1000 and robot.meta["dof"] == 2
+    assert robot.n_states > 1000 and robot.arm.dof == 2
     start, goal = TABLE_I[4].cells()  # the longest task, across three rooms
     assert robot.shortest_path(robot.start_state(start), goal) is not None
     joint = arm_robot(None, "joint", xml_path=xml, tip_site="pen_tip", base_pos=(-0.1, 0.0, 0.0))

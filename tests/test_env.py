@@ -4,7 +4,9 @@ import gymnasium as gym
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-import tasks  # noqa: F401  (registers the environments)
+from armtransfer.tasks.envs import register_envs
+
+register_envs()
 
 
 @pytest.mark.parametrize("robot", ["fine", "coarse"])

@@ -4,15 +4,15 @@ import mujoco
 import numpy as np
 import pytest
 
-from ik.compile import PlanarFK
-from ik.errors import UnknownArmError
-from ik.labels import Labeller, cells_of_xy
-from ik.robots import arm_robot, arm_scene, parse_robot_spec
-from ik.solve import TipIK
-from models import ARMS
-from tasks.catalog import TABLE_I
-from tasks.errors import ArmTransferError
-from tasks.layout import ROOMS
+from armtransfer.ik.compile import PlanarFK
+from armtransfer.errors import UnknownArmError
+from armtransfer.ik.labels import Labeller, cells_of_xy
+from armtransfer.tasks.arms import arm_robot, arm_scene, parse_robot_spec
+from armtransfer.ik.solve import TipIK
+from armtransfer.models import ARMS
+from armtransfer.tasks.catalog import TABLE_I
+from armtransfer.errors import ArmTransferError
+from armtransfer.tasks.layout import ROOMS
 
 
 @pytest.fixture(scope="module")
@@ -82,7 +82,7 @@ def test_a_joint_action_traces_an_arc(scenes):
     robot = arm_robot("planar2", "joint")
     scene = scenes["planar2"]
     labeller = Labeller(scene)
-    step = robot.meta["joint_step"]
+    step = robot.arm.joint_step
     model = scene.model
     data = mujoco.MjData(model)
     data.qpos[:] = 0
@@ -94,7 +94,7 @@ def test_a_joint_action_traces_an_arc(scenes):
             tips, qs = [], []
             state = s
             for _ in range(6):
-                qs.append(robot.meta["qpos"][state])
+                qs.append(robot.arm.qpos[state])
                 tips.append(labeller.tip(qs[-1])[:2])
                 nxt = int(robot.next_state[state, action])
                 if nxt == state:

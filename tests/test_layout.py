@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from tasks import ROOMS, TABLE_I, grid_robot, table_task
-from tasks.catalog import TABLE_I_ROOMS, custom_task
-from tasks.errors import InvalidCellError, InvalidTaskError, UnknownRobotError
+from armtransfer.tasks import ROOMS, TABLE_I, grid_robot, table_task
+from armtransfer.tasks.catalog import TABLE_I_ROOMS, custom_task
+from armtransfer.errors import InvalidCellError, InvalidTaskError, UnknownRobotError
 
 
 def bfs_distance(robot, task):
@@ -43,7 +43,7 @@ def test_rooms_are_connected_only_through_doors():
     for door in ROOMS.doors:
         x, y = door
         # closing this door makes some cell pairs farther apart or disconnected
-        from tasks.layout import Layout
+        from armtransfer.tasks.layout import Layout
 
         closed = Layout(ROOMS.lo, ROOMS.hi, ROOMS.walls, tuple(d for d in ROOMS.doors if d != door), ROOMS.rooms)
         robot = grid_robot("fine", closed)

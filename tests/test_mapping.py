@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 
 from armtransfer.cli import main
-from tasks.errors import InvalidMappingError
-from tasks.grid_robots import grid_robot
-from tasks.layout import ROOMS, Layout
-from transfer import experiment, reference, rewards, sarsa
-from transfer import trajectory as trajectories
-from transfer.config import LearnerConfig
-from transfer.mapping import ActionMapping, MacroTable, chain, load_for
+from armtransfer.errors import InvalidMappingError
+from armtransfer.tasks.grid_robots import grid_robot
+from armtransfer.tasks.layout import ROOMS, Layout
+from armtransfer.learning import experiment, reference, rewards, sarsa
+from armtransfer.learning import trajectory as trajectories
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.mapping import ActionMapping, MacroTable, chain, load_for
 
 # A 7 x 7 open world (no walls) and the 7 x 7 two-room world of test_sarsa.
 OPEN = Layout(lo=-3, hi=3, walls=(), doors=())
@@ -352,7 +352,7 @@ def test_reproduce_reports_the_mapping_columns_beside_the_papers(reproduce_fast)
 
 def test_macros_in_every_episode_keep_the_greedy_path_from_converging():
     """Why macros are offered in the first episode only (see transfer.mapping)."""
-    from tasks.catalog import TABLE_I
+    from armtransfer.tasks.catalog import TABLE_I
 
     coarse, fine = grid_robot("coarse"), grid_robot("fine")
     config = LearnerConfig()

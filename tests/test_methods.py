@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-from tasks.grid_robots import grid_robot
-from tasks.layout import Layout
-from transfer import controls, experiment, learning_metrics, potentials, rewards, sarsa
-from transfer import trajectory as trajectories
-from transfer.config import LearnerConfig
-from transfer.rewards import Shaping
+from armtransfer.tasks.grid_robots import grid_robot
+from armtransfer.tasks.layout import Layout
+from armtransfer.learning import controls, experiment, learning_metrics, potentials, rewards, sarsa
+from armtransfer.learning import trajectory as trajectories
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.shaping import Shaping
 
 # 9 x 9, two rooms joined by one door at (0, 2)
 GRID = Layout(lo=-4, hi=4, walls=(((0, -4), (0, 4)),), doors=((0, 2),))

@@ -6,10 +6,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from ik.scene import build_scene
-from models import ARMS
-from tasks.layout import ROOMS
-from tasks.workspace import wall_boxes
+from armtransfer.ik.scene import build_scene
+from armtransfer.models import ARMS
+from armtransfer.tasks.layout import ROOMS
+from armtransfer.ik.workspace import wall_boxes
 
 NAMED = [
     (mujoco.mjtObj.mjOBJ_BODY, "nbody"),
@@ -42,7 +42,7 @@ def test_arm_follows_the_naming_contract(arm):
 @pytest.mark.parametrize("arm", list(ARMS))
 def test_one_second_of_random_control_has_no_warnings(arm):
     info = ARMS[arm]
-    scene = build_scene(info.xml_path, "tip", info.mount_pos, info.mount_yaw)
+    scene = build_scene(info.xml_path, "tip", info.mount_pos, info.mount_yaw, layout=ROOMS)
     model = scene.model
     data = mujoco.MjData(model)
     data.qpos[:] = scene.home
@@ -129,10 +129,10 @@ def test_mjcf_walls_cover_exactly_the_wall_cells(cell):
 
 def test_scene_is_composed_with_every_element_named():
     info = ARMS["panda_like"]
-    scene = build_scene(info.xml_path, "tip", info.mount_pos, info.mount_yaw)
+    scene = build_scene(info.xml_path, "tip", info.mount_pos, info.mount_yaw, layout=ROOMS)
     model = scene.model
     for obj, count in NAMED:
         for i in range(getattr(model, count)):
             assert mujoco.mj_id2name(model, obj, i)
     assert scene.tip == "arm/tip"
-    assert scene.env_geoms.sum() == 1 + len(wall_boxes())
+    assert scene.env_geoms.sum() == 1 + len(wall_boxes(ROOMS))

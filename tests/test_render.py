@@ -8,11 +8,11 @@ import pytest
 
 pytest.importorskip("mujoco")
 
-from armtransfer.render import (  # noqa: E402
+from armtransfer.ik.render import (  # noqa: E402
     PanelRenderer, RenderError, RolloutPanel, render_rollouts, rollout_video)
-from armtransfer.replay import ReplayError, polyline_distance, replay  # noqa: E402
-from tasks.errors import ArmTransferError  # noqa: E402
-from tasks.layout import ROOMS  # noqa: E402
+from armtransfer.ik.replay import ReplayError, polyline_distance, replay  # noqa: E402
+from armtransfer.errors import ArmTransferError  # noqa: E402
+from armtransfer.tasks.layout import ROOMS  # noqa: E402
 
 START, GOAL = (0, 0), (4, 5)  # a few cells apart in room 1, a short replay
 
@@ -21,7 +21,7 @@ START, GOAL = (0, 0), (4, 5)  # a few cells apart in room 1, a short replay
 def robots(tmp_path_factory):
     mp = pytest.MonkeyPatch()
     mp.setenv("ARMTRANSFER_CACHE", str(tmp_path_factory.mktemp("cache")))
-    from ik.robots import robot
+    from armtransfer.tasks.arms import robot
 
     out = {spec: robot(spec) for spec in ("planar2:cartesian", "ur5e_like:cartesian")}
     mp.undo()
@@ -63,7 +63,7 @@ def test_replay_is_physics_not_slideshow(robots):
     a = replay(r, states, segment_seconds=0.06, settle_seconds=0.0)
     b = replay(r, states, segment_seconds=0.06, settle_seconds=0.0)
     np.testing.assert_array_equal(a.qpos, b.qpos)
-    way = r.meta["qpos"][states]
+    way = r.arm.qpos[states]
     lag = np.abs(a.qpos[a.waypoint_index[1:]] - way[1:]).max()
     assert 1e-6 < lag < 0.05
     stiff = replay(r, states, segment_seconds=0.06, settle_seconds=0.0, feedforward=False)
@@ -78,7 +78,7 @@ def test_replay_bad_input(robots):
         replay(r, [])
     with pytest.raises(ReplayError, match="not a state"):
         replay(r, [r.n_states + 5])
-    from tasks.grid_robots import grid_robot
+    from armtransfer.tasks.grid_robots import grid_robot
 
     with pytest.raises(ReplayError, match="not an arm robot"):
         replay(grid_robot("fine"), [0, 1])
@@ -175,7 +175,7 @@ def test_output_is_a_directory(replays, tmp_path):
 
 
 def test_failed_render_leaves_no_temp_file(replays, tmp_path, monkeypatch):
-    import armtransfer.render as render
+    import armtransfer.ik.render as render
 
     def boom(self, qpos):
         raise RuntimeError("render failed")

@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-from tasks.errors import InvalidParameterError
-from tasks.grid_robots import grid_robot
-from tasks.layout import Layout
-from transfer import reference, rewards, sarsa
-from transfer import trajectory as trajectories
-from transfer.config import LearnerConfig
+from armtransfer.errors import InvalidParameterError
+from armtransfer.tasks.grid_robots import grid_robot
+from armtransfer.tasks.layout import Layout
+from armtransfer.learning import reference, rewards, sarsa
+from armtransfer.learning import trajectory as trajectories
+from armtransfer.learning.config import LearnerConfig
 
 # A 7 x 7 world with two rooms and one door: small enough for the dense reference.
 SMALL = Layout(lo=-3, hi=3, walls=(((0, -3), (0, 3)),), doors=((0, 2),))
@@ -108,7 +108,7 @@ def test_farmable_k_is_refused_with_the_bound_named():
 
 
 def test_pseudo_reward_speeds_up_the_first_episode_on_the_rooms_world():
-    from tasks.catalog import table_task
+    from armtransfer.tasks.catalog import table_task
 
     fine, coarse = grid_robot("fine"), grid_robot("coarse")
     start, goal = table_task(1).cells()

@@ -13,10 +13,10 @@ import pytest
 from armtransfer.cli import main
 from armtransfer.execute import execute
 from armtransfer.executors import run_local
-from tasks.grid_robots import grid_robot
-from transfer import sweep as sweeps
-from transfer.store import ResultStore
-from transfer.summary import summarize
+from armtransfer.tasks.grid_robots import grid_robot
+from armtransfer.learning import sweep as sweeps
+from armtransfer.learning.store import ResultStore
+from armtransfer.learning.summary import summarize
 
 SWEEP = """
 [sweep]

@@ -11,12 +11,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import replace
 
-from tasks.catalog import TABLE_I
-from tasks.robot import DiscreteRobot
-from transfer import experiment
-from transfer import trajectory as trajectories
-from transfer.config import LearnerConfig
-from transfer.report import fmt_ci, fmt_num, markdown_table
+from armtransfer.tasks.catalog import TABLE_I
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.learning import experiment
+from armtransfer.learning import trajectory as trajectories
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.report import fmt_ci, fmt_num, markdown_table
 
 METHODS = ("none", *experiment.SHAPING_METHODS)
 TASKS = (1, 2, 3, 4)
@@ -178,8 +178,8 @@ def metrics_markdown(res: dict) -> str:
 def oracle_markdown(coarse: DiscreteRobot, fine: DiscreteRobot, trials: int, seed: int,
                     config: LearnerConfig) -> tuple[str, dict]:
     """The oracle control: a potential from the true map distance (no robot has it)."""
-    from transfer import metrics, potentials, sarsa
-    from transfer.rewards import Shaping
+    from armtransfer.learning import metrics, potentials, sarsa
+    from armtransfer.learning.shaping import Shaping
 
     out = {}
     cells = []

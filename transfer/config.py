@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
-from tasks.errors import InvalidParameterError
+from armtransfer.errors import InvalidParameterError
 
 
 @dataclass(frozen=True)

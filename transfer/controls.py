@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from tasks.robot import DiscreteRobot
-from transfer.trajectory import Trajectory
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.learning.trajectory import Trajectory
 
 CONTROLS = ("shuffled", "random")
 

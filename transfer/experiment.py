@@ -12,13 +12,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tasks.errors import InvalidParameterError
-from tasks.robot import DiscreteRobot
-from transfer import metrics, rewards, sarsa
-from transfer import trajectory as trajectories
-from transfer.config import LearnerConfig
-from transfer.mapping import DEFAULT_MAX_SPAN, ActionMapping, MacroTable
-from transfer.trajectory import Trajectory
+from armtransfer.errors import InvalidParameterError
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.learning import metrics, potentials, rewards, sarsa
+from armtransfer.learning import trajectory as trajectories
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.mapping import DEFAULT_MAX_SPAN, ActionMapping, MacroTable
+from armtransfer.learning.trajectory import Trajectory
 
 SHAPING_METHODS = ("pseudo", "first-visit", "potential", "progress", "dense")
 METHODS = ("none", *SHAPING_METHODS, "mapping")
@@ -77,7 +77,7 @@ def run_method(
     K: float | str | None = "auto",
     macros=None,
     on_trial: Callable[[], None] | None = None,
-    beta: float = rewards.potentials.DENSE_BETA,
+    beta: float = potentials.DENSE_BETA,
     label: str | None = None,
 ) -> MethodResult:
     """``trials`` independent trials of one method on the target robot."""
@@ -199,7 +199,7 @@ def control_trajectories(
     kind: str, source: DiscreteRobot, trajs: Sequence[Trajectory], seed: int
 ) -> list[Trajectory]:
     """``shuffled`` or ``random`` stand-ins for the real trajectories, seeded by ``seed``."""
-    from transfer import controls
+    from armtransfer.learning import controls
 
     rng = np.random.default_rng(np.random.SeedSequence([int(seed), 2, controls.CONTROLS.index(kind)]))
     if kind == "shuffled":
@@ -209,7 +209,7 @@ def control_trajectories(
 
 def add_transfer_metrics(summary: dict, optimal: int, baseline: str = "none") -> None:
     """Add Taylor and Stone's metrics (``transfer.learning_metrics``) to every method."""
-    from transfer import learning_metrics as lm
+    from armtransfer.learning import learning_metrics as lm
 
     base = summary.get(baseline)
     if base is None:
@@ -242,7 +242,7 @@ def run_transfer(
     config: LearnerConfig,
     wind: float = 0.0,
     K: float | str | None = "auto",
-    beta: float = rewards.potentials.DENSE_BETA,
+    beta: float = potentials.DENSE_BETA,
     mapping: ActionMapping | None = None,
     max_span: int = DEFAULT_MAX_SPAN,
     controls: bool = True,

@@ -11,7 +11,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from transfer.io import write_bytes_atomic  # noqa: E402
+from armtransfer.io import write_bytes_atomic  # noqa: E402
 
 
 def _save(fig, path: str | os.PathLike) -> None:
@@ -57,7 +57,7 @@ def learning_curves(
     """Steps per episode: the mean over trials and its 95% confidence band, log scale.
 
     A trial that has converged stops contributing after its last episode."""
-    from transfer.metrics import t95
+    from armtransfer.learning.metrics import t95
 
     fig, ax = plt.subplots(figsize=(7, 4))
     for label, trials in curves.items():

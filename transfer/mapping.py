@@ -75,9 +75,9 @@ from pathlib import Path
 
 import numpy as np
 
-from tasks.errors import InvalidMappingError
-from tasks.robot import DiscreteRobot
-from transfer.trajectory import Trajectory
+from armtransfer.errors import InvalidMappingError
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.learning.trajectory import Trajectory
 
 FORMAT = "armtransfer-mapping/1"
 
@@ -314,7 +314,7 @@ class ActionMapping:
 
     def save(self, path: str | os.PathLike) -> None:
         """Write the JSON form atomically, one entry per line (easy to read and diff)."""
-        from transfer.io import write_text_atomic
+        from armtransfer.io import write_text_atomic
 
         data = self.to_json()
         entries = data.pop("entries")
@@ -326,7 +326,7 @@ class ActionMapping:
 
     @staticmethod
     def load(path: str | os.PathLike) -> "ActionMapping":
-        from transfer.io import read_json
+        from armtransfer.io import read_json
 
         data = read_json(path, "mapping file", InvalidMappingError)
         return ActionMapping.from_json(data, where=f"mapping file {str(Path(path))!r}")

@@ -30,9 +30,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from tasks.layout import Layout
-from tasks.robot import DiscreteRobot
-from transfer.trajectory import Trajectory
+from armtransfer.tasks.layout import Layout
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.learning.trajectory import Trajectory
 
 DENSE_K = 4.0
 DENSE_BETA = 1.5

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from tasks.robot import DiscreteRobot
-from transfer.config import LearnerConfig
-from transfer.trajectory import Trajectory
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.trajectory import Trajectory
 
 
 def _egreedy(q_row: np.ndarray, eps: float, rng: np.random.Generator) -> int:

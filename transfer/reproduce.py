@@ -14,14 +14,14 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from tasks.catalog import TABLE_I
-from tasks.grid_robots import grid_robot
-from tasks.layout import ROOMS
-from transfer import beyond, experiment, metrics, paper
-from transfer.mapping import ActionMapping, MacroTable
-from transfer import trajectory as trajectories
-from transfer.config import LearnerConfig
-from transfer.report import fmt_ci, fmt_num, markdown_table
+from armtransfer.tasks.catalog import TABLE_I
+from armtransfer.tasks.grid_robots import grid_robot
+from armtransfer.tasks.layout import ROOMS
+from armtransfer.learning import beyond, experiment, metrics, paper
+from armtransfer.learning.mapping import ActionMapping, MacroTable
+from armtransfer.learning import trajectory as trajectories
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.report import fmt_ci, fmt_num, markdown_table
 
 TASKS = (1, 2, 3, 4)
 

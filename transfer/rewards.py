@@ -15,41 +15,17 @@ paper's; see ``transfer.methods`` for what each does.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
-
 import numpy as np
 
-from tasks.errors import InvalidParameterError
-from tasks.robot import DiscreteRobot
-from transfer import potentials, sarsa
-from transfer.trajectory import Trajectory
+from armtransfer.errors import InvalidParameterError
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.learning import potentials
+from armtransfer.learning import shaping as modes
+from armtransfer.learning.shaping import Shaping
+from armtransfer.learning.trajectory import Trajectory
 
 K_FRACTION = 0.5
 """With ``K='auto'``, K is this fraction of the farming bound -step_reward / n."""
-
-
-@dataclass(frozen=True)
-class Shaping:
-    """Per-state arrays the learner's kernel reads."""
-
-    mode: int
-    bonus: np.ndarray  # float64 [S]: i*K on states labelled s_ti
-    traj_index: np.ndarray  # int64 [S]: i for states labelled s_ti, -1 elsewhere
-    phi: np.ndarray  # float64 [S]: potential, for potential-based methods
-    K: float = 0.0
-
-    @staticmethod
-    def potential(phi: np.ndarray, K: float = 0.0) -> "Shaping":
-        """Potential-based shaping F = gamma * phi(s') - phi(s) with the given potential."""
-        n = len(phi)
-        return Shaping(sarsa.MODE_POTENTIAL, np.zeros(n), np.full(n, -1, np.int64),
-                       np.asarray(phi, dtype=np.float64), K)
-
-    @staticmethod
-    def none(n_states: int) -> "Shaping":
-        return Shaping(
-            sarsa.MODE_NONE, np.zeros(n_states), np.full(n_states, -1, np.int64), np.zeros(n_states)
-        )
 
 
 # K='auto', per method, in units of -step_reward. Chosen on held-out start/goal pairs, not on
@@ -145,16 +121,16 @@ def build(
                 f"n*K = {N}*{k:g} >= 0; use K < {farming_bound(step_reward, trajs):.6g} "
                 f"(-step_reward/n) or the method 'first-visit'"
             )
-        return Shaping(sarsa.MODE_PSEUDO, bonus, ids, zeros, k)
+        return Shaping(modes.MODE_PSEUDO, bonus, ids, zeros, k)
     if method == "first-visit":
-        return Shaping(sarsa.MODE_FIRST_VISIT, bonus, ids, zeros, k)
+        return Shaping(modes.MODE_FIRST_VISIT, bonus, ids, zeros, k)
     if method == "progress":
-        return Shaping(sarsa.MODE_PROGRESS, bonus, ids, zeros, k)
+        return Shaping(modes.MODE_PROGRESS, bonus, ids, zeros, k)
     if method == "potential":
-        return Shaping(sarsa.MODE_POTENTIAL, zeros, ids, bonus.copy(), k)
+        return Shaping(modes.MODE_POTENTIAL, zeros, ids, bonus.copy(), k)
     if method == "dense":
         if not (np.isfinite(beta) and beta >= 0):
             raise InvalidParameterError(f"beta must be a non-negative number, got {beta}")
         phi = np.max([potentials.dense(robot, t, k, beta) for t in trajs], axis=0)
-        return Shaping(sarsa.MODE_POTENTIAL, zeros, ids, phi, k)
+        return Shaping(modes.MODE_POTENTIAL, zeros, ids, phi, k)
     raise InvalidParameterError(f"no shaping for method {method!r}")

@@ -39,15 +39,17 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
-from tasks.robot import DiscreteRobot
-from transfer.config import LearnerConfig
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.learning.config import LearnerConfig
 
-# Shaping modes (see transfer.rewards).
-MODE_NONE = 0
-MODE_PSEUDO = 1
-MODE_FIRST_VISIT = 2
-MODE_POTENTIAL = 3
-MODE_PROGRESS = 4
+from armtransfer.learning.shaping import (  # noqa: E402  (the kernel's shaping modes)
+    MODE_FIRST_VISIT,
+    MODE_NONE,
+    MODE_POTENTIAL,
+    MODE_PROGRESS,
+    MODE_PSEUDO,
+    Shaping,
+)
 
 
 @numba.njit(cache=True, inline="always")
@@ -132,16 +134,6 @@ def _shaping(mode, s, s2, terminal, bonus, traj_index, phi, gamma, paid_stamp, e
         # pay only the part of the bonus beyond the best reached so far this episode
         if bonus[s2] > best:
             return bonus[s2] - best, bonus[s2]
-        return 0.0, best
-    return 0.0, best
-    if mode == MODE_POTENTIAL:
-        phi2 = 0.0 if terminal else phi[s2]
-        return gamma * phi2 - phi[s], best
-    if mode == MODE_PROGRESS:
-        i = traj_index[s2]
-        if i > best:
-            # bonus is i*K on trajectory states: pay only the progress beyond the best so far
-            return bonus[s2] * (i - best) / i, i
         return 0.0, best
     return 0.0, best
 
@@ -343,13 +335,11 @@ def learn(
 ) -> TrialResult:
     """Run one trial of SARSA(lambda) on ``robot`` from ``start_state`` to ``goal_cell``.
 
-    ``shaping`` is a :class:`transfer.rewards.Shaping` (None: no transfer); ``macros`` a
+    ``shaping`` is a :class:`armtransfer.learning.shaping.Shaping` (None: no transfer); ``macros`` a
     :class:`transfer.mapping.MacroTable` (None: no action sequence mapping); its attribute
     ``episodes`` (None: all) says in how many first episodes macros are offered. ``rng`` is
     the only source of randomness.
     """
-    from transfer.rewards import Shaping
-
     n = robot.n_states
     sh = shaping if shaping is not None else Shaping.none(n)
     m_episodes = None

@@ -15,9 +15,9 @@ import json
 import os
 from pathlib import Path
 
-from tasks.errors import ArmTransferError
-from transfer.io import OutputError, write_json_atomic
-from transfer.sweep import Sweep
+from armtransfer.errors import ArmTransferError
+from armtransfer.io import OutputError, write_json_atomic
+from armtransfer.learning.sweep import Sweep
 
 STORE_FORMAT = "armtransfer-store/1"
 

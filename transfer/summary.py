@@ -7,9 +7,9 @@ rows are sorted, so a resumed sweep and an uninterrupted one give the same summa
 
 from __future__ import annotations
 
-from transfer import metrics
-from transfer.report import fmt_ci, fmt_num, markdown_table
-from transfer.sweep import group_key
+from armtransfer.learning import metrics
+from armtransfer.learning.report import fmt_ci, fmt_num, markdown_table
+from armtransfer.learning.sweep import group_key
 
 
 def _method_label(cfg: dict) -> str:
@@ -83,7 +83,7 @@ def summary_markdown(rows: list[dict]) -> str:
 
 
 def plot(rows: list[dict], path) -> None:
-    from transfer.figures import bar_chart
+    from armtransfer.learning.figures import bar_chart
 
     groups: list[str] = []
     series: dict[str, dict[str, tuple]] = {}

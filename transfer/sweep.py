@@ -34,9 +34,9 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from tasks.catalog import TABLE_I, parse_xy
-from tasks.errors import ArmTransferError
-from transfer.config import LearnerConfig
+from armtransfer.tasks.catalog import TABLE_I, parse_xy
+from armtransfer.errors import ArmTransferError
+from armtransfer.learning.config import LearnerConfig
 
 RUN_FORMAT = "armtransfer-run/1"
 METHODS = ("none", "pseudo", "first-visit", "potential", "progress", "dense")

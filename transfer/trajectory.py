@@ -22,9 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
-from tasks.errors import InvalidTrajectoryError
-from tasks.layout import ROOMS, Layout
-from tasks.robot import DiscreteRobot
+from armtransfer.errors import InvalidTrajectoryError
+from armtransfer.tasks.layout import ROOMS, Layout
+from armtransfer.tasks.robot import DiscreteRobot
 
 FORMAT = "armtransfer-trajectory/1"
 
@@ -75,7 +75,7 @@ class Trajectory:
         }
 
     def save(self, path: str | os.PathLike, layout: Layout = ROOMS) -> None:
-        from transfer.io import write_json_atomic
+        from armtransfer.io import write_json_atomic
 
         write_json_atomic(path, self.to_json(layout))
 
@@ -159,7 +159,7 @@ def parse(data: object, layout: Layout = ROOMS, where: str = "trajectory") -> Tr
 
 
 def load(path: str | os.PathLike, layout: Layout = ROOMS) -> Trajectory:
-    from transfer.io import read_json
+    from armtransfer.io import read_json
 
     data = read_json(path, "trajectory file", InvalidTrajectoryError)
     return parse(data, layout, where=f"trajectory file {str(Path(path))!r}")

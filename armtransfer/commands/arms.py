@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import argparse
 
+from armtransfer.commands import common
+
 HELP = ("transfer a trajectory from one arm to another (default: planar2:joint -> ur5e_like:cartesian, "
         "task 1); 'arms list' lists the arm robots")
 
@@ -34,30 +36,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     arm_transfer.add_arguments(parser)
 
 
-def _base_pos(text: str | None):
-    from ik.errors import ArmModelError
-
-    if text is None:
-        return None
-    try:
-        values = tuple(float(v) for v in text.split(","))
-        if len(values) != 3:
-            raise ValueError
-    except ValueError:
-        raise ArmModelError(f"--base-pos must be three numbers 'X,Y,Z', got {text!r}") from None
-    return values
-
-
 def run(args: argparse.Namespace) -> int:
-    from ik.actions import ACTION_MODELS
-    from ik.errors import ArmModelError
+    from armtransfer.ik.actions import ACTION_MODELS
+    from armtransfer.errors import ArmModelError
 
     if args.action != "list":
         from armtransfer import arm_transfer
 
         return arm_transfer.run(args)
-    from ik.robots import arm_robot, robot_specs
-    from tasks.catalog import TABLE_I
+    from armtransfer.tasks.arms import arm_robot, robot_specs
+    from armtransfer.tasks.catalog import TABLE_I
 
     wanted = None
     if args.actions:
@@ -66,7 +54,7 @@ def run(args: argparse.Namespace) -> int:
             if a not in ACTION_MODELS:
                 raise ArmModelError(
                     f"unknown action model {a!r}; valid action models: {', '.join(ACTION_MODELS)}")
-    from models import ARMS
+    from armtransfer.models import ARMS
 
     arms = None
     if args.arm:
@@ -82,26 +70,26 @@ def run(args: argparse.Namespace) -> int:
     if args.arm_xml:
         custom = [a for a in (wanted or ["cartesian"])]
         # Validate the file before the long built-in listing, so bad input fails fast.
-        from ik.robots import arm_scene
+        from armtransfer.tasks.arms import arm_scene
 
-        arm_scene(xml_path=args.arm_xml, tip_site=args.tip_site, base_pos=_base_pos(args.base_pos),
+        arm_scene(xml_path=args.arm_xml, tip_site=args.tip_site, base_pos=common.parse_base_pos(args.base_pos),
                   base_yaw=args.base_yaw, cell_size=args.cell_size)
         for a in custom:
             jobs.append(dict(arm=None, actions=a, xml_path=args.arm_xml, tip_site=args.tip_site,
-                             base_pos=_base_pos(args.base_pos), base_yaw=args.base_yaw))
+                             base_pos=common.parse_base_pos(args.base_pos), base_yaw=args.base_yaw))
     header = f"{'robot':<24} {'dof':>3} {'actions':>7} {'states':>7} {'reach':>6} {'tableI':>6} {'cache':>6}"
     print(header)
     for job in jobs:
         r = arm_robot(job.pop("arm"), job.pop("actions"), cell_size=args.cell_size,
                       cache=not args.no_cache, **job)
         solved = sum(_solvable(r, t) for t in TABLE_I.values())
-        print(f"{r.name:<24} {r.meta['dof']:>3} {r.n_actions:>7} {r.n_states:>7} "
-              f"{r.meta['reach']:>6.1%} {solved:>4}/{len(TABLE_I)} {r.meta['cache']:>6}")
+        print(f"{r.name:<24} {r.arm.dof:>3} {r.n_actions:>7} {r.n_states:>7} "
+              f"{r.arm.reach:>6.1%} {solved:>4}/{len(TABLE_I)} {r.arm.cache:>6}")
     return 0
 
 
 def _solvable(robot, task) -> bool:
-    from tasks.errors import InvalidCellError
+    from armtransfer.errors import InvalidCellError
 
     try:
         s, g = task.cells()

@@ -11,11 +11,11 @@ import time
 import numpy as np
 
 from armtransfer.commands.common import positive_int
-from tasks.catalog import table_task
-from tasks.grid_robots import grid_robot
-from transfer import sarsa
-from transfer.config import LearnerConfig
-from transfer.io import check_writable, write_json_atomic
+from armtransfer.tasks.catalog import table_task
+from armtransfer.tasks.grid_robots import grid_robot
+from armtransfer.learning import sarsa
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.io import check_writable, write_json_atomic
 
 HELP = "Measure the learner's steps per second on task 1 without transfer (median of repeats)."
 
@@ -49,7 +49,7 @@ def measure(steps: int, seed: int) -> tuple[int, float]:
 
 def measure_reference(steps: int, seed: int) -> tuple[int, float]:
     """The baseline: the dense, line-by-line Algorithm 1 in plain Python (transfer.reference)."""
-    from transfer import reference
+    from armtransfer.learning import reference
 
     robot = grid_robot("fine")
     start, goal = table_task(1).cells()

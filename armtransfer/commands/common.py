@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 import sys
 
-from tasks.catalog import Task, custom_task, parse_xy, table_task
-from tasks.errors import InvalidParameterError, InvalidTaskError
-from transfer.config import LearnerConfig
+from armtransfer.tasks.catalog import Task, custom_task, parse_xy, table_task
+from armtransfer.errors import ArmModelError, InvalidParameterError, InvalidTaskError
+from armtransfer.learning.config import LearnerConfig
 
 
 def positive_int(text: str) -> int:
@@ -43,9 +43,9 @@ def k_value(text: str) -> float | str:
 
 
 def add_method_arguments(p: argparse.ArgumentParser, default: list[str] | None = None) -> None:
-    from transfer import mapping as mappings
-    from transfer import potentials
-    from transfer.experiment import METHODS
+    from armtransfer.learning import mapping as mappings
+    from armtransfer.learning import potentials
+    from armtransfer.learning.experiment import METHODS
 
     default = default or ["none", "pseudo"]
     p.add_argument("--method", nargs="+", default=default, metavar="METHOD",
@@ -76,8 +76,8 @@ def trajectory_specs(args: argparse.Namespace) -> list[str]:
 
 def task_for(args: argparse.Namespace) -> Task:
     """The task from --task/--start/--goal; a trajectory file alone also names its task."""
-    from tasks.layout import ROOMS
-    from transfer import trajectory as trajectories
+    from armtransfer.tasks.layout import ROOMS
+    from armtransfer.learning import trajectory as trajectories
 
     files = [s for s in trajectory_specs(args) if s not in TRAJECTORY_KINDS]
     if args.task is None and args.start is None and args.goal is None and files:
@@ -88,8 +88,8 @@ def task_for(args: argparse.Namespace) -> Task:
 
 def resolve_trajectories(specs: list[str] | None, source, task: Task, config, seed: int) -> list:
     """Each --trajectory: a kind made from the source robot, or a JSON file for this task."""
-    from transfer import experiment
-    from transfer import trajectory as trajectories
+    from armtransfer.learning import experiment
+    from armtransfer.learning import trajectory as trajectories
 
     start, goal = task.cells()
     out = []
@@ -188,3 +188,15 @@ def check_methods(methods: list[str], valid: tuple[str, ...]) -> None:
     for m in methods:
         if m not in valid:
             raise InvalidParameterError(f"unknown method {m!r}; valid methods: {', '.join(valid)}")
+
+
+def parse_base_pos(text: str | None):
+    if text is None:
+        return None
+    try:
+        values = tuple(float(v) for v in text.split(","))
+        if len(values) != 3:
+            raise ValueError
+    except ValueError:
+        raise ArmModelError(f"--base-pos must be three numbers 'X,Y,Z', got {text!r}") from None
+    return values

@@ -7,12 +7,12 @@ import time
 from pathlib import Path
 
 from armtransfer.commands import common
-from transfer import beyond, figures
-from transfer import reproduce as rep
-from tasks.layout import ROOMS
-from transfer.config import LearnerConfig
-from transfer.mapping import ActionMapping
-from transfer.io import check_writable, write_json_atomic, write_text_atomic
+from armtransfer.learning import beyond, figures
+from armtransfer.learning import reproduce as rep
+from armtransfer.tasks.layout import ROOMS
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.mapping import ActionMapping
+from armtransfer.io import check_writable, write_json_atomic, write_text_atomic
 
 HELP = "Reproduce the paper's tables and figures on the rooms world; writes report.md."
 

@@ -7,10 +7,10 @@ from pathlib import Path
 
 from armtransfer.commands import common
 from armtransfer.robots import resolve
-from tasks.errors import InvalidParameterError
-from transfer import experiment, report
-from transfer import mapping as mappings
-from transfer.io import check_writable, write_json_atomic
+from armtransfer.errors import InvalidParameterError
+from armtransfer.learning import experiment, report
+from armtransfer.learning import mapping as mappings
+from armtransfer.io import check_writable, write_json_atomic
 
 HELP = "Transfer a trajectory from one grid robot to another in the rooms world (Table II style)."
 METHODS = experiment.METHODS

@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from transfer.io import write_json_atomic, write_text_atomic
-from transfer.store import ResultStore
-from transfer.summary import plot, summarize, summary_markdown
+from armtransfer.io import write_json_atomic, write_text_atomic
+from armtransfer.learning.store import ResultStore
+from armtransfer.learning.summary import plot, summarize, summary_markdown
 
 HELP = "Summarize a sweep directory: summary.md, summary.json and summary.png."
 

@@ -9,8 +9,8 @@ from armtransfer.commands import common
 from armtransfer.execute import robot_specs
 from armtransfer.executors import _import_ray, run_local, run_ray
 from armtransfer.robots import resolve
-from transfer import sweep as sweeps
-from transfer.store import ResultStore
+from armtransfer.learning import sweep as sweeps
+from armtransfer.learning.store import ResultStore
 
 HELP = "Run a sweep file (TOML) into --out; re-running resumes, skipping finished runs."
 

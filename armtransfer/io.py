@@ -7,7 +7,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from tasks.errors import ArmTransferError
+from armtransfer.errors import ArmTransferError, OutputError
 
 
 def _umask() -> int:
@@ -17,10 +17,6 @@ def _umask() -> int:
 
 
 _UMASK = _umask()
-
-
-class OutputError(ArmTransferError):
-    """An output path cannot be written."""
 
 
 def write_text_atomic(path: str | os.PathLike, text: str) -> None:

@@ -4,7 +4,7 @@ Rendering is MuJoCo's offscreen OpenGL; ``MUJOCO_GL`` must name the backend befo
 ``mujoco`` is first imported (this module sets ``egl`` unless the user chose one), which
 works without a display and without a GPU through Mesa's EGL (llvmpipe).
 
-Each panel is one ``Replay`` (``armtransfer.replay``) rendered with its own model and
+Each panel is one ``Replay`` (``armtransfer.ik.replay``) rendered with its own model and
 ``mujoco.Renderer`` from a fixed free camera that shows the whole table and its walls.
 Markers are drawn as MuJoCo user geoms added to the renderer's scene (they are not part
 of the model, so they never collide): the transferred trajectory's cells as orange
@@ -19,7 +19,7 @@ halves the frame rate (see BENCHMARKS.md, "Rendering"); ``shadows=True`` turns t
 
 Typical use (the ``armtransfer`` command does this)::
 
-    from armtransfer.render import rollout_video
+    from armtransfer.ik.render import rollout_video
     report = rollout_video([(src_robot, src_states), (tgt_robot, tgt_states)], "out.mp4",
                            trajectory_cells=traj.cells, goal_cell=traj.goal)
 """
@@ -42,11 +42,10 @@ from typing import Sequence  # noqa: E402
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
-from armtransfer.replay import Replay, replay  # noqa: E402
-from tasks.errors import ArmTransferError  # noqa: E402
-from tasks.robot import DiscreteRobot  # noqa: E402
-from tasks.workspace import WALL_HEIGHT  # noqa: E402
-from transfer.io import OutputError, check_writable  # noqa: E402
+from armtransfer.ik.replay import Replay, replay  # noqa: E402
+from armtransfer.errors import ArmTransferError  # noqa: E402
+from armtransfer.ik.workspace import WALL_HEIGHT  # noqa: E402
+from armtransfer.io import OutputError, check_writable  # noqa: E402
 
 FORMATS = {".mp4": "mp4", ".gif": "gif"}
 TRAJECTORY_RGBA = (1.0, 0.55, 0.1, 1.0)
@@ -333,7 +332,7 @@ def _umask() -> int:
     return mask
 
 
-def rollout_video(rollouts: Sequence[tuple[DiscreteRobot, Sequence[int]]],
+def rollout_video(rollouts: Sequence[tuple[object, Sequence[int]]],
                   path: str | os.PathLike, *, trajectory_cells: Sequence[int] = (),
                   goal_cell: int | None = None, width: int = 320, height: int = 240,
                   fps: float = 30.0, format: str | None = None, shadows: bool = False,

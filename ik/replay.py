@@ -1,8 +1,8 @@
 """Physics replay of an arm robot's path: position actuators track the joint waypoints.
 
 A path of a discrete arm robot (``ik.robots``) is a list of its states; every state has a
-joint configuration (``robot.meta["qpos"]``). ``replay`` rebuilds the exact MuJoCo scene the
-robot was compiled in (arm on the table with the rooms walls, from ``robot.meta``), puts the
+joint configuration (``robot.arm.qpos``). ``replay`` rebuilds the exact MuJoCo scene the
+robot was compiled in (arm on the table with the rooms walls, from ``robot.arm``), puts the
 arm at the first waypoint and then *simulates* the move: for each next waypoint the
 position actuators' controls ramp linearly from the previous waypoint to it over
 ``segment_seconds`` and ``mj_step`` integrates the dynamics, then the controls hold the
@@ -35,11 +35,15 @@ from typing import Sequence
 import mujoco
 import numpy as np
 
-from ik.labels import OFF_TABLE, cells_of_xy
-from ik.scene import ArmScene, build_scene
-from tasks.errors import ArmTransferError
-from tasks.layout import ROOMS, Layout
-from tasks.robot import DiscreteRobot
+from armtransfer.ik.labels import OFF_TABLE, cells_of_xy
+from armtransfer.ik.scene import ArmScene, build_scene
+from armtransfer.errors import ArmTransferError
+from armtransfer.ik.description import ArmDescription
+
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never imported
+    from armtransfer.tasks.layout import Layout
 
 SEGMENT_SECONDS = 0.1
 SETTLE_SECONDS = 0.3
@@ -163,17 +167,19 @@ def polyline_distance(points: np.ndarray, vertices: np.ndarray) -> np.ndarray:
     return np.linalg.norm(p - closest, axis=-1).min(axis=1)
 
 
-def robot_scene(robot: DiscreteRobot, layout: Layout | None = None) -> ArmScene:
-    """The MuJoCo scene ``robot`` was compiled in, rebuilt from its ``meta``."""
-    meta = robot.meta
-    needed = ("xml_path", "tip_site", "mount", "yaw", "cell_size", "qpos")
-    missing = [k for k in needed if k not in meta]
-    if missing:
-        raise ReplayError(f"robot {robot.name} is not an arm robot (no {', '.join(missing)} in its "
-                          "meta); only ARM:ACTIONS robots can be replayed in MuJoCo")
-    layout = layout or meta.get("layout") or ROOMS
-    return build_scene(meta["xml_path"], meta["tip_site"], meta["mount"], meta["yaw"],
-                       meta["cell_size"], layout)
+def arm_of(robot) -> ArmDescription:
+    """The arm description of a discrete robot; a grid robot cannot be replayed."""
+    arm = getattr(robot, "arm", None)
+    if not isinstance(arm, ArmDescription):
+        raise ReplayError(f"robot {robot.name} is not an arm robot; only ARM:ACTIONS robots can be "
+                          "replayed in MuJoCo")
+    return arm
+
+
+def robot_scene(robot) -> ArmScene:
+    """The MuJoCo scene ``robot`` (a discrete arm robot) was compiled in, rebuilt from its arm."""
+    arm = arm_of(robot)
+    return build_scene(arm.xml_path, arm.tip_site, arm.mount, arm.yaw, arm.cell_size, layout=arm.layout)
 
 
 def _dedupe(cells: Sequence[int]) -> list[int]:
@@ -184,7 +190,7 @@ def _dedupe(cells: Sequence[int]) -> list[int]:
     return out
 
 
-def replay(robot: DiscreteRobot, path_states: Sequence[int], *, goal_cell: int | None = None,
+def replay(robot, path_states: Sequence[int], *, goal_cell: int | None = None,
            segment_seconds: float = SEGMENT_SECONDS, settle_seconds: float = SETTLE_SECONDS,
            bandwidth_hz: float = BANDWIDTH_HZ, feedforward: bool = True,
            scene: ArmScene | None = None) -> Replay:
@@ -199,7 +205,8 @@ def replay(robot: DiscreteRobot, path_states: Sequence[int], *, goal_cell: int |
     states = [int(s) for s in path_states]
     if not states:
         raise ReplayError("a replay needs at least one path state")
-    qtable = robot.meta.get("qpos")
+    arm = arm_of(robot)
+    qtable = arm.qpos
     scene = scene or robot_scene(robot)
     if any(not 0 <= s < len(qtable) for s in states):
         bad = next(s for s in states if not 0 <= s < len(qtable))
@@ -212,7 +219,7 @@ def replay(robot: DiscreteRobot, path_states: Sequence[int], *, goal_cell: int |
     data = mujoco.MjData(model)
     tip_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, scene.tip)
     way = np.asarray(qtable[states], dtype=float)
-    planned_tip = np.asarray(robot.meta["tip"][states], dtype=float) if "tip" in robot.meta else None
+    planned_tip = np.asarray(arm.tip[states], dtype=float) if arm.tip is not None else None
 
     data.qpos[:] = way[0]
     data.ctrl[:] = _ctrl_of(model, way[0])

@@ -6,7 +6,7 @@ labels are the shared rooms-world cells, so every learner runs on it unchanged. 
 paths with the position actuators), ``tip`` [n_states, 3], ``reach`` (fraction of free
 cells reached), ``cache`` ("hit", "miss", "stale", "corrupt") and the compile settings
 (``xml_path``, ``tip_site``, ``mount``, ``yaw``, ``cell_size``, ``layout``: enough to rebuild
-the exact MuJoCo scene, as ``armtransfer.replay`` does).
+the exact MuJoCo scene, as ``armtransfer.ik.replay`` does).
 """
 
 from __future__ import annotations
@@ -17,13 +17,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ik import cache as _cache
-from ik.actions import ACTION_MODELS, action_model
-from ik.errors import ArmModelError, UnknownArmError
-from models import ARMS
-from tasks.layout import ROOMS, Layout
-from tasks.robot import DiscreteRobot
-from tasks.workspace import DEFAULT_CELL, WALL_HEIGHT
+from armtransfer.ik import cache as _cache
+from armtransfer.ik.actions import ACTION_MODELS, action_model
+from armtransfer.ik.description import ArmDescription
+from armtransfer.errors import ArmModelError, UnknownArmError
+from armtransfer.models import ARMS
+from armtransfer.tasks.layout import ROOMS, Layout
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.ik.workspace import DEFAULT_CELL, WALL_HEIGHT
 
 CUSTOM_JOINT_STEP = 0.05
 
@@ -129,15 +130,13 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
     dof = int(arrays["qpos"].shape[1])
     label = arrays["label"]
     reach = float(len(np.unique(label)) / layout.free.sum())
-    meta = {
-        "arm": name, "actions": model.name, "dof": dof, "kind": kind,
-        "qpos": arrays["qpos"], "tip": arrays["tip"], "reach": reach, "cache": status,
-        "key": key, "seconds": seconds, "cell_size": cell_size, "mount": mount, "yaw": yaw,
-        "xml_path": str(path), "tip_site": tip,
-        "joint_step": step if model.kind == "joint" else None, "layout": layout,
-    }
-    if "lattice" in arrays:
-        meta["lattice"] = arrays["lattice"]
+    description = ArmDescription(
+        name=name, actions=model.name, dof=dof, kind=kind, qpos=arrays["qpos"], tip=arrays["tip"],
+        reach=reach, cache=status, key=key, seconds=seconds, cell_size=cell_size,
+        mount=mount, yaw=yaw, xml_path=str(path), tip_site=tip,
+        joint_step=step if model.kind == "joint" else None, layout=layout,
+        lattice=arrays.get("lattice"),
+    )
     return DiscreteRobot(
         name=robot_name,
         next_state=arrays["next_state"],
@@ -146,7 +145,8 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
         action_names=model.action_names(dof),
         cell_step=model.cells,
         canonical=arrays["canonical"],
-        meta=meta,
+        layout=layout,
+        arm=description,
     )
 
 
@@ -160,25 +160,25 @@ def arm_scene(arm: str | None = None, *, cell_size: float = DEFAULT_CELL, xml_pa
               tip_site: str | None = None, base_pos=None, base_yaw: float = 0.0,
               layout: Layout = ROOMS):
     """The MuJoCo scene (``ik.scene.ArmScene``) a robot of this arm is compiled in."""
-    from ik.scene import build_scene
+    from armtransfer.ik.scene import build_scene
 
     if xml_path is not None:
         return build_scene(Path(xml_path), tip_site or "tip", base_pos or (0.0, 0.0, 0.0),
-                           base_yaw, cell_size, layout)
+                           base_yaw, cell_size, layout=layout)
     if arm not in ARMS:
         raise UnknownArmError(f"unknown arm {arm!r}; valid arms: {', '.join(ARMS)}")
     info = ARMS[arm]
     mount = info.mount_pos
     if info.kind == "planar":
         mount = (mount[0] * cell_size / DEFAULT_CELL, mount[1] * cell_size / DEFAULT_CELL, mount[2])
-    return build_scene(info.xml_path, info.tip_site, mount, info.mount_yaw, cell_size, layout)
+    return build_scene(info.xml_path, info.tip_site, mount, info.mount_yaw, cell_size, layout=layout)
 
 
 def _compile(path, tip, mount, yaw, model, tip_down, step, cell, layout, progress) -> dict:
-    from ik.compile import compile_cartesian, compile_joint
-    from ik.scene import build_scene
+    from armtransfer.ik.compile import compile_cartesian, compile_joint
+    from armtransfer.ik.scene import build_scene
 
-    scene = build_scene(Path(path), tip, mount, yaw, cell, layout)
+    scene = build_scene(Path(path), tip, mount, yaw, cell, layout=layout)
     if model.kind == "joint":
         return compile_joint(scene, step, progress)
     return compile_cartesian(scene, tip_down, model.cells, progress)

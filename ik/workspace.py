@@ -16,7 +16,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from tasks.layout import ROOMS, Layout
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never imported
+    from armtransfer.tasks.layout import Layout
+
 
 DEFAULT_CELL = 0.01
 """One cell = 1 cm by default."""
@@ -24,7 +28,7 @@ WALL_HEIGHT = 0.02
 TABLE_THICKNESS = 0.02
 
 
-def wall_runs(layout: Layout = ROOMS) -> list[tuple[tuple[int, int], tuple[int, int]]]:
+def wall_runs(layout: Layout) -> list[tuple[tuple[int, int], tuple[int, int]]]:
     """Runs of wall cells ((x0, y0), (x1, y1)), inclusive, along each wall segment."""
     runs = []
     for (x0, y0), (x1, y1) in layout.walls:
@@ -44,7 +48,7 @@ def wall_runs(layout: Layout = ROOMS) -> list[tuple[tuple[int, int], tuple[int, 
     return runs
 
 
-def wall_boxes(layout: Layout = ROOMS, cell: float = DEFAULT_CELL,
+def wall_boxes(layout: Layout, cell: float = DEFAULT_CELL,
                height: float = WALL_HEIGHT) -> list[tuple[np.ndarray, np.ndarray]]:
     """(centre, half sizes) of each wall box, in metres."""
     boxes = []
@@ -57,7 +61,7 @@ def wall_boxes(layout: Layout = ROOMS, cell: float = DEFAULT_CELL,
     return boxes
 
 
-def build_workspace(layout: Layout = ROOMS, cell: float = DEFAULT_CELL,
+def build_workspace(layout: Layout, cell: float = DEFAULT_CELL,
                     wall_height: float = WALL_HEIGHT):
     """The table scene as a ``dm_control.mjcf`` root element (arms are attached to it)."""
     from dm_control import mjcf

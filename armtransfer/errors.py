@@ -1,0 +1,51 @@
+"""Every error a user can cause, in one hierarchy.
+
+Each message is one line that names the problem and, where there is a choice, lists the
+valid names. The command prints it as ``armtransfer COMMAND: error: MESSAGE`` and exits
+with code 2; a library user catches ``ArmTransferError``. This module imports nothing of
+the project, so every layer can raise these.
+"""
+
+
+class ArmTransferError(Exception):
+    """Base class of every error caused by bad input."""
+
+
+class InvalidCellError(ArmTransferError):
+    """A cell is off the grid or inside a wall."""
+
+
+class InvalidTaskError(ArmTransferError):
+    """A task is unknown or malformed (e.g. start equals goal)."""
+
+
+class UnknownRobotError(ArmTransferError):
+    """A robot or action model name is not known."""
+
+
+class UnknownArmError(UnknownRobotError):
+    """An arm or action model name is not known (the message lists the valid ones)."""
+
+
+class ArmModelError(ArmTransferError):
+    """An arm's MJCF cannot be used: unreadable, no hinge joints, missing tip site."""
+
+
+class UnreachableTableError(ArmTransferError):
+    """The arm's tool tip cannot reach any free cell of the table."""
+
+
+class InvalidTrajectoryError(ArmTransferError):
+    """A transferred trajectory is malformed or names cells off the grid."""
+
+
+class InvalidParameterError(ArmTransferError):
+    """A learning parameter is out of range (e.g. a farmable K, non-positive trials)."""
+
+
+class InvalidMappingError(ArmTransferError):
+    """An action sequence mapping file is malformed or made for another robot pair."""
+
+
+class OutputError(ArmTransferError):
+    """An output path cannot be written."""

@@ -1,0 +1,50 @@
+"""What a compiled arm robot knows of its arm: a typed description, no MuJoCo import.
+
+A discrete arm robot (``armtransfer.tasks.arms``) carries one of these as ``robot.arm``.
+It holds everything needed to rebuild the exact MuJoCo scene the robot was compiled in
+(``xml_path``, ``tip_site``, ``mount``, ``yaw``, ``cell_size``, ``layout``) and the joint
+configuration and tip position of every state, so a path can be replayed in physics.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never imported
+    from armtransfer.tasks.layout import Layout
+
+
+@dataclass(frozen=True, eq=False)
+class ArmDescription:
+    name: str
+    """The arm's name: a built-in arm, or a bring-your-own arm's file stem."""
+    actions: str
+    """The action model: ``joint``, ``cartesian`` or ``cartesian2``."""
+    dof: int
+    kind: str
+    """``planar`` (vertical joint axes), ``spatial``, or ``custom`` (bring-your-own)."""
+    qpos: np.ndarray
+    """float [n_states, nq]: the joint configuration of every state."""
+    tip: np.ndarray
+    """float [n_states, 3]: the tool tip's position (m) at every state."""
+    reach: float
+    """The share of the layout's free cells that some state is labelled with."""
+    cache: str
+    """How the arrays were obtained: ``hit``, ``miss``, ``stale``, ``corrupt`` or ``off``."""
+    key: str
+    """The content hash the compiled arrays are cached under."""
+    seconds: float
+    """Wall time to compile (or load) the arrays."""
+    cell_size: float
+    mount: tuple[float, float, float]
+    yaw: float
+    xml_path: str
+    tip_site: str
+    joint_step: float | None
+    """Lattice step of the ``joint`` action model (rad); None for cartesian models."""
+    layout: Layout
+    lattice: Any = None
+    """The ``joint`` model's lattice indices per state, when it has one."""
