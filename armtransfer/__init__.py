@@ -26,12 +26,13 @@ __version__ = "0.1.0"
 
 _LAZY = {
     "transfer": "armtransfer.api",
-    "TransferResult": "armtransfer.results",
-    "MethodResult": "armtransfer.results",
-    "TrialResult": "armtransfer.results",
+    "TransferResult": "armtransfer.learning.results",
+    "MethodResult": "armtransfer.learning.experiment",
+    "TrialResult": "armtransfer.learning.sarsa",
     "LearnerConfig": "armtransfer.learning.config",
     "METHODS": "armtransfer.learning.methods",
-    "resolve_robot": "armtransfer.robots",
+    "Method": "armtransfer.learning.methods",
+    "resolve_robot": "armtransfer.tasks.specs",
     "register_envs": "armtransfer.tasks.envs",
     "ArmTransferError": "armtransfer.errors",
 }

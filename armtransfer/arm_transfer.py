@@ -20,17 +20,18 @@ import time
 from pathlib import Path
 
 
+from armtransfer import api
 from armtransfer.commands import common
-from armtransfer.commands.rooms import print_results, run_experiment
-from armtransfer.errors import InvalidParameterError, UnknownRobotError
+from armtransfer.commands.rooms import print_results, results_table
+from armtransfer.errors import InvalidParameterError
 from armtransfer.tasks.layout import ROOMS
 from armtransfer.tasks.robot import DiscreteRobot
-from armtransfer.learning import figures, report
+from armtransfer.learning import experiment, figures
+from armtransfer.tasks.specs import CUSTOM, resolve
 from armtransfer.io import OutputError, check_writable, write_json_atomic, write_text_atomic
 
 DEFAULT_SOURCE = "planar2:joint"
 DEFAULT_TARGET = "ur5e_like:cartesian"
-CUSTOM = "custom"
 DEFAULT_METHODS = ["none", "pseudo", "dense"]
 
 
@@ -57,27 +58,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "a small low-rate video")
 
 
-def _custom_options(args: argparse.Namespace) -> dict:
-    if not getattr(args, "arm_xml", None):
-        raise UnknownRobotError(f"robot '{CUSTOM}' needs --arm-xml PATH (and --tip-site NAME)")
-    return dict(xml_path=args.arm_xml, tip_site=args.tip_site, base_pos=common.parse_base_pos(args.base_pos),
-                base_yaw=args.base_yaw)
-
-
-def resolve_arm(spec: str, args: argparse.Namespace) -> DiscreteRobot:
-    """An arm robot from ``ARM[:ACTIONS]`` (``custom`` = the --arm-xml arm)."""
-    from armtransfer.robots import resolve
-    from armtransfer.tasks.arms import arm_robot
-
-    arm, _, actions = spec.partition(":")
-    if arm == CUSTOM:
-        return arm_robot(CUSTOM, actions or "cartesian", progress=common.interactive(), **_custom_options(args))
-    if arm in ("fine", "coarse"):
-        return resolve(spec)
-    from armtransfer.tasks.arms import parse_robot_spec
-
-    arm, actions = parse_robot_spec(spec)
-    return arm_robot(arm, actions, progress=common.interactive())
+def arm_options(args: argparse.Namespace) -> dict:
+    """The bring-your-own arm's options (for ``custom[:ACTIONS]``) and the cell size."""
+    options = dict(cell_size=args.cell_size)
+    if getattr(args, "arm_xml", None):
+        options.update(tip_site=args.tip_site, base_pos=common.parse_base_pos(args.base_pos), base_yaw=args.base_yaw)
+    return options
 
 
 def _prepare_out(out: Path) -> Path:
@@ -95,15 +81,14 @@ def _commit_out(tmp: Path, out: Path) -> None:
     os.replace(tmp, out)
 
 
-def _apply_fast(args: argparse.Namespace) -> None:
-    if args.fast:
-        args.trials = min(args.trials, 2)
-        args.patience = min(args.patience, 5)
-        args.no_controls = True
+def _fast_overrides(args: argparse.Namespace) -> dict:
+    """--fast: 2 trials, convergence after 5 unchanged episodes, no controls."""
+    if not args.fast:
+        return {}
+    return dict(trials=min(args.trials, 2), patience=min(args.patience, 5), controls=False)
 
 
 def run(args: argparse.Namespace) -> int:
-    _apply_fast(args)
     t0 = time.perf_counter()
     out = Path(args.out) if args.out else Path("runs") / _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
     for extra in (args.json, args.render):
@@ -135,20 +120,25 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run_into(args: argparse.Namespace, tmp: Path) -> dict:
-    with common.phase("compiling arms"):
-        source = resolve_arm(args.source, args)
-        target = resolve_arm(args.target, args)
+    kwargs = {**common.transfer_kwargs(args), **_fast_overrides(args)}
     if args.source_planner == "learn" and not args.trajectory:
-        args.trajectory = ["learned"]
-    out_json, learned = run_experiment(args, source=source, target=target)
+        kwargs["trajectory"] = ["learned"]
+    elif not args.trajectory:
+        kwargs["trajectory"] = ["optimal"]
+    with common.phase("compiling arms"):
+        options = arm_options(args)
+        source = resolve(args.source, xml_path=args.arm_xml, progress=common.interactive(), **options)
+        target = resolve(args.target, xml_path=args.arm_xml, progress=common.interactive(), **options)
+    total = experiment.count_trials(args.method, kwargs["trials"], kwargs["controls"])
+    with common.progress_bar(total, "learning") as bar:
+        result = api.transfer(source, target, progress=bar.update, **kwargs)
+    out_json = result.to_json()
     print_results(out_json)
-    if out_json["mapping"] is not None and out_json["mapping"]["saved"]:
-        learned.save(args.mapping)
     write_json_atomic(tmp / "results.json", out_json)
     write_text_atomic(tmp / "table.md", _table_md(out_json))
-    curves = {m: r["episode_steps"] for m, r in out_json["results"].items() if "[" not in m}
+    curves = {m: r["episode_steps"] for m, r in out_json["results"].items()}
     figures.learning_curves(curves, f"{source.name} -> {target.name}: steps per episode", tmp / "learning_curves.png")
-    paths = _paths(out_json, source, target, args)
+    paths = _paths(out_json, source, target)
     traj_xy = [list(ROOMS.xy(c)) for c in paths["trajectory_cells"]] + [list(out_json["task"]["goal"])]
     figures.mapping_paths(ROOMS.wall_mask, ROOMS.lo, traj_xy, paths["target_xy"] or traj_xy, [],
                           f"{source.name} (dashed) -> {target.name} (solid)", tmp / "map.png")
@@ -164,7 +154,7 @@ def _run_into(args: argparse.Namespace, tmp: Path) -> dict:
     return {"json": out_json, "video": video, "paths": paths, "source": source, "target": target}
 
 
-def _paths(out_json: dict, source: DiscreteRobot, target: DiscreteRobot, args) -> dict:
+def _paths(out_json: dict, source: DiscreteRobot, target: DiscreteRobot) -> dict:
     """The source's transferred path and the target's converged greedy path (first
     converged trial of the first transfer method), as states and cells."""
     start = ROOMS.cell(*out_json["task"]["start"])
@@ -174,7 +164,7 @@ def _paths(out_json: dict, source: DiscreteRobot, target: DiscreteRobot, args) -
     source_states = _states_along(source, start, steps, goal) if steps else [source.start_state(start)]
     target_states = None
     for method, r in out_json["results"].items():
-        if method != "none" and "[" not in method:
+        if method != "none":
             for states in r.get("greedy_path_states", []):
                 if states:
                     target_states = states
@@ -230,5 +220,5 @@ def _table_md(out_json: dict) -> str:
         f"{t['name']}: {tuple(t['start'])} -> {tuple(t['goal'])}; target's optimal distance "
         f"{out_json['distance']}; {out_json['trials']} trials, seed {out_json['seed']}"
         + (f", wind {out_json['wind']}" if out_json["wind"] else "")
-        + "\n\n" + report.method_table(out_json["results"]) + "\n"
+        + "\n\n" + results_table(out_json) + "\n"
     )

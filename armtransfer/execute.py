@@ -16,10 +16,8 @@ from armtransfer.learning.config import LearnerConfig
 
 
 def learner_config(run: dict) -> LearnerConfig:
-    return LearnerConfig(
-        alpha=run["alpha"], gamma=run["gamma"], lam=run["lam"], epsilon=run["epsilon"],
-        patience=run["patience"], max_episodes=run["max_episodes"],
-    )
+    """The learner settings a sweep run carries (every LearnerConfig field it names)."""
+    return LearnerConfig.from_options({k: run[k] for k in LearnerConfig.options() if k in run})
 
 
 def robot_specs(runs: list[dict]) -> list[str]:

@@ -12,7 +12,7 @@ from __future__ import annotations
 import argparse
 import time
 
-from armtransfer.robots import resolve
+from armtransfer.tasks.specs import resolve
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.learning import experiment
 from armtransfer.learning.config import LearnerConfig

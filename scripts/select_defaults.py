@@ -19,7 +19,7 @@ import numpy as np
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.tasks.layout import ROOMS
-from armtransfer.learning import potentials, rewards, sarsa
+from armtransfer.learning import potentials, methods, rewards, sarsa
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.experiment import trial_rng
@@ -60,7 +60,7 @@ def score(method: str, params: dict, pairs, trials: int) -> float:
             phi = potentials.dense(fine, traj, params["K"], params["beta"])
             shaping = Shaping.potential(phi, params["K"])
         else:
-            shaping = rewards.build(method, fine, traj, params["K"], config.step_reward, config.gamma)
+            shaping = methods.build_shaping(method, fine, traj, params["K"], config.step_reward)
         optimal = len(fine.shortest_path(fine.start_state(s), g)) - 1
         for t in range(trials):
             res = sarsa.learn(fine, fine.start_state(s), g, config, trial_rng(12345, t), shaping=shaping)

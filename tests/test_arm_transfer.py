@@ -103,5 +103,6 @@ def test_a_bring_your_own_arm_on_either_side(tmp_path, scara_xml, side):
                  "--base-pos=-0.1,0,0", "--source-planner", "bfs", "--task", "4"])
     assert code == 0
     data = json.loads((out / "results.json").read_text())
-    assert data["source" if side == "--source" else "target"] == "custom:cartesian"
+    # a bring-your-own arm is named after its file's model (my_scara), not "custom"
+    assert data["source" if side == "--source" else "target"] == "my_scara:cartesian"
     assert all(x is not None for x in data["results"]["pseudo"]["exploration_steps"])

@@ -9,7 +9,7 @@ from armtransfer.cli import main
 from armtransfer.errors import InvalidMappingError
 from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.tasks.layout import ROOMS, Layout
-from armtransfer.learning import experiment, reference, rewards, sarsa
+from armtransfer.learning import experiment, reference, methods, rewards, sarsa
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import ActionMapping, MacroTable, chain, load_for
@@ -200,8 +200,8 @@ def test_kernel_runs_macros_bit_identically_to_the_dense_reference(wind):
     m.add([2, 2], [L, L, R, R, R, R])  # runs into the border: abandoned when blocked
     table = MacroTable(m, t, fine, episodes=None)
     config = LearnerConfig(trace_cutoff=0.0, max_episodes=12, patience=1000)
-    K = rewards.resolve_k("auto", config.step_reward, t)
-    shaping = rewards.build("mapping", fine, t, K, config.step_reward, config.gamma)
+    K = methods.get("pseudo").resolve_k("auto", config.step_reward, t)
+    shaping = methods.build_shaping("mapping", fine, t, K, config.step_reward)
     s0 = fine.start_state(start)
     fast = sarsa.learn(fine, s0, goal, config, np.random.default_rng(11), shaping=shaping,
                        wind=wind, macros=table, keep_q=True)
@@ -361,7 +361,7 @@ def test_macros_in_every_episode_keep_the_greedy_path_from_converging():
     _, m = experiment.run_mapping(fine, s1, g1, t1, ActionMapping.for_robots(coarse, fine), 10, 0, config)
     s2, g2 = TABLE_I[2].cells()
     t2 = trajectories.shortest(coarse, s2, g2)
-    shaping = rewards.build("mapping", fine, t2, "auto", config.step_reward, config.gamma)
+    shaping = methods.build_shaping("mapping", fine, t2, "auto", config.step_reward)
     start = fine.start_state(s2)
     first = MacroTable(m, t2, fine)
     every = MacroTable(m, t2, fine, episodes=None)

@@ -5,7 +5,7 @@ import pytest
 
 from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.tasks.layout import Layout
-from armtransfer.learning import controls, experiment, learning_metrics, potentials, rewards, sarsa
+from armtransfer.learning import controls, experiment, learning_metrics, potentials, methods, rewards, sarsa
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.shaping import Shaping
@@ -38,7 +38,7 @@ def test_first_visit_ends_the_farming_loop_that_plain_pseudo_falls_into(setup):
     config = LearnerConfig(max_episodes=200, max_total_steps=300_000, max_episode_steps=20_000)
     looped = sarsa.learn(fine, fine.start_state(start), goal, config, np.random.default_rng(0), shaping=farmable)
     fixed = sarsa.learn(fine, fine.start_state(start), goal, config, np.random.default_rng(0),
-                        shaping=rewards.build("first-visit", fine, traj, K, -1.0, 0.99))
+                        shaping=methods.build_shaping("first-visit", fine, traj, K, -1.0))
     # plain pseudo: episodes run into the cap as the agent collects the bonus forever
     assert (looped.episode_steps < 0).any() and not looped.converged
     # first-visit: every episode reaches the goal and the greedy path converges
@@ -61,7 +61,7 @@ def test_potential_leaves_the_converged_greedy_path_length_unchanged(setup):
     none = greedy(None)
     assert none <= optimal + 1
     for K in (1.0, 5.0):
-        assert abs(greedy(rewards.build("potential", fine, traj, K, -1.0, config.gamma)) - none) <= 1.0
+        assert abs(greedy(methods.build_shaping("potential", fine, traj, K, -1.0)) - none) <= 1.0
 
 
 def test_potential_shaping_equals_q_initialised_to_the_potential(setup):
@@ -69,7 +69,7 @@ def test_potential_shaping_equals_q_initialised_to_the_potential(setup):
     actions as no shaping from Q(s, a) = Phi(s)."""
     fine, _, start, goal, traj = setup
     config = LearnerConfig(max_episodes=10, patience=1000)
-    sh = rewards.build("dense", fine, traj, 2.0, -1.0, config.gamma)
+    sh = methods.build_shaping("dense", fine, traj, 2.0, -1.0)
     shaped = sarsa.learn(fine, fine.start_state(start), goal, config, np.random.default_rng(7), shaping=sh, keep_q=True)
     q0 = np.repeat(sh.phi[:, None], fine.n_actions, axis=1)
     init = sarsa.learn(fine, fine.start_state(start), goal, config, np.random.default_rng(7), q_init=q0, keep_q=True)
@@ -85,8 +85,8 @@ def test_dense_reaches_the_goal_sooner_than_pseudo():
     fine, coarse = grid_robot("fine", OPEN), grid_robot("coarse", OPEN)
     start, goal = OPEN.cell(-6, -6), OPEN.cell(6, 6)
     traj = trajectories.shortest(coarse, start, goal)
-    pseudo = rewards.build("pseudo", fine, traj, "auto", -1.0, 0.99)
-    dense = rewards.build("dense", fine, traj, "auto", -1.0, 0.99)
+    pseudo = methods.build_shaping("pseudo", fine, traj, "auto", -1.0)
+    dense = methods.build_shaping("dense", fine, traj, "auto", -1.0)
     assert mean_exploration(fine, start, goal, dense) < 0.5 * mean_exploration(fine, start, goal, pseudo)
 
 
@@ -110,7 +110,7 @@ def test_progress_and_first_visit_pay_at_most_n_times_k_per_episode(setup):
     fine, _, start, goal, traj = setup
     K = 0.5
     for method in ("progress", "first-visit"):
-        sh = rewards.build(method, fine, traj, K, -1.0, 0.99)
+        sh = methods.build_shaping(method, fine, traj, K, -1.0)
         # walk the shortest path there and back twice: the total bonus never exceeds n*K
         path = [s for s, _ in fine.shortest_path(fine.start_state(start), goal)]
         assert sh.bonus.max() == pytest.approx(traj.n * K)
@@ -121,13 +121,13 @@ def test_several_trajectories_take_each_index_as_a_fraction_of_its_length(setup)
     fine, coarse, start, goal, traj = setup
     longer = trajectories.via(coarse, start, goal, [GRID.cell(-4, 4)])
     assert longer.n > traj.n
-    sh = rewards.build("pseudo", fine, [traj, longer], 0.01, -1.0, 0.99)
+    sh = methods.build_shaping("pseudo", fine, [traj, longer], 0.01, -1.0)
     N = longer.n
     # the last cell of the short trajectory gets its full fraction 1 of N*K
     s = fine.start_state(traj.cells[-1])
     assert sh.bonus[s] == pytest.approx(N * 0.01)
-    alone = rewards.build("pseudo", fine, traj, 0.01, -1.0, 0.99)
-    assert np.allclose(alone.bonus, rewards.build("pseudo", fine, [traj], 0.01, -1.0, 0.99).bonus)
+    alone = methods.build_shaping("pseudo", fine, traj, 0.01, -1.0)
+    assert np.allclose(alone.bonus, methods.build_shaping("pseudo", fine, [traj], 0.01, -1.0).bonus)
 
 
 def test_controls_keep_length_and_cells_and_are_seeded(setup):

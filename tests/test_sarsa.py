@@ -6,7 +6,7 @@ import pytest
 from armtransfer.errors import InvalidParameterError
 from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.tasks.layout import Layout
-from armtransfer.learning import reference, rewards, sarsa
+from armtransfer.learning import reference, methods, rewards, sarsa
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 
@@ -29,8 +29,8 @@ def test_compiled_learner_is_bit_identical_to_dense_algorithm_1(wind, with_trans
     K = 0.0
     if with_transfer:
         traj = trajectories.shortest(grid_robot("coarse", SMALL), robot.label[s0], goal)
-        K = rewards.resolve_k("auto", config.step_reward, traj)
-        shaping = rewards.build("pseudo", robot, traj, K, config.step_reward, config.gamma)
+        K = methods.get("pseudo").resolve_k("auto", config.step_reward, traj)
+        shaping = methods.build_shaping("pseudo", robot, traj, K, config.step_reward)
     fast = sarsa.learn(robot, s0, goal, config, np.random.default_rng(3), shaping=shaping,
                        wind=wind, keep_q=True)
     Q, steps = reference.learn(robot, s0, goal, config, np.random.default_rng(3), episodes=15,
@@ -91,7 +91,7 @@ def test_pseudo_reward_is_i_times_k_with_the_largest_index_on_loops():
     traj = trajectories.Trajectory(
         cells=(c(-2, -2), c(-1, -2), c(-2, -2), c(-1, -2), c(-1, -1)), actions=(2, 3, 2, 0, 0), goal=goal
     )
-    sh = rewards.build("pseudo", robot, traj, 0.1, -1.0, 0.99)
+    sh = methods.build_shaping("pseudo", robot, traj, 0.1, -1.0)
     bonus = {SMALL.xy(int(robot.label[s])): sh.bonus[s] for s in range(robot.n_states) if sh.bonus[s]}
     assert bonus == pytest.approx({(-2, -2): 0.2, (-1, -2): 0.3, (-1, -1): 0.4})
 
@@ -102,9 +102,9 @@ def test_farmable_k_is_refused_with_the_bound_named():
     bound = rewards.farming_bound(-1.0, traj)
     assert bound == pytest.approx(1.0 / traj.n)
     with pytest.raises(InvalidParameterError, match=r"farmed.*K < "):
-        rewards.build("pseudo", robot, traj, bound, -1.0, 0.99)
-    rewards.build("pseudo", robot, traj, bound * 0.99, -1.0, 0.99)  # just below: accepted
-    rewards.build("first-visit", robot, traj, bound * 10, -1.0, 0.99)  # cannot be farmed
+        methods.build_shaping("pseudo", robot, traj, bound, -1.0)
+    methods.build_shaping("pseudo", robot, traj, bound * 0.99, -1.0)  # just below: accepted
+    methods.build_shaping("first-visit", robot, traj, bound * 10, -1.0)  # cannot be farmed
 
 
 def test_pseudo_reward_speeds_up_the_first_episode_on_the_rooms_world():
@@ -114,7 +114,7 @@ def test_pseudo_reward_speeds_up_the_first_episode_on_the_rooms_world():
     start, goal = table_task(1).cells()
     traj = trajectories.shortest(coarse, start, goal)
     config = LearnerConfig(max_episodes=1)
-    sh = rewards.build("pseudo", fine, traj, "auto", config.step_reward, config.gamma)
+    sh = methods.build_shaping("pseudo", fine, traj, "auto", config.step_reward)
     base, pseudo = [], []
     for trial in range(40):
         base.append(sarsa.learn(fine, fine.start_state(start), goal, config, np.random.default_rng(trial)).exploration_steps)

@@ -1,10 +1,20 @@
-"""Learning parameters of SARSA(lambda) (Algorithm 1) and the limits of one trial."""
+"""Learning parameters of SARSA(lambda) (Algorithm 1) and the limits of one trial.
+
+Every field says once what it is (``help``) and the range it must lie in (``lo``/``hi``); the
+command's flags (``--alpha`` ...), the API's keyword options and the sweep files' keys are
+all made from these fields, so a new parameter is one field here.
+"""
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+import math
+from dataclasses import asdict, dataclass, field, fields
 
 from armtransfer.errors import InvalidParameterError
+
+
+def _param(default, help: str, lo: float, hi: float = math.inf, *, lo_open: bool = False, cli: bool = True):
+    return field(default=default, metadata={"help": help, "lo": lo, "hi": hi, "lo_open": lo_open, "cli": cli})
 
 
 @dataclass(frozen=True)
@@ -15,49 +25,54 @@ class LearnerConfig:
     better than a tried one: the agent explores systematically, as in the paper.
     """
 
-    alpha: float = 0.1
-    gamma: float = 0.99
-    lam: float = 0.9
-    epsilon: float = 0.1
-    step_reward: float = -1.0
-    goal_reward: float = 0.0
-    trace_cutoff: float = 1e-3
-    """Eligibility traces below this are dropped (set to 0). With gamma*lambda = 0.891 a
-    trace of 1 falls below 1e-3 after 60 steps. 0 keeps every trace until it underflows,
-    which is exactly the dense Algorithm 1."""
-    max_episodes: int = 2000
-    max_total_steps: int = 20_000_000
-    max_episode_steps: int = 200_000
+    alpha: float = _param(0.1, "learning rate", 0.0, 1.0, lo_open=True)
+    gamma: float = _param(0.99, "discount", 0.0, 1.0)
+    lam: float = _param(0.9, "trace decay lambda", 0.0, 1.0)
+    epsilon: float = _param(0.1, "exploration rate of epsilon-greedy", 0.0, 1.0)
+    step_reward: float = _param(-1.0, "reward per step", -math.inf)
+    goal_reward: float = _param(0.0, "reward on reaching the goal", -math.inf)
+    trace_cutoff: float = _param(1e-3, "eligibility traces below this are dropped", 0.0, 1.0, cli=False)
+    """With gamma*lambda = 0.891 a trace of 1 falls below 1e-3 after 60 steps. 0 keeps every
+    trace until it underflows, which is exactly the dense Algorithm 1."""
+    max_episodes: int = _param(2000, "episodes per trial at most", 1)
+    max_total_steps: int = _param(20_000_000, "steps per trial at most (a trial that has not reached the goal by "
+                                  "then counts as unreached)", 1)
+    max_episode_steps: int = _param(200_000, "steps per episode at most, after the first", 1)
     """Cap on every episode but the first (the first runs until the goal or the total cap)."""
-    patience: int = 20
+    patience: int = _param(20, "episodes the greedy path must stay the same to count as converged", 1)
     """The greedy path has converged when it reaches the goal and stays the same for this
     many consecutive episodes."""
 
     def __post_init__(self) -> None:
-        checks = {
-            "alpha": 0.0 < self.alpha <= 1.0,
-            "gamma": 0.0 <= self.gamma <= 1.0,
-            "lam": 0.0 <= self.lam <= 1.0,
-            "epsilon": 0.0 <= self.epsilon <= 1.0,
-            "trace_cutoff": 0.0 <= self.trace_cutoff < 1.0,
-            "max_episodes": self.max_episodes >= 1,
-            "max_total_steps": self.max_total_steps >= 1,
-            "max_episode_steps": self.max_episode_steps >= 1,
-            "patience": self.patience >= 1,
-        }
-        ranges = {
-            "alpha": "(0, 1]",
-            "gamma": "[0, 1]",
-            "lam": "[0, 1]",
-            "epsilon": "[0, 1]",
-            "trace_cutoff": "[0, 1)",
-        }
-        for name, ok in checks.items():
+        for f in fields(self):
+            value = getattr(self, f.name)
+            lo, hi, lo_open = f.metadata["lo"], f.metadata["hi"], f.metadata["lo_open"]
+            integer = f.type in (int, "int")
+            ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+            if integer:
+                ok = ok and float(value).is_integer()
+            ok = ok and (value > lo if lo_open else value >= lo) and value <= hi and (f.name != "trace_cutoff" or value < 1)
             if not ok:
-                want = ranges.get(name, ">= 1")
-                raise InvalidParameterError(
-                    f"{name} must be in {want}, got {getattr(self, name)}"
-                )
+                want = "an integer >= 1" if integer else (
+                    f"in {'(' if lo_open else '['}{lo:g}, {hi:g}]" if math.isfinite(hi) and math.isfinite(lo)
+                    else "a finite number")
+                if f.name == "trace_cutoff":
+                    want = "in [0, 1)"
+                raise InvalidParameterError(f"{f.name} must be {want}, got {value!r}")
 
     def to_dict(self) -> dict:
         return asdict(self)
+
+    @classmethod
+    def options(cls) -> tuple[str, ...]:
+        """The fields a user may set (flags, API keywords, sweep keys)."""
+        return tuple(f.name for f in fields(cls))
+
+    @classmethod
+    def from_options(cls, options: dict) -> "LearnerConfig":
+        """A config from keyword options; an unknown one is a one-line error listing the valid."""
+        unknown = sorted(set(options) - set(cls.options()))
+        if unknown:
+            raise InvalidParameterError(
+                f"unknown learner option {unknown[0]!r}; valid options: {', '.join(cls.options())}")
+        return cls(**options)

@@ -14,16 +14,16 @@ import numpy as np
 
 from armtransfer.errors import InvalidParameterError
 from armtransfer.tasks.robot import DiscreteRobot
-from armtransfer.learning import metrics, potentials, rewards, sarsa
+from armtransfer.learning import controls, methods, metrics, potentials, sarsa
+from armtransfer.learning.controls import CONTROLS
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import DEFAULT_MAX_SPAN, ActionMapping, MacroTable
 from armtransfer.learning.trajectory import Trajectory
 
-SHAPING_METHODS = ("pseudo", "first-visit", "potential", "progress", "dense")
-METHODS = ("none", *SHAPING_METHODS, "mapping")
-"""Every method: ``none`` (Algorithm 1 without transfer), the paper's ``pseudo`` and
-``mapping``, and the methods new here (see ``transfer.rewards`` and ``transfer.potentials``)."""
+SHAPING_METHODS = methods.SHAPED
+METHODS = tuple(methods.METHODS)
+"""Every method's name, from the registry ``armtransfer.learning.methods``."""
 
 
 def trial_rng(seed: int, trial: int, stream: int = 0) -> np.random.Generator:
@@ -56,9 +56,18 @@ def source_trajectory(
 
 @dataclass
 class MethodResult:
+    """Every trial of one method on one task; ``control`` names the control trajectory the
+    method was given instead of the real one (None: the real trajectory)."""
+
     method: str
     trials: list[sarsa.TrialResult] = field(default_factory=list)
     extra: dict = field(default_factory=dict)
+    control: str | None = None
+
+    @property
+    def label(self) -> str:
+        """How tables name it: ``dense``, or ``dense [shuffled]`` for a control."""
+        return self.method if self.control is None else f"{self.method} [{self.control}]"
 
     def column(self, name: str) -> list:
         return [getattr(t, name) for t in self.trials]
@@ -78,18 +87,18 @@ def run_method(
     macros=None,
     on_trial: Callable[[], None] | None = None,
     beta: float = potentials.DENSE_BETA,
-    label: str | None = None,
+    control: str | None = None,
 ) -> MethodResult:
     """``trials`` independent trials of one method on the target robot."""
     if trials < 1:
         raise InvalidParameterError(f"trials must be a positive integer, got {trials}")
     shaping = None
-    if method != "none":
+    if methods.get(method).shaped:
         if traj is None:
             raise InvalidParameterError(f"method {method!r} needs a trajectory")
-        shaping = rewards.build(method, target, traj, K, config.step_reward, config.gamma, beta=beta)
+        shaping = methods.build_shaping(method, target, traj, K, config.step_reward, beta=beta)
     start_state = target.start_state(start_cell)
-    out = MethodResult(label or method)
+    out = MethodResult(method, control=control)
     for trial in range(trials):
         res = sarsa.learn(
             target, start_state, goal_cell, config, trial_rng(seed, trial),
@@ -146,7 +155,7 @@ def run_mapping(
 
 def summarize(results: Sequence[MethodResult], baseline: str = "none") -> dict:
     """The JSON ``results`` block: per method, per-trial lists, means, CIs, improvement."""
-    by_name = {r.method: r for r in results}
+    by_name = {r.label: r for r in results}
     base = by_name.get(baseline)
     base_ex = base.column("exploration_steps") if base else None
     base_mean = metrics.mean_ci(base_ex)[0] if base else None
@@ -162,8 +171,8 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none") -> dict:
             "exploration_steps": ex,
             "mean": mean,
             "ci95": ci,
-            "improvement_percent": None if r.method == baseline else metrics.improvement_percent(base_mean, mean),
-            "improvement_ci95": None if r.method == baseline or base is None else metrics.improvement_ci(base_ex, ex),
+            "improvement_percent": None if r.label == baseline else metrics.improvement_percent(base_mean, mean),
+            "improvement_ci95": None if r.label == baseline or base is None else metrics.improvement_ci(base_ex, ex),
             "greedy_steps": greedy,
             "greedy_mean": g_mean,
             "greedy_ci95": g_ci,
@@ -176,7 +185,7 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none") -> dict:
             "greedy_path_states": [[int(s) for s, _ in t.greedy_path] for t in r.trials],
         }
         entry.update(r.extra)
-        out[r.method] = entry
+        out[r.label] = entry
     return out
 
 
@@ -199,9 +208,7 @@ def control_trajectories(
     kind: str, source: DiscreteRobot, trajs: Sequence[Trajectory], seed: int
 ) -> list[Trajectory]:
     """``shuffled`` or ``random`` stand-ins for the real trajectories, seeded by ``seed``."""
-    from armtransfer.learning import controls
-
-    rng = np.random.default_rng(np.random.SeedSequence([int(seed), 2, controls.CONTROLS.index(kind)]))
+    rng = np.random.default_rng(np.random.SeedSequence([int(seed), 2, CONTROLS.index(kind)]))
     if kind == "shuffled":
         return [controls.shuffled(t, rng) for t in trajs]
     return [controls.random_walk(source, t, rng) for t in trajs]
@@ -230,12 +237,12 @@ def add_transfer_metrics(summary: dict, optimal: int, baseline: str = "none") ->
         entry["transfer_metrics"] = block
 
 
-def run_transfer(
+def run_all(
     source: DiscreteRobot,
     target: DiscreteRobot,
     start_cell: int,
     goal_cell: int,
-    methods: Sequence[str],
+    method_names: Sequence[str],
     trajs: Sequence[Trajectory],
     trials: int,
     seed: int,
@@ -247,45 +254,68 @@ def run_transfer(
     max_span: int = DEFAULT_MAX_SPAN,
     controls: bool = True,
     tick: Callable[[], None] | None = None,
-) -> tuple[dict, ActionMapping | None]:
-    """Every method on one task, plus the controls, summarised: the ``results`` block of
-    the JSON that ``armtransfer rooms`` and ``armtransfer arms`` write. Returns it and,
-    for ``mapping``, the mapping updated from this task's converged trials."""
-    for m in methods:
-        if m not in METHODS:
-            raise InvalidParameterError(f"unknown method {m!r}; valid methods: {', '.join(METHODS)}")
-    if any(m != "none" for m in methods) and not trajs:
+) -> tuple[list[MethodResult], ActionMapping | None]:
+    """Every method on one task, then (``controls``) every reward-only method again with each
+    control trajectory. Returns the results in that order and, for ``mapping``, the mapping
+    updated from this task's converged trials."""
+    chosen = [methods.get(m) for m in method_names]
+    if any(m.shaped for m in chosen) and not trajs:
         raise InvalidParameterError("the transfer methods need a trajectory")
-    if "mapping" in methods and len(trajs) != 1:
+    if any(m.macros for m in chosen) and len(trajs) != 1:
         raise InvalidParameterError("method 'mapping' takes exactly one trajectory")
     results: list[MethodResult] = []
     learned = None
     kw = dict(wind=wind, K=K, on_trial=tick)
-    for method in methods:
-        if method == "mapping":
+    for m in chosen:
+        if m.macros:
             if mapping is None:
                 mapping = ActionMapping.for_robots(source, target)
             res, learned = run_mapping(target, start_cell, goal_cell, trajs[0], mapping, trials, seed,
                                        config, max_span=max_span, **kw)
             results.append(res)
         else:
-            results.append(run_method(method, target, start_cell, goal_cell, trajs if method != "none" else None,
+            results.append(run_method(m.name, target, start_cell, goal_cell, trajs if m.shaped else None,
                                       trials, seed, config, beta=beta, **kw))
     if controls:
-        for kind in ("shuffled", "random"):
+        for kind in CONTROLS:
             fake = control_trajectories(kind, source, trajs, seed)
-            for method in methods:
-                if method in SHAPING_METHODS:
-                    results.append(run_method(method, target, start_cell, goal_cell, fake, trials, seed, config,
-                                              beta=beta, label=f"{method} [{kind}]", **kw))
-    summary = summarize(results, baseline="none" if "none" in methods else "")
+            for m in chosen:
+                if m.name in SHAPING_METHODS:
+                    results.append(run_method(m.name, target, start_cell, goal_cell, fake, trials, seed, config,
+                                              beta=beta, control=kind, **kw))
+    return results, learned
+
+
+def summary_of(results: Sequence[MethodResult], target: DiscreteRobot, start_cell: int, goal_cell: int) -> dict:
+    """The ``summarize`` block of ``results`` (keyed by label), with the transfer metrics."""
+    labels = [r.label for r in results]
+    summary = summarize(results, baseline="none" if "none" in labels else "")
     path = target.shortest_path(target.start_state(start_cell), goal_cell)
     if path is not None:
         add_transfer_metrics(summary, len(path) - 1)
-    return summary, learned
+    return summary
 
 
-def count_trials(methods: Sequence[str], trials: int, controls: bool) -> int:
+def run_transfer(
+    source: DiscreteRobot,
+    target: DiscreteRobot,
+    start_cell: int,
+    goal_cell: int,
+    method_names: Sequence[str],
+    trajs: Sequence[Trajectory],
+    trials: int,
+    seed: int,
+    config: LearnerConfig,
+    **kwargs,
+) -> tuple[dict, ActionMapping | None]:
+    """:func:`run_all`, summarised by label (``dense``, ``dense [shuffled]``, ...), for reports
+    that tabulate every run side by side. Returns the summary and the updated mapping."""
+    results, learned = run_all(source, target, start_cell, goal_cell, method_names, trajs, trials, seed,
+                               config, **kwargs)
+    return summary_of(results, target, start_cell, goal_cell), learned
+
+
+def count_trials(method_names: Sequence[str], trials: int, controls: bool) -> int:
     """How many trials ``run_transfer`` runs (for progress bars)."""
-    shaped = sum(m in SHAPING_METHODS for m in methods)
-    return trials * (len(methods) + (2 * shaped if controls else 0))
+    shaped = sum(m in SHAPING_METHODS for m in method_names)
+    return trials * (len(method_names) + (len(CONTROLS) * shaped if controls else 0))

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
+from dataclasses import fields
 
-from armtransfer.tasks.catalog import Task, custom_task, parse_xy, table_task
 from armtransfer.errors import ArmModelError, InvalidParameterError, InvalidTaskError
 from armtransfer.learning.config import LearnerConfig
+from armtransfer.tasks.catalog import parse_xy
 
 
 def positive_int(text: str) -> int:
@@ -42,20 +44,32 @@ def k_value(text: str) -> float | str:
     return value
 
 
+def non_negative_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 0, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 0, got {text!r}")
+    return value
+
+
 def add_method_arguments(p: argparse.ArgumentParser, default: list[str] | None = None) -> None:
+    from armtransfer.api import TRAJECTORY_KINDS
     from armtransfer.learning import mapping as mappings
-    from armtransfer.learning import potentials
-    from armtransfer.learning.experiment import METHODS
+    from armtransfer.learning import methods, potentials
 
     default = default or ["none", "pseudo"]
+    listing = "; ".join(f"{m.name}: {m.description}" for m in methods.METHODS.values())
     p.add_argument("--method", nargs="+", default=default, metavar="METHOD",
-                   help=f"one or more of: {', '.join(METHODS)} (default: {' '.join(default)})")
+                   help=f"one or more methods (default: {' '.join(default)}). {listing}")
     p.add_argument("--trajectory", action="append", default=None, metavar="KIND|PATH",
-                   help="the transferred trajectory: optimal (the source's shortest path; default), "
-                        "learned (its greedy path after learning), shuffled or random (controls), or a "
-                        "JSON file; give it more than once to transfer several trajectories")
+                   help=f"the transferred trajectory: one of {', '.join(TRAJECTORY_KINDS)} (learned: the "
+                        "source's converged greedy path, the paper's protocol and the default; optimal: its "
+                        "shortest path; shuffled, random: controls), or a JSON file; give it more than once "
+                        "to transfer several trajectories")
     p.add_argument("--no-controls", action="store_true",
-                   help="skip the control runs (each transfer method again with a shuffled and a "
+                   help="skip the control runs (each reward-only method again with a shuffled and a "
                         "random trajectory)")
     p.add_argument("--beta", type=float, default=potentials.DENSE_BETA,
                    help=f"method dense: indices lost per cell from the trajectory (default {potentials.DENSE_BETA})")
@@ -67,90 +81,71 @@ def add_method_arguments(p: argparse.ArgumentParser, default: list[str] | None =
                         f"(default {mappings.DEFAULT_MAX_SPAN})")
 
 
-TRAJECTORY_KINDS = ("optimal", "learned", "shuffled", "random")
-
-
-def trajectory_specs(args: argparse.Namespace) -> list[str]:
-    return args.trajectory or ["optimal"]
-
-
-def task_for(args: argparse.Namespace) -> Task:
-    """The task from --task/--start/--goal; a trajectory file alone also names its task."""
-    from armtransfer.tasks.layout import ROOMS
-    from armtransfer.learning import trajectory as trajectories
-
-    files = [s for s in trajectory_specs(args) if s not in TRAJECTORY_KINDS]
-    if args.task is None and args.start is None and args.goal is None and files:
-        traj = trajectories.load(files[0])
-        return Task("trajectory file", ROOMS.xy(traj.start), ROOMS.xy(traj.goal))
-    return task_from_args(args)
-
-
-def resolve_trajectories(specs: list[str] | None, source, task: Task, config, seed: int) -> list:
-    """Each --trajectory: a kind made from the source robot, or a JSON file for this task."""
-    from armtransfer.learning import experiment
-    from armtransfer.learning import trajectory as trajectories
-
-    start, goal = task.cells()
-    out = []
-    for spec in specs or ["optimal"]:
-        if spec in ("optimal", "learned"):
-            out.append(experiment.source_trajectory(spec, source, start, goal, config, seed))
-        elif spec in ("shuffled", "random"):
-            real = experiment.source_trajectory("optimal", source, start, goal, config, seed)
-            out.extend(experiment.control_trajectories(spec, source, [real], seed))
-        else:
-            traj = trajectories.load(spec)
-            trajectories.check_task(traj, start, goal)
-            out.append(traj)
-    return out
-
-
 def add_task_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--task", type=int, default=None, help="Table I task 1-4 (default 1)")
     p.add_argument("--start", default=None, metavar="X,Y", help="start cell (with --goal)")
     p.add_argument("--goal", default=None, metavar="X,Y", help="goal cell (with --start)")
 
 
-def task_from_args(args: argparse.Namespace) -> Task:
-    if args.start is not None or args.goal is not None:
-        if args.task is not None:
-            raise InvalidTaskError("give either --task or --start/--goal, not both")
-        if args.start is None or args.goal is None:
-            raise InvalidTaskError("--start and --goal go together")
-        return custom_task(parse_xy(args.start, "--start"), parse_xy(args.goal, "--goal"))
-    return table_task(1 if args.task is None else args.task)
-
-
 def add_learning_arguments(p: argparse.ArgumentParser, trials: int = 10) -> None:
-    d = LearnerConfig()
+    """--trials, --seed, --wind, --K and one flag per settable LearnerConfig field."""
     p.add_argument("--trials", type=positive_int, default=trials, help=f"trials per method (default {trials})")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=non_negative_int, default=0, help="random seed, an integer >= 0 (default 0)")
     p.add_argument("--wind", type=probability, default=0.0, help="wind probability (paper: 0.01; default 0)")
     p.add_argument("--K", type=k_value, default="auto",
-                   help="pseudo reward scale; 'auto' = half the farming bound -step_reward/n (default)")
-    p.add_argument("--alpha", type=float, default=d.alpha, help=f"learning rate (default {d.alpha})")
-    p.add_argument("--gamma", type=float, default=d.gamma, help=f"discount (default {d.gamma})")
-    p.add_argument("--lam", type=float, default=d.lam, help=f"trace decay lambda (default {d.lam})")
-    p.add_argument("--epsilon", type=float, default=d.epsilon, help=f"exploration rate (default {d.epsilon})")
-    p.add_argument("--step-reward", type=float, default=d.step_reward, help=f"reward per step (default {d.step_reward})")
-    p.add_argument("--goal-reward", type=float, default=d.goal_reward, help=f"reward at the goal (default {d.goal_reward})")
-    p.add_argument("--max-episodes", type=positive_int, default=d.max_episodes,
-                   help=f"episodes per trial at most (default {d.max_episodes})")
-    p.add_argument("--patience", type=positive_int, default=d.patience,
-                   help=f"episodes the greedy path must stay the same to count as converged (default {d.patience})")
+                   help="pseudo reward scale; 'auto' = the method's default (pseudo: half the farming "
+                        "bound -step_reward/n)")
+    add_config_arguments(p)
+
+
+def add_config_arguments(p: argparse.ArgumentParser) -> None:
+    """One flag per LearnerConfig field, made from the field (name, type, default, help)."""
+    for f in fields(LearnerConfig):
+        if not f.metadata.get("cli"):
+            continue
+        integer = f.type in (int, "int")
+        p.add_argument(f"--{f.name.replace('_', '-')}", dest=f.name, default=f.default,
+                       type=positive_int if integer else finite_float,
+                       help=f"{f.metadata['help']} (default {f.default:,})" if integer
+                       else f"{f.metadata['help']} (default {f.default:g})")
+
+
+def finite_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a finite number, got {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"must be a finite number, got {text!r}")
+    return value
+
+
+def config_options(args: argparse.Namespace) -> dict:
+    """The LearnerConfig fields the command line set, as API keyword options."""
+    return {f.name: getattr(args, f.name) for f in fields(LearnerConfig) if f.metadata.get("cli")}
 
 
 def config_from_args(args: argparse.Namespace) -> LearnerConfig:
-    return LearnerConfig(
-        alpha=args.alpha,
-        gamma=args.gamma,
-        lam=args.lam,
-        epsilon=args.epsilon,
-        step_reward=args.step_reward,
-        goal_reward=args.goal_reward,
-        max_episodes=args.max_episodes,
-        patience=args.patience,
+    return LearnerConfig.from_options(config_options(args))
+
+
+def transfer_kwargs(args: argparse.Namespace) -> dict:
+    """The keyword arguments of ``armtransfer.transfer`` that the common flags give (the task's
+    flags are checked here, so that errors name them)."""
+    start, goal = args.start, args.goal
+    if start is not None or goal is not None:
+        if args.task is not None:
+            raise InvalidTaskError("give either --task or --start/--goal, not both")
+        if start is None or goal is None:
+            raise InvalidTaskError("--start and --goal go together")
+        start, goal = parse_xy(start, "--start"), parse_xy(goal, "--goal")
+    if args.mapping is not None and "mapping" not in args.method:
+        raise InvalidParameterError("--mapping goes with --method mapping")
+    return dict(
+        task=args.task, start=start, goal=goal, methods=args.method, trials=args.trials, seed=args.seed,
+        wind=args.wind, K=args.K, beta=args.beta, trajectory=args.trajectory, controls=not args.no_controls,
+        mapping=args.mapping, save_mapping=args.mapping is not None, max_span=args.max_span,
+        **config_options(args),
     )
 
 
@@ -183,11 +178,6 @@ def progress_bar(total: int, desc: str):
 
     return tqdm(total=total, desc=desc, disable=not sys.stderr.isatty(), leave=False)
 
-
-def check_methods(methods: list[str], valid: tuple[str, ...]) -> None:
-    for m in methods:
-        if m not in valid:
-            raise InvalidParameterError(f"unknown method {m!r}; valid methods: {', '.join(valid)}")
 
 
 def parse_base_pos(text: str | None):

@@ -3,17 +3,13 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
+from armtransfer import api
 from armtransfer.commands import common
-from armtransfer.robots import resolve
-from armtransfer.errors import InvalidParameterError
-from armtransfer.learning import experiment, report
-from armtransfer.learning import mapping as mappings
 from armtransfer.io import check_writable, write_json_atomic
+from armtransfer.learning import experiment, report
 
 HELP = "Transfer a trajectory from one grid robot to another in the rooms world (Table II style)."
-METHODS = experiment.METHODS
 
 
 def add_arguments(p: argparse.ArgumentParser, source: str = "coarse", target: str = "fine") -> None:
@@ -25,63 +21,25 @@ def add_arguments(p: argparse.ArgumentParser, source: str = "coarse", target: st
     p.add_argument("--json", default=None, metavar="PATH", help="write the results as JSON here")
 
 
-def run_experiment(args: argparse.Namespace, source=None, target=None) -> tuple[dict, object]:
-    """The experiment the arguments describe: the JSON dict, and the updated mapping (or None)."""
-    common.check_methods(args.method, METHODS)
-    config = common.config_from_args(args)
-    task = common.task_for(args)
-    start, goal = task.cells()
-    source = source or resolve(args.source)
-    target = target or resolve(args.target)
-    source.start_state(start)
-    source.start_state(goal, what="goal")
-    target.start_state(start)
-    target.start_state(goal, what="goal")
-    target_path = target.shortest_path(target.start_state(start), goal)
-    if target_path is None:
-        raise InvalidParameterError(f"robot {target.name} cannot reach the goal {task.goal} from {task.start}")
-    if args.mapping is not None and "mapping" not in args.method:
-        raise InvalidParameterError("--mapping goes with --method mapping")
-    mapping = None
-    if "mapping" in args.method and args.mapping is not None:
-        check_writable(args.mapping)
-        mapping = mappings.load_for(args.mapping, source, target)
-    trajs = []
-    if any(m != "none" for m in args.method):
-        trajs = common.resolve_trajectories(args.trajectory, source, task, config, args.seed)
-    controls = not args.no_controls
-    entries_before = None if mapping is None else len(mapping)
-    with common.progress_bar(experiment.count_trials(args.method, args.trials, controls), task.name) as bar:
-        results, learned = experiment.run_transfer(
-            source, target, start, goal, args.method, trajs, args.trials, args.seed, config,
-            wind=args.wind, K=args.K, beta=args.beta, mapping=mapping, max_span=args.max_span,
-            controls=controls, tick=bar.update,
-        )
-    mapping_info = None
-    if "mapping" in args.method:
-        mapping_info = {
-            "path": args.mapping,
-            "entries_before": entries_before or 0,
-            "entries_after": len(learned),
-            "macro_states": results["mapping"]["macro_states"],
-            "saved": args.mapping is not None,
-        }
-    out = {
-        "task": {"name": task.name, "start": list(task.start), "goal": list(task.goal)},
-        "distance": len(target_path) - 1,
-        "source": source.name,
-        "target": target.name,
-        "trajectory": None if not trajs else trajs[0].to_json(),
-        "trajectories": [t.to_json() for t in trajs],
-        "trajectory_length": None if not trajs else len(trajs[0]),
-        "seed": args.seed,
-        "trials": args.trials,
-        "wind": args.wind,
-        "config": config.to_dict(),
-        "mapping": mapping_info,
-        "results": results,
-    }
-    return out, learned
+def run(args: argparse.Namespace) -> int:
+    if args.json:
+        check_writable(args.json)
+    total = experiment.count_trials(args.method, args.trials, not args.no_controls)
+    with common.progress_bar(total, "learning") as bar:
+        result = api.transfer(args.source, args.target, progress=bar.update, **common.transfer_kwargs(args))
+    out = result.to_json()
+    print_results(out)
+    if args.json:
+        write_json_atomic(args.json, out)
+    return 0
+
+
+def results_table(out: dict) -> str:
+    """The methods, then their control runs, as one Table II-style table."""
+    rows = dict(out["results"])
+    for kind, by in out.get("controls", {}).items():
+        rows.update({f"{m} [{kind}]": entry for m, entry in by.items()})
+    return report.method_table(rows)
 
 
 def print_results(out: dict) -> None:
@@ -91,8 +49,8 @@ def print_results(out: dict) -> None:
         f"target's optimal distance {out['distance']}, {out['trials']} trials, seed {out['seed']}"
         + (f", wind {out['wind']}" if out["wind"] else "")
     )
-    print(report.method_table(out["results"]))
-    if any("[" in m for m in out["results"]):
+    print(results_table(out))
+    if out.get("controls"):
         print("[shuffled] and [random] are controls: the same method given the trajectory's cells in a "
               "random order, or a random walk of the source robot of the same length.")
     info = out["mapping"]
@@ -112,15 +70,3 @@ def print_results(out: dict) -> None:
             print(f"mapping: {info['entries_after']} entries after this run, saved to {info['path']}")
         else:
             print(f"mapping: {info['entries_after']} entries learned, not saved (give --mapping PATH to keep them)")
-
-
-def run(args: argparse.Namespace) -> int:
-    if args.json:
-        check_writable(args.json)
-    out, learned = run_experiment(args)
-    print_results(out)
-    if out["mapping"] is not None and out["mapping"]["saved"]:
-        learned.save(args.mapping)
-    if args.json:
-        write_json_atomic(Path(args.json), out)
-    return 0

@@ -8,7 +8,7 @@ import os
 from armtransfer.commands import common
 from armtransfer.execute import robot_specs
 from armtransfer.executors import _import_ray, run_local, run_ray
-from armtransfer.robots import resolve
+from armtransfer.tasks.specs import resolve
 from armtransfer.learning import sweep as sweeps
 from armtransfer.learning.store import ResultStore
 

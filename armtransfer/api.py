@@ -1,0 +1,217 @@
+"""The Python API: one call runs what ``armtransfer rooms`` and ``armtransfer arms`` run.
+
+    import armtransfer
+    r = armtransfer.transfer(source="coarse", target="fine", task=1,
+                             methods=["none", "pseudo"], trials=3, seed=1)
+    r.methods["pseudo"].column("exploration_steps")   # per trial
+    r.to_json()                                        # what `rooms --json` writes
+
+Robots are specs (``"coarse"``, ``"planar2:joint"``, ``"custom:cartesian"`` with ``arm_xml=``)
+or ``DiscreteRobot`` objects. Every bad input raises an ``armtransfer.errors.ArmTransferError``
+with a one-line message before any learning starts.
+"""
+
+from __future__ import annotations
+
+import numbers
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from armtransfer.errors import InvalidParameterError, InvalidTaskError
+from armtransfer.learning import experiment, potentials
+from armtransfer.learning import methods as registry
+from armtransfer.learning import trajectory as trajectories
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.mapping import DEFAULT_MAX_SPAN, ActionMapping
+from armtransfer.learning.mapping import load_for as load_mapping
+from armtransfer.learning.results import MappingInfo, TransferResult
+from armtransfer.learning.trajectory import Trajectory
+from armtransfer.tasks.catalog import Task, custom_task, parse_xy, table_task
+from armtransfer.tasks.layout import ROOMS
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.tasks.specs import resolve
+
+TRAJECTORY_KINDS = ("optimal", "learned", "shuffled", "random")
+"""``learned``: the source's converged greedy path after SARSA(lambda), the paper's protocol
+(the default); ``optimal``: its shortest path; ``shuffled``/``random``: control trajectories."""
+
+TrajectorySpec = str | Trajectory
+
+
+def transfer(
+    source: str | DiscreteRobot = "coarse",
+    target: str | DiscreteRobot = "fine",
+    *,
+    task: int | None = None,
+    start: tuple[int, int] | str | None = None,
+    goal: tuple[int, int] | str | None = None,
+    methods: Sequence[str] = ("none", "pseudo"),
+    trials: int = 10,
+    seed: int = 0,
+    wind: float = 0.0,
+    K: float | str = "auto",
+    beta: float | None = None,
+    trajectory: TrajectorySpec | Sequence[TrajectorySpec] | None = None,
+    controls: bool = True,
+    mapping: str | Path | ActionMapping | None = None,
+    save_mapping: bool = False,
+    max_span: int = DEFAULT_MAX_SPAN,
+    arm_xml: str | Path | None = None,
+    arm_options: dict | None = None,
+    progress: Callable[[], None] | None = None,
+    **learner_options,
+) -> TransferResult:
+    """Transfer a trajectory from ``source`` to ``target`` and learn with each method.
+
+    ``task`` is a Table I task (1-4) or give ``start`` and ``goal`` cells; with neither, a
+    trajectory file names its task, else task 1. ``trajectory`` is one or several of
+    :data:`TRAJECTORY_KINDS`, trajectory JSON files or :class:`Trajectory` objects (default
+    ``learned``). ``controls`` also runs every reward-only method with a shuffled and a
+    random trajectory. ``mapping`` (for method ``mapping``) is a mapping or its JSON file;
+    with ``save_mapping`` the file is updated from this run's converged trials.
+    ``learner_options`` are :class:`LearnerConfig` fields (``alpha``, ``epsilon``, ...).
+    ``progress`` is called after every trial.
+    """
+    config = LearnerConfig.from_options(learner_options)
+    method_names = [registry.get(m).name for m in _as_sequence(methods, "methods")]
+    if not method_names:
+        raise InvalidParameterError(f"give at least one method; valid methods: {', '.join(registry.METHODS)}")
+    trials = _whole(trials, "trials", 1)
+    seed = _whole(seed, "seed", 0)
+    wind = _probability(wind, "wind")
+    max_span = _whole(max_span, "max_span", 1)
+    specs = list(_as_sequence(trajectory, "trajectory")) if trajectory is not None else ["learned"]
+    uses_mapping = any(registry.get(m).macros for m in method_names)
+    if mapping is not None and not uses_mapping:
+        raise InvalidParameterError("a mapping goes with method 'mapping'")
+    if save_mapping and not isinstance(mapping, (str, Path)):
+        raise InvalidParameterError("save_mapping needs the mapping's file path")
+
+    the_task = _task(task, start, goal, specs)
+    start_cell, goal_cell = the_task.cells()
+    options = dict(arm_options or {})
+    src = resolve(source, xml_path=arm_xml, **options)
+    tgt = resolve(target, xml_path=arm_xml, **options)
+    for robot in (src, tgt):
+        robot.start_state(start_cell)
+        robot.start_state(goal_cell, what="goal")
+    path = tgt.shortest_path(tgt.start_state(start_cell), goal_cell)
+    if path is None:
+        raise InvalidTaskError(f"robot {tgt.name} cannot reach the goal {the_task.goal} from {the_task.start}")
+
+    mapping_obj, mapping_path = None, None
+    if uses_mapping:
+        if isinstance(mapping, ActionMapping):
+            mapping_obj = mapping
+        elif mapping is not None:
+            mapping_path = str(mapping)
+            if save_mapping:
+                from armtransfer.io import check_writable
+
+                check_writable(mapping_path)
+            mapping_obj = load_mapping(mapping_path, src, tgt)
+    shaped = any(registry.get(m).shaped for m in method_names)
+    trajs = resolve_trajectories(specs, src, the_task, config, seed) if shaped else []
+    for m in method_names:  # a farmable K is refused before any learning
+        if registry.get(m).shaped:
+            registry.build_shaping(m, tgt, trajs, K, config.step_reward, beta=beta)
+
+    entries_before = 0 if mapping_obj is None else len(mapping_obj)
+    runs, learned = experiment.run_all(
+        src, tgt, start_cell, goal_cell, method_names, trajs, trials, seed, config,
+        wind=wind, K=K, beta=potentials.DENSE_BETA if beta is None else beta,
+        mapping=mapping_obj, max_span=max_span, controls=controls, tick=progress,
+    )
+    by_method = {r.method: r for r in runs if r.control is None}
+    by_control: dict[str, dict] = {}
+    for r in runs:
+        if r.control is not None:
+            by_control.setdefault(r.control, {})[r.method] = r
+    info = None
+    if uses_mapping:
+        info = MappingInfo(path=mapping_path, entries_before=entries_before, entries_after=len(learned),
+                           macro_states=int(by_method["mapping"].extra["macro_states"]),
+                           saved=bool(save_mapping))
+        if save_mapping:
+            learned.save(mapping_path)
+    return TransferResult(
+        task=the_task, source=src, target=tgt, distance=len(path) - 1, trajectories=trajs, seed=seed,
+        trials=trials, wind=wind, config=config, methods=by_method, controls=by_control,
+        mapping=info, learned_mapping=learned,
+    )
+
+
+def resolve_trajectories(specs: Sequence[TrajectorySpec], source: DiscreteRobot, task: Task,
+                         config: LearnerConfig, seed: int) -> list[Trajectory]:
+    """Each spec: a :data:`TRAJECTORY_KINDS` kind made from the source robot, a trajectory JSON
+    file for this task, or a :class:`Trajectory`."""
+    start, goal = task.cells()
+    out: list[Trajectory] = []
+    for spec in specs:
+        if isinstance(spec, Trajectory):
+            trajectories.check_task(spec, start, goal)
+            out.append(spec)
+        elif spec in ("optimal", "learned"):
+            out.append(experiment.source_trajectory(spec, source, start, goal, config, seed))
+        elif spec in ("shuffled", "random"):
+            real = experiment.source_trajectory("optimal", source, start, goal, config, seed)
+            out.extend(experiment.control_trajectories(spec, source, [real], seed))
+        elif isinstance(spec, (str, Path)):
+            traj = trajectories.load(spec)
+            trajectories.check_task(traj, start, goal)
+            out.append(traj)
+        else:
+            raise InvalidParameterError(
+                f"a trajectory is one of {', '.join(TRAJECTORY_KINDS)}, a JSON file or a Trajectory, got {spec!r}")
+    return out
+
+
+def _task(task, start, goal, specs) -> Task:
+    if start is not None or goal is not None:
+        if task is not None:
+            raise InvalidTaskError("give either a task or start/goal cells, not both")
+        if start is None or goal is None:
+            raise InvalidTaskError("start and goal go together")
+        return custom_task(_xy(start, "start"), _xy(goal, "goal"))
+    if task is None:
+        files = [s for s in specs if isinstance(s, (str, Path)) and s not in TRAJECTORY_KINDS]
+        if files:
+            traj = trajectories.load(files[0])
+            return Task("trajectory file", ROOMS.xy(traj.start), ROOMS.xy(traj.goal))
+        task = 1
+    if isinstance(task, bool) or not isinstance(task, numbers.Integral):
+        raise InvalidTaskError(f"a task is a Table I task number, got {task!r}")
+    return table_task(int(task))
+
+
+def _xy(value, what: str) -> tuple[int, int]:
+    if isinstance(value, str):
+        return parse_xy(value, what)
+    try:
+        x, y = value
+    except (TypeError, ValueError):
+        raise InvalidTaskError(f"{what} must be a cell (x, y), got {value!r}") from None
+    if any(isinstance(v, bool) or not isinstance(v, numbers.Integral) for v in (x, y)):
+        raise InvalidTaskError(f"{what} must be a cell of two integers (x, y), got {value!r}")
+    return int(x), int(y)
+
+
+def _as_sequence(value, what: str) -> Sequence:
+    if isinstance(value, (str, Path, Trajectory)):
+        return [value]
+    try:
+        return list(value)
+    except TypeError:
+        raise InvalidParameterError(f"{what} must be a name or a list of them, got {value!r}") from None
+
+
+def _whole(value, what: str, lo: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < lo:
+        raise InvalidParameterError(f"{what} must be an integer >= {lo}, got {value!r}")
+    return int(value)
+
+
+def _probability(value, what: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0.0 <= float(value) <= 1.0:
+        raise InvalidParameterError(f"{what} must be a probability in [0, 1], got {value!r}")
+    return float(value)

@@ -1,0 +1,45 @@
+"""Robot specs as users type them: grid robots by name, arms as ``ARM[:ACTIONS]``, and
+``custom[:ACTIONS]`` for a bring-your-own arm file."""
+
+from __future__ import annotations
+
+from armtransfer.errors import UnknownArmError, UnknownRobotError
+from armtransfer.tasks.grid_robots import GRID_ROBOTS, grid_robot
+from armtransfer.tasks.robot import DiscreteRobot
+
+CUSTOM = "custom"
+"""The spec of a bring-your-own arm: ``custom`` or ``custom:ACTIONS`` with its file given."""
+
+
+def resolve(spec: str | DiscreteRobot, *, xml_path=None, progress: bool = False, **arm_options) -> DiscreteRobot:
+    """A robot from its spec: ``fine``/``coarse`` (grid robots), ``planar2:joint`` (a built-in
+    arm and action model; the arm's first model when omitted), or ``custom[:ACTIONS]`` (the
+    arm in ``xml_path``, with ``arm_options`` such as ``tip_site`` and ``base_pos``). A robot
+    passes through unchanged."""
+    if isinstance(spec, DiscreteRobot):
+        return spec
+    if not isinstance(spec, str):
+        raise UnknownRobotError(f"a robot is a spec string or a DiscreteRobot, got {type(spec).__name__}")
+    if spec in GRID_ROBOTS:
+        return grid_robot(spec)
+    from armtransfer.models import ARMS
+
+    name, _, actions = spec.partition(":")
+    if name == CUSTOM:
+        if xml_path is None:
+            raise UnknownRobotError(f"robot '{CUSTOM}' needs --arm-xml PATH (arm_xml= in the API)")
+        from armtransfer.tasks.arms import arm_robot
+
+        return arm_robot(None, actions or "cartesian", xml_path=xml_path, progress=progress, **arm_options)
+    if name in ARMS:
+        from armtransfer.tasks.arms import arm_robot, parse_robot_spec
+
+        arm, actions = parse_robot_spec(spec)
+        sized = {"cell_size": arm_options["cell_size"]} if arm_options.get("cell_size") is not None else {}
+        return arm_robot(arm, actions, progress=progress, **sized)
+    if actions:
+        raise UnknownArmError(f"unknown arm {name!r}; valid arms: {', '.join(ARMS)}, or {CUSTOM} with --arm-xml")
+    raise UnknownRobotError(
+        f"unknown robot {spec!r}; valid: {', '.join(sorted(GRID_ROBOTS))}, ARM[:ACTIONS] with ARM one of "
+        f"{', '.join(ARMS)} (see `armtransfer arms list`), or {CUSTOM}[:ACTIONS] with --arm-xml"
+    )
