@@ -28,7 +28,7 @@ from armtransfer.tasks.layout import ROOMS
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.learning import experiment, figures
 from armtransfer.tasks.specs import CUSTOM, resolve
-from armtransfer.io import OutputError, check_writable, write_json_atomic, write_text_atomic
+from armtransfer.io import OutputError, check_writable, copy_atomic, write_json_atomic, write_text_atomic
 
 DEFAULT_SOURCE = "planar2:joint"
 DEFAULT_TARGET = "ur5e_like:cartesian"
@@ -107,8 +107,7 @@ def run(args: argparse.Namespace) -> int:
             tmp_video = tmp / result["video"]
             target = Path(args.render)
             if target.suffix.lower() == tmp_video.suffix.lower():
-                shutil.copyfile(tmp_video, target.with_name(f".{target.name}.tmp"))
-                os.replace(target.with_name(f".{target.name}.tmp"), target)
+                copy_atomic(tmp_video, target)
             else:
                 _video(result, args, target)
         _commit_out(tmp, out)

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from armtransfer.errors import ArmTransferError, OutputError
@@ -24,27 +27,41 @@ def write_text_atomic(path: str | os.PathLike, text: str) -> None:
     write_bytes_atomic(path, text.encode())
 
 
-def write_bytes_atomic(path: str | os.PathLike, data: bytes) -> None:
-    """Write ``data`` to a temporary file beside ``path``, then rename it into place."""
+@contextmanager
+def atomic_path(path: str | os.PathLike, suffix: str = ".tmp") -> Iterator[Path]:
+    """A temporary path beside ``path`` to write to; on leaving the block without an error it
+    is renamed onto ``path`` (readable as a normal new file), otherwise deleted. Every file
+    this project writes goes through here, so nothing half-written is ever taken for a result.
+    ``suffix`` keeps a file type that a writer infers from the name (``.tmp.mp4``)."""
     p = Path(path)
     try:
         p.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent)
+        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=suffix, dir=p.parent)
+        os.close(fd)
     except OSError as err:
         raise OutputError(f"cannot write {str(p)!r}: {err.strerror}") from None
     try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
+        yield Path(tmp)
         os.chmod(tmp, 0o666 & ~_UMASK)
         os.replace(tmp, p)
     except OSError as err:
+        raise OutputError(f"cannot write {str(p)!r}: {err.strerror or err}") from None
+    finally:
         Path(tmp).unlink(missing_ok=True)
-        raise OutputError(f"cannot write {str(p)!r}: {err.strerror}") from None
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+
+
+def write_bytes_atomic(path: str | os.PathLike, data: bytes) -> None:
+    """Write ``data`` to a temporary file beside ``path``, then rename it into place."""
+    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+        fh.write(data)
+        fh.flush()
+        os.fsync(fh.fileno())
+
+
+def copy_atomic(src: str | os.PathLike, path: str | os.PathLike) -> None:
+    """Copy ``src`` to ``path`` through a temporary file beside it."""
+    with atomic_path(path) as tmp:
+        shutil.copyfile(src, tmp)
 
 
 def write_json_atomic(path: str | os.PathLike, data: object) -> None:

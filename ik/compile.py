@@ -167,8 +167,7 @@ def _nearest_free_cell(xy, cell, layout) -> int:
 
 def _cells_by_distance(xy, cell, layout) -> np.ndarray:
     ids = np.flatnonzero(layout.free)
-    ys, xs = np.divmod(ids, layout.width)
-    centres = np.stack([xs + layout.lo, ys + layout.lo], axis=1) * cell
+    centres = layout.xy_of(ids) * cell
     return ids[np.argsort(np.linalg.norm(centres - np.asarray(xy)[:2], axis=1), kind="stable")]
 
 
@@ -334,8 +333,7 @@ def compile_joint(scene: ArmScene, step: float, progress: bool = False) -> dict:
 
     # Wind: the state labelled with the cell to the right nearest a Jacobian step.
     wind = np.arange(n, dtype=np.int64)
-    lx = (label % layout.width) + layout.lo
-    ly = (label // layout.width) + layout.lo
+    lx, ly = layout.xy_of(label).T
     right = np.where(lx + 1 <= layout.hi, label + 1, -1)
     has_right = (right >= 0) & free[np.maximum(right, 0)]
     target = np.stack([(lx + 1) * cell, ly * cell], axis=1)

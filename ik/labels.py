@@ -21,18 +21,12 @@ OFF_TABLE = -1
 
 def cell_of_xy(x: float, y: float, cell: float, layout: Layout) -> int:
     """The shared cell id under the point (x, y) (metres), or -1 off the grid."""
-    cx, cy = int(round(x / cell)), int(round(y / cell))
-    if not layout.in_grid(cx, cy):
-        return OFF_TABLE
-    return layout.cell(cx, cy)
+    return int(cells_of_xy(np.array([x, y]), cell, layout))
 
 
 def cells_of_xy(xy: np.ndarray, cell: float, layout: Layout) -> np.ndarray:
     """Vectorised ``cell_of_xy`` over points [..., 2]; -1 off the grid."""
-    c = np.rint(np.asarray(xy)[..., :2] / cell).astype(np.int64)
-    inside = np.all((c >= layout.lo) & (c <= layout.hi), axis=-1)
-    ids = (c[..., 1] - layout.lo) * layout.width + (c[..., 0] - layout.lo)
-    return np.where(inside, ids, OFF_TABLE)
+    return layout.ids_of(np.rint(np.asarray(xy)[..., :2] / cell))
 
 
 def cell_centre(cell_id: int, cell: float, layout: Layout) -> np.ndarray:

@@ -39,7 +39,7 @@ def wall_runs(layout: Layout) -> list[tuple[tuple[int, int], tuple[int, int]]]:
             inside = i < n
             if inside:
                 x, y = x0 + dx * i, y0 + dy * i
-                inside = bool(layout.wall_mask[y - layout.lo, x - layout.lo])
+                inside = layout.is_wall(x, y)
             if inside and start is None:
                 start = (x0 + dx * i, y0 + dy * i)
             elif not inside and start is not None:

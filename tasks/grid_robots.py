@@ -22,7 +22,7 @@ GRID_ROBOTS = {"fine": (1, ("F", "B", "R", "L")), "coarse": (2, ("1", "2", "3", 
 def _blocked_move(layout: Layout, x: int, y: int, dx: int, dy: int, k: int) -> tuple[int, int]:
     for step in range(1, k + 1):
         nx, ny = x + dx * step, y + dy * step
-        if not layout.in_grid(nx, ny) or layout.wall_mask[ny - layout.lo, nx - layout.lo]:
+        if not layout.in_grid(nx, ny) or layout.is_wall(nx, ny):
             return x, y
     return x + dx * k, y + dy * k
 

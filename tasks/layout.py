@@ -76,6 +76,22 @@ class Layout:
     def in_grid(self, x: int, y: int) -> bool:
         return self.lo <= x <= self.hi and self.lo <= y <= self.hi
 
+    def is_wall(self, x: int, y: int) -> bool:
+        """True for a wall cell; (x, y) must be on the grid."""
+        return bool(self.wall_mask[y - self.lo, x - self.lo])
+
+    def ids_of(self, xy: np.ndarray) -> np.ndarray:
+        """Vectorised :meth:`cell` over integer cells [..., 2]: the cell ids, -1 off the grid."""
+        c = np.asarray(xy, dtype=np.int64)
+        inside = np.all((c >= self.lo) & (c <= self.hi), axis=-1)
+        ids = (c[..., 1] - self.lo) * self.width + (c[..., 0] - self.lo)
+        return np.where(inside, ids, -1)
+
+    def xy_of(self, ids: np.ndarray) -> np.ndarray:
+        """Vectorised :meth:`xy` over cell ids: int64 [..., 2] of (x, y)."""
+        y, x = np.divmod(np.asarray(ids, dtype=np.int64), self.width)
+        return np.stack([x + self.lo, y + self.lo], axis=-1)
+
     def cell(self, x: int, y: int) -> int:
         """The cell id of (x, y); raises InvalidCellError off the grid."""
         if not self.in_grid(x, y):

@@ -41,9 +41,7 @@ PROGRESS_RANGE = 20.0
 
 
 def _label_xy(robot: DiscreteRobot, layout: Layout) -> np.ndarray:
-    width = layout.width
-    y, x = np.divmod(robot.label.astype(np.int64), width)
-    return np.stack([x + layout.lo, y + layout.lo], axis=1).astype(np.float64)
+    return layout.xy_of(robot.label).astype(np.float64)
 
 
 def dense(

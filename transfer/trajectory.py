@@ -172,7 +172,3 @@ def check_task(traj: Trajectory, start_cell: int, goal_cell: int, layout: Layout
             f"the trajectory goes {layout.xy(traj.start)} -> {layout.xy(traj.goal)} but the task is "
             f"{layout.xy(start_cell)} -> {layout.xy(goal_cell)}"
         )
-
-
-def as_array(traj: Trajectory) -> np.ndarray:
-    return np.asarray(traj.cells, dtype=np.int64)

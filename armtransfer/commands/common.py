@@ -125,10 +125,6 @@ def config_options(args: argparse.Namespace) -> dict:
     return {f.name: getattr(args, f.name) for f in fields(LearnerConfig) if f.metadata.get("cli")}
 
 
-def config_from_args(args: argparse.Namespace) -> LearnerConfig:
-    return LearnerConfig.from_options(config_options(args))
-
-
 def transfer_kwargs(args: argparse.Namespace) -> dict:
     """The keyword arguments of ``armtransfer.transfer`` that the common flags give (the task's
     flags are checked here, so that errors name them)."""
