@@ -20,6 +20,7 @@ COMMANDS = {
     "sweep": "sweep",
     "summarize": "summarize",
     "arms": "arms",
+    "matrix": "matrix",
 }
 
 

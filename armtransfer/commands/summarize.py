@@ -30,6 +30,12 @@ def run(args: argparse.Namespace) -> int:
     write_text_atomic(out / "summary.md", f"# Sweep {store.meta['name']!r}\n\n{len(records)} finished runs, "
                       f"{len(failures)} failed.\n\n{text}\n")
     print(text)
+    from armtransfer.learning.matrix import is_matrix
+
+    if is_matrix(store.meta["spec"]):
+        from armtransfer.commands.matrix import write_summary
+
+        print(write_summary(store, out))
     if failures:
         print(f"{len(failures)} runs failed; see {out / 'failed'}")
     return 0

@@ -18,6 +18,14 @@ HELP = "Run a sweep file (TOML) into --out; re-running resumes, skipping finishe
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("sweep_file", metavar="SWEEP.toml", help="the sweep (see scripts/sweeps/)")
     p.add_argument("--out", required=True, help="result store directory")
+    add_executor_arguments(p)
+
+
+def run(args: argparse.Namespace) -> int:
+    return run_sweep(sweeps.load(args.sweep_file), args)
+
+
+def add_executor_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--executor", choices=["local", "ray"], default="local",
                    help="local process pool (default) or Ray")
     p.add_argument("--workers", type=common.positive_int, default=None,
@@ -26,8 +34,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--retries", type=int, default=2, help="retries of a run whose worker died (default 2)")
 
 
-def run(args: argparse.Namespace) -> int:
-    sweep = sweeps.load(args.sweep_file)
+def run_sweep(sweep: sweeps.Sweep, args: argparse.Namespace) -> int:
+    """Run every unfinished run of ``sweep`` into the store at ``args.out`` with the executor
+    the arguments name; returns the exit code (1 when a run failed)."""
     if args.executor == "ray":
         _import_ray()  # say how to install Ray before anything is written
     store = ResultStore.open_for(args.out, sweep)

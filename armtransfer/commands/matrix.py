@@ -1,0 +1,97 @@
+"""armtransfer matrix: every ordered source -> target pair of a set of robots, one command.
+
+The runs go through the sweep store (resumable after a crash, local or Ray); when they are
+done, ``matrix.md``, ``matrix.json`` and ``matrix.png`` (one heatmap per method) are written
+into the store, as ``armtransfer summarize DIR`` also does for a matrix store.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from armtransfer.commands import common
+from armtransfer.commands.sweep import add_executor_arguments, run_sweep
+from armtransfer.errors import InvalidParameterError
+from armtransfer.io import write_bytes_atomic, write_json_atomic, write_text_atomic
+from armtransfer.learning import matrix
+from armtransfer.learning.store import ResultStore
+
+HELP = "Run every ordered source -> target pair of the robots (a robot to itself too) and draw the matrix."
+
+
+def _task_list(text: str) -> list[int]:
+    """'1-4', '1,3' or '2' -> task numbers."""
+    out: list[int] = []
+    try:
+        for part in text.split(","):
+            lo, _, hi = part.strip().partition("-")
+            out.extend(range(int(lo), int(hi or lo) + 1))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"tasks are numbers or ranges like 1-4 or 1,3, got {text!r}") from None
+    if not out:
+        raise argparse.ArgumentTypeError(f"no tasks in {text!r}")
+    return out
+
+
+def _robot_list(text: str) -> list[str]:
+    robots = [r.strip() for r in text.split(",") if r.strip()]
+    if not robots:
+        raise argparse.ArgumentTypeError(f"no robots in {text!r}")
+    return robots
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--robots", type=_robot_list, required=True, metavar="SPEC,SPEC,...",
+                   help="robot specs: coarse, fine, ARM:ACTIONS (see `armtransfer arms list`)")
+    p.add_argument("--tasks", type=_task_list, default=[1, 2, 3, 4], metavar="1-4",
+                   help="Table I tasks (default 1-4)")
+    p.add_argument("--methods", nargs="+", default=["none", "pseudo", "dense"], metavar="METHOD",
+                   help="methods; 'none' is always run as the baseline (default: none pseudo dense)")
+    p.add_argument("--trials", type=common.positive_int, default=10, help="trials per run (default 10)")
+    p.add_argument("--seeds", type=common.non_negative_int, nargs="+", default=[0], help="seeds (default 0)")
+    p.add_argument("--trajectory", choices=["learned", "optimal"], default="learned",
+                   help="each source's learned path (default) or its shortest path")
+    p.add_argument("--out", required=True, help="result store directory (re-running resumes)")
+    add_executor_arguments(p)
+
+
+def run(args: argparse.Namespace) -> int:
+    from armtransfer.learning import methods
+
+    for m in args.methods:
+        methods.get(m)
+    sweep = matrix.matrix_sweep(args.robots, args.tasks, args.methods, args.trials, args.seeds, args.trajectory)
+    code = run_sweep(sweep, args)
+    text = write_summary(ResultStore.open_existing(args.out), Path(args.out))
+    print(text)
+    return code
+
+
+def write_summary(store: ResultStore, out: Path) -> str:
+    """matrix.md, matrix.json and matrix.png of a matrix store; returns the markdown."""
+    spec = store.meta["spec"]
+    if not matrix.is_matrix(spec):
+        raise InvalidParameterError(f"{str(out)!r} holds a sweep, not a matrix")
+    records = store.records()
+    robots = list(dict.fromkeys(s for p in spec["pairs"] for s in p))
+    cells = matrix.cells(records)
+    text = matrix.markdown(cells, robots) if cells else "(no finished runs yet)"
+    expected = len(store_runs(spec))
+    header = (f"# Matrix {spec['name']!r}\n\n{len(records)} of {expected} runs finished; tasks "
+              f"{', '.join(map(str, spec['tasks']))}; {spec['trials']} trials per run and seed; seeds "
+              f"{', '.join(map(str, spec['seeds']))}; {spec['trajectory']} trajectories.\n\n")
+    write_json_atomic(out / "matrix.json", {
+        "robots": robots, "families": {r: matrix.family(r) for r in robots}, "runs": len(records),
+        "expected_runs": expected,
+        "cells": [c.__dict__ for c in cells], "families_summary": matrix.family_rows(cells)})
+    write_text_atomic(out / "matrix.md", header + text + "\n")
+    if cells:
+        write_bytes_atomic(out / "matrix.png", matrix.heatmap_png(cells, robots))
+    return header + text
+
+
+def store_runs(spec: dict) -> list[dict]:
+    from armtransfer.learning import sweep as sweeps
+
+    return sweeps.expand(spec)
