@@ -297,21 +297,11 @@ def summary_of(results: Sequence[MethodResult], target: DiscreteRobot, start_cel
 
 
 def run_transfer(
-    source: DiscreteRobot,
-    target: DiscreteRobot,
-    start_cell: int,
-    goal_cell: int,
-    method_names: Sequence[str],
-    trajs: Sequence[Trajectory],
-    trials: int,
-    seed: int,
-    config: LearnerConfig,
-    **kwargs,
+    source: DiscreteRobot, target: DiscreteRobot, start_cell: int, goal_cell: int, *args, **kwargs
 ) -> tuple[dict, ActionMapping | None]:
     """:func:`run_all`, summarised by label (``dense``, ``dense [shuffled]``, ...), for reports
     that tabulate every run side by side. Returns the summary and the updated mapping."""
-    results, learned = run_all(source, target, start_cell, goal_cell, method_names, trajs, trials, seed,
-                               config, **kwargs)
+    results, learned = run_all(source, target, start_cell, goal_cell, *args, **kwargs)
     return summary_of(results, target, start_cell, goal_cell), learned
 
 
