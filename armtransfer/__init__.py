@@ -34,6 +34,7 @@ _LAZY = {
     "Method": "armtransfer.learning.methods",
     "resolve_robot": "armtransfer.tasks.specs",
     "register_envs": "armtransfer.tasks.envs",
+    "TransferReward": "armtransfer.wrappers",
     "ArmTransferError": "armtransfer.errors",
 }
 
