@@ -146,6 +146,41 @@ def view_extent(scene, width: int, height: int, elevation: float = ELEVATION) ->
     return 1.12 * max(vertical, horizontal_as_vertical)
 
 
+def offscreen_model(scene, width: int, height: int, samples: int = 4) -> mujoco.MjModel:
+    """A copy of the scene's model set up for an orthographic offscreen view of the table."""
+    model = copy.copy(scene.model)
+    model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), width)
+    model.vis.global_.offheight = max(int(model.vis.global_.offheight), height)
+    model.vis.quality.offsamples = int(samples)
+    model.vis.global_.orthographic = 1
+    model.vis.global_.fovy = view_extent(scene, width, height)
+    return model
+
+
+def render_with_markers(renderer: mujoco.Renderer, model: mujoco.MjModel, data: mujoco.MjData,
+                        camera: mujoco.MjvCamera, qpos: np.ndarray, markers: Sequence[tuple],
+                        shadows: bool = False) -> np.ndarray:
+    """[height, width, 3] uint8 image of the arm at ``qpos`` with decor ``markers``
+    (geom type, size, pos, rgba; a size of length 2 draws a line between two points)."""
+    data.qpos[:] = qpos
+    mujoco.mj_kinematics(model, data)
+    renderer.update_scene(data, camera)
+    scn = renderer.scene
+    scn.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = shadows
+    for gtype, size, pos, rgba in markers:
+        if scn.ngeom >= scn.maxgeom:
+            break
+        g = scn.geoms[scn.ngeom]
+        if gtype == int(mujoco.mjtGeom.mjGEOM_LINE):
+            mujoco.mjv_initGeom(g, gtype, np.zeros(3), np.zeros(3), np.eye(3).reshape(-1), rgba)
+            mujoco.mjv_connector(g, gtype, float(size), pos[0], pos[1])
+        else:
+            mujoco.mjv_initGeom(g, gtype, size, pos, np.eye(3).reshape(-1), rgba)
+        g.category = mujoco.mjtCatBit.mjCAT_DECOR
+        scn.ngeom += 1
+    return renderer.render()
+
+
 class PanelRenderer:
     """Renders one replay's configurations with its markers (close it, or use ``with``)."""
 
@@ -154,35 +189,18 @@ class PanelRenderer:
                  camera: mujoco.MjvCamera | None = None) -> None:
         self.panel = panel
         rp = panel.replay
-        model = copy.copy(rp.scene.model)
-        model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), width)
-        model.vis.global_.offheight = max(int(model.vis.global_.offheight), height)
-        model.vis.quality.offsamples = int(samples)
-        model.vis.global_.orthographic = 1
-        model.vis.global_.fovy = view_extent(rp.scene, width, height)
-        self.model = model
-        self.data = mujoco.MjData(model)
+        self.model = offscreen_model(rp.scene, width, height, samples)
+        self.data = mujoco.MjData(self.model)
         self.camera = camera or table_camera(rp, width, height)
         self.shadows = shadows
         self._markers = _markers(panel)
-        self.renderer = mujoco.Renderer(model, height, width, max_geom=model.ngeom + len(self._markers) + 100)
+        self.renderer = mujoco.Renderer(self.model, height, width,
+                                        max_geom=self.model.ngeom + len(self._markers) + 100)
 
     def render(self, qpos: np.ndarray) -> np.ndarray:
         """[height, width, 3] uint8 image of the arm at ``qpos``."""
-        self.data.qpos[:] = qpos
-        mujoco.mj_kinematics(self.model, self.data)
-        r = self.renderer
-        r.update_scene(self.data, self.camera)
-        scn = r.scene
-        scn.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = self.shadows
-        for gtype, size, pos, rgba in self._markers:
-            if scn.ngeom >= scn.maxgeom:
-                break
-            g = scn.geoms[scn.ngeom]
-            mujoco.mjv_initGeom(g, gtype, size, pos, np.eye(3).reshape(-1), rgba)
-            g.category = mujoco.mjtCatBit.mjCAT_DECOR
-            scn.ngeom += 1
-        return r.render()
+        return render_with_markers(self.renderer, self.model, self.data, self.camera, qpos, self._markers,
+                                   self.shadows)
 
     def close(self) -> None:
         self.renderer.close()

@@ -13,6 +13,7 @@ from __future__ import annotations
 from typing import Any
 
 import gymnasium as gym
+import numpy as np
 from gymnasium import spaces
 
 from armtransfer.tasks.catalog import Task, custom_task, table_task
@@ -23,7 +24,7 @@ from armtransfer.tasks.robot import DiscreteRobot
 class RobotRoomsEnv(gym.Env):
     """A start/goal task for one discrete robot, in the style of Gymnasium's toy_text."""
 
-    metadata = {"render_modes": ["ansi"], "render_fps": 4}
+    metadata = {"render_modes": ["ansi", "rgb_array"], "render_fps": 4}
 
     def __init__(
         self,
@@ -36,6 +37,9 @@ class RobotRoomsEnv(gym.Env):
     ) -> None:
         if not 0.0 <= wind <= 1.0:
             raise InvalidParameterError(f"wind must be a probability in [0, 1], got {wind}")
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise InvalidParameterError(
+                f"unknown render_mode {render_mode!r}; valid: {', '.join(self.metadata['render_modes'])}")
         self.robot = robot
         self.task = task
         start_cell, self.goal_cell = task.cells()
@@ -48,6 +52,7 @@ class RobotRoomsEnv(gym.Env):
         self.observation_space = spaces.Discrete(robot.n_states)
         self.action_space = spaces.Discrete(robot.n_actions)
         self.state = self.start_state
+        self._snapshot = None
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         super().reset(seed=seed)
@@ -65,13 +70,46 @@ class RobotRoomsEnv(gym.Env):
         return s, reward, terminated, False, {"label": label}
 
     def render(self):
+        """``ansi``: a text map; ``rgb_array``: for an arm robot the arm drawn by MuJoCo
+        offscreen at the current state's configuration with the cell grid, the goal and the
+        tip's cell; for a grid robot the layout drawn cell by cell."""
+        label = int(self.robot.label[self.state])
+        layout = self.robot.layout
         if self.render_mode == "ansi":
-            from armtransfer.tasks.layout import ROOMS
+            x, y = layout.xy(label)
+            gx, gy = layout.xy(self.goal_cell)
+            return layout.ascii({(x, y): "R", (gx, gy): "G"}) + "\n"
+        if self.render_mode == "rgb_array":
+            if self.robot.arm is None:
+                return grid_image(layout, label, self.goal_cell)
+            if self._snapshot is None:
+                from armtransfer.ik.replay import robot_scene
+                from armtransfer.ik.snapshot import ArmSnapshot
 
-            x, y = ROOMS.xy(int(self.robot.label[self.state]))
-            gx, gy = ROOMS.xy(self.goal_cell)
-            return ROOMS.ascii({(x, y): "R", (gx, gy): "G"}) + "\n"
+                self._snapshot = ArmSnapshot(robot_scene(self.robot))
+            return self._snapshot.render(self.robot.arm.qpos[self.state], self.goal_cell, label)
         return None
+
+    def close(self) -> None:
+        if self._snapshot is not None:
+            self._snapshot.close()
+            self._snapshot = None
+        super().close()
+
+
+CELL_PIXELS = 6
+FREE_RGB, WALL_RGB = (235, 225, 205), (90, 75, 70)
+ROBOT_RGB, GOAL_RGB = (40, 90, 230), (30, 190, 50)
+
+
+def grid_image(layout, robot_cell: int, goal_cell: int, cell_pixels: int = CELL_PIXELS) -> np.ndarray:
+    """The layout from above (+y up) as uint8 RGB, walls dark, goal green, robot blue."""
+    rgb = np.where(layout.wall_mask[..., None], np.array(WALL_RGB, np.uint8), np.array(FREE_RGB, np.uint8))
+    for cell, colour in ((goal_cell, GOAL_RGB), (robot_cell, ROBOT_RGB)):
+        x, y = layout.xy(int(cell))
+        rgb[y - layout.lo, x - layout.lo] = colour
+    image = rgb[::-1].repeat(cell_pixels, axis=0).repeat(cell_pixels, axis=1)
+    return np.ascontiguousarray(image)
 
 
 def make_rooms_env(

@@ -4,10 +4,12 @@ import gymnasium as gym
 import pytest
 from gymnasium.utils.env_checker import check_env
 
+import numpy as np
+
+from armtransfer.errors import ArmTransferError
 from armtransfer.tasks.envs import register_envs
 
 register_envs()
-from armtransfer.errors import ArmTransferError
 
 
 @pytest.mark.parametrize("arm, actions", [("planar2", "joint"), ("ur5e_like", "cartesian")])
@@ -37,3 +39,27 @@ def test_arm_env_takes_custom_tasks_and_wind():
 def test_unknown_arm_is_a_one_line_error():
     with pytest.raises(ArmTransferError, match="valid arms"):
         gym.make("armtransfer/ArmRooms-v0", arm="puma", actions="joint")
+
+
+@pytest.mark.parametrize("arm, actions", [("planar2", "joint"), ("ur5e_like", "cartesian")])
+def test_rgb_array_draws_the_arm_and_passes_check_env(arm, actions):
+    env = gym.make("armtransfer/ArmRooms-v0", arm=arm, actions=actions, task=1, render_mode="rgb_array")
+    check_env(env.unwrapped, skip_render_check=False)
+    obs, _ = env.reset(seed=0)
+    first = env.render()
+    assert first.dtype == np.uint8 and first.shape == (240, 320, 3)
+    assert first.std() > 10  # not a blank frame
+    robot = env.unwrapped.robot
+    path = robot.shortest_path(obs, env.unwrapped.goal_cell)
+    for _, action in path[:-1]:
+        env.step(action)
+    last = env.render()
+    changed = np.any(np.abs(first.astype(int) - last.astype(int)) > 30, axis=-1)
+    assert changed.mean() > 0.002  # the arm (and the tip's tile) moved across the picture
+    env.close()
+    assert env.unwrapped._snapshot is None
+
+
+def test_unknown_render_mode_is_refused():
+    with pytest.raises(ArmTransferError, match="unknown render_mode 'human'; valid: ansi, rgb_array"):
+        gym.make("armtransfer/ArmRooms-v0", arm="planar2", actions="joint", render_mode="human")

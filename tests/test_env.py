@@ -38,3 +38,20 @@ def test_wind_is_reproducible_from_the_reset_seed():
 
     assert rollout(3) == rollout(3)
     assert rollout(3) != rollout(4)
+
+
+def test_rooms_rgb_array_shows_the_robot_and_goal():
+    import numpy as np
+
+    env = gym.make("armtransfer/Rooms-v0", task=1, robot="fine", render_mode="rgb_array")
+    check_env(env.unwrapped, skip_render_check=False)
+    env.reset(seed=0)
+    image = env.render()
+    assert image.dtype == np.uint8 and image.shape == (51 * 6, 51 * 6, 3)
+    blue = np.all(image == (40, 90, 230), axis=-1)
+    green = np.all(image == (30, 190, 50), axis=-1)
+    assert blue.sum() == 36 and green.sum() == 36  # one cell each, 6 x 6 pixels
+    # the robot starts at (0, 0): column 25 from the left, row 25 from the top
+    assert blue[25 * 6 + 3, 25 * 6 + 3]
+    env.step(0)  # F: +y, one row up in the picture
+    assert np.all(env.render()[24 * 6 + 3, 25 * 6 + 3] == (40, 90, 230))
