@@ -13,9 +13,6 @@ from __future__ import annotations
 
 import argparse
 import datetime as _dt
-import os
-import shutil
-import tempfile
 import time
 from pathlib import Path
 
@@ -28,7 +25,7 @@ from armtransfer.tasks.layout import ROOMS
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.learning import experiment, figures
 from armtransfer.tasks.specs import CUSTOM, resolve
-from armtransfer.io import OutputError, check_writable, copy_atomic, write_json_atomic, write_text_atomic
+from armtransfer.io import check_writable, copy_atomic, staged_directory, write_json_atomic, write_text_atomic
 
 DEFAULT_SOURCE = "planar2:joint"
 DEFAULT_TARGET = "ur5e_like:cartesian"
@@ -66,21 +63,6 @@ def arm_options(args: argparse.Namespace) -> dict:
     return options
 
 
-def _prepare_out(out: Path) -> Path:
-    """A hidden temporary directory beside ``out`` (which must be absent or empty)."""
-    if out.exists() and (not out.is_dir() or any(out.iterdir())):
-        raise OutputError(f"output directory {str(out)!r} exists and is not empty; choose a new --out")
-    check_writable(out / "results.json")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    return Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
-
-
-def _commit_out(tmp: Path, out: Path) -> None:
-    if out.exists():
-        out.rmdir()  # empty, checked before
-    os.replace(tmp, out)
-
-
 def _fast_overrides(args: argparse.Namespace) -> dict:
     """--fast: 2 trials, convergence after 5 unchanged episodes, no controls."""
     if not args.fast:
@@ -98,8 +80,7 @@ def run(args: argparse.Namespace) -> int:
         from armtransfer.ik.render import video_format
 
         video_format(args.render, None)
-    tmp = _prepare_out(out)
-    try:
+    with staged_directory(out) as tmp:
         result = _run_into(args, tmp)
         if args.json:
             write_json_atomic(args.json, result["json"])
@@ -110,10 +91,6 @@ def run(args: argparse.Namespace) -> int:
                 copy_atomic(tmp_video, target)
             else:
                 _video(result, args, target)
-        _commit_out(tmp, out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
     print(f"wrote {out}/ ({', '.join(sorted(p.name for p in out.iterdir()))}) in {time.perf_counter() - t0:.0f} s")
     return 0
 

@@ -68,6 +68,36 @@ def write_json_atomic(path: str | os.PathLike, data: object) -> None:
     write_text_atomic(path, json.dumps(data, indent=2, sort_keys=False) + "\n")
 
 
+def check_output_dir(out: str | os.PathLike, flag: str = "--out") -> None:
+    """Fail early when ``out`` cannot become a new output directory: it must be absent or an
+    empty directory, somewhere writable."""
+    out = Path(out)
+    if out.exists() and (not out.is_dir() or any(out.iterdir())):
+        raise OutputError(f"output directory {str(out)!r} exists and is not empty; choose a new {flag}")
+    check_writable(out / "results.json")
+
+
+@contextmanager
+def staged_directory(out: str | os.PathLike, flag: str = "--out") -> Iterator[Path]:
+    """A hidden temporary directory beside ``out`` to write every output into; renamed onto
+    ``out`` when the block ends without an error, deleted otherwise. So an output directory
+    exists only complete, whatever stops the run (an error, Ctrl-C, a kill before the rename)."""
+    out = Path(out)
+    check_output_dir(out, flag)
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
+    except OSError as err:
+        raise OutputError(f"cannot write {str(out)!r}: {err.strerror}") from None
+    try:
+        yield tmp
+        if out.exists():
+            out.rmdir()  # empty, checked before
+        os.replace(tmp, out)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
 def check_writable(path: str | os.PathLike) -> None:
     """Fail early (before any work) when ``path`` cannot be created."""
     p = Path(path)

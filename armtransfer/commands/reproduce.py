@@ -3,22 +3,26 @@
 from __future__ import annotations
 
 import argparse
+import datetime as _dt
 import time
 from pathlib import Path
 
 from armtransfer.commands import common
 from armtransfer.learning import beyond, figures
+from armtransfer.learning import paper, reproduce_report
 from armtransfer.learning import reproduce as rep
 from armtransfer.tasks.layout import ROOMS
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import ActionMapping
-from armtransfer.io import check_writable, write_json_atomic, write_text_atomic
+from armtransfer.io import check_output_dir, staged_directory, write_json_atomic, write_text_atomic
 
 HELP = "Reproduce the paper's tables and figures on the rooms world; writes report.md."
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--out", default="runs/reproduce", help="output directory (default runs/reproduce)")
+    p.add_argument("--out", default=None,
+                   help="output directory, absent or empty; written whole or not at all "
+                        "(default runs/reproduce-<timestamp>)")
     p.add_argument("--trials", type=common.positive_int, default=30,
                    help="trials per table cell (default 30; the paper used 10)")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
@@ -39,12 +43,25 @@ def _bars(res: dict, key: str) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-    out = Path(args.out)
-    check_writable(out / "report.md")
+    final = Path(args.out) if args.out else Path("runs") / _dt.datetime.now().strftime("reproduce-%Y%m%d-%H%M%S")
+    check_output_dir(final)
     config = LearnerConfig(max_total_steps=args.max_total_steps)
     t0 = time.perf_counter()
     with common.progress_bar(rep.plan(args.trials), "reproduce") as bar:
         res = rep.run_all(args.trials, args.seed, config, tick=bar.update)
+    with staged_directory(final) as out:
+        names = _write(res, out)
+    print(f"wrote {final / 'report.md'} ({time.perf_counter() - t0:.0f} s)")
+    print(reproduce_report.table_ii_markdown(res["table_ii"], paper.TABLE_II, "Table II A-C: coarse -> fine"))
+    print()
+    print(reproduce_report.table_ii_mapping_markdown(res))
+    print()
+    print(beyond.methods_markdown(res["methods"]))
+    return 0
+
+
+def _write(res: dict, out: Path) -> dict[str, str]:
+    """Every figure, the mappings, results.json and report.md, into ``out``."""
     groups = [f"task {t}" for t in rep.TASKS]
     names = {"fig4": "fig4_coarse_to_fine.png", "fig5": "fig5_fine_to_coarse.png", "fig6": "fig6_wind.png",
              "fig7": "fig7_mapping.png", "methods": "fig_methods.png"}
@@ -69,11 +86,5 @@ def run(args: argparse.Namespace) -> int:
         ActionMapping.from_json(res[key]["mapping"]).save(out / f"{key}.json")
     write_json_atomic(out / "results.json", res)
     # report.md last: its presence means everything else was written
-    write_text_atomic(out / "report.md", rep.report_markdown(res, names))
-    print(f"wrote {out / 'report.md'} ({time.perf_counter() - t0:.0f} s)")
-    print(rep.table_ii_markdown(res["table_ii"], rep.paper.TABLE_II, "Table II A-C: coarse -> fine"))
-    print()
-    print(rep.table_ii_mapping_markdown(res))
-    print()
-    print(beyond.methods_markdown(methods))
-    return 0
+    write_text_atomic(out / "report.md", reproduce_report.report_markdown(res, names))
+    return names
