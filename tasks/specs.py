@@ -1,5 +1,5 @@
-"""Robot specs as users type them: grid robots by name, arms as ``ARM[:ACTIONS]``, and
-``custom[:ACTIONS]`` for a bring-your-own arm file."""
+"""Robot specs as users type them: grid robots by name, arms as ``ARM[:ACTIONS]``, an arm file
+as ``PATH.xml[:ACTIONS]``, and ``custom[:ACTIONS]`` for the arm file given separately."""
 
 from __future__ import annotations
 
@@ -13,9 +13,9 @@ CUSTOM = "custom"
 
 def resolve(spec: str | DiscreteRobot, *, xml_path=None, progress: bool = False, **arm_options) -> DiscreteRobot:
     """A robot from its spec: ``fine``/``coarse`` (grid robots), ``planar2:joint`` (a built-in
-    arm and action model; the arm's first model when omitted), or ``custom[:ACTIONS]`` (the
-    arm in ``xml_path``, with ``arm_options`` such as ``tip_site`` and ``base_pos``). A robot
-    passes through unchanged."""
+    arm and action model; the arm's first model when omitted), ``PATH.xml[:ACTIONS]`` (an arm
+    file), or ``custom[:ACTIONS]`` (the arm in ``xml_path``); ``arm_options`` such as
+    ``tip_site`` and ``base_pos`` go to arm files. A robot passes through unchanged."""
     if isinstance(spec, DiscreteRobot):
         return spec
     if not isinstance(spec, str):
@@ -24,6 +24,11 @@ def resolve(spec: str | DiscreteRobot, *, xml_path=None, progress: bool = False,
         return grid_robot(spec)
     from armtransfer.models import ARMS
 
+    if ".xml" in spec:  # an arm file: PATH.xml or PATH.xml:ACTIONS
+        path, _, actions = spec.rpartition(":") if not spec.endswith(".xml") else (spec, "", "")
+        from armtransfer.tasks.arms import arm_robot
+
+        return arm_robot(None, actions or "cartesian", xml_path=path, progress=progress, **arm_options)
     name, _, actions = spec.partition(":")
     if name == CUSTOM:
         if xml_path is None:

@@ -145,3 +145,11 @@ def test_robot_objects_and_specs_are_interchangeable():
     b = armtransfer.transfer(source="coarse", target=grid_robot("fine"), methods=["pseudo"], trials=1, controls=False)
     assert a.to_json() == b.to_json()
     assert np.array_equal(a.methods["pseudo"].trials[0].episode_steps, b.methods["pseudo"].trials[0].episode_steps)
+
+
+def test_an_arm_file_is_a_robot_spec(scara_xml):
+    r = armtransfer.transfer(source="coarse", target=f"{scara_xml}:cartesian", task=4, methods=["none"], trials=1,
+                             controls=False, arm_options={"tip_site": "pen_tip", "base_pos": (-0.1, 0.0, 0.0)})
+    assert r.target.name == "my_scara:cartesian"
+    assert r.target.arm is not None and r.target.arm.xml_path == str(scara_xml)
+    assert r.methods["none"].trials[0].exploration_steps is not None
