@@ -70,13 +70,14 @@ def _layout_data(layout: Layout) -> dict:
 def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
               xml_path: str | Path | None = None, tip_site: str | None = None,
               base_pos: tuple[float, float, float] | None = None, base_yaw: float = 0.0,
-              joint_step: float | None = None, layout: Layout = ROOMS, cache: bool = True,
-              progress: bool = False) -> DiscreteRobot:
+              joint_step: float | None = None, tip_down: bool | None = None, layout: Layout = ROOMS,
+              cache: bool = True, progress: bool = False) -> DiscreteRobot:
     """Compile (or load from the cache) the discrete robot of an arm and action model.
 
     Built-in arms are named by ``arm``; a bring-your-own arm is given by ``xml_path`` and
     ``tip_site`` (and optionally its base pose ``base_pos``/``base_yaw`` in the table frame:
-    tabletop z = 0, cell (x, y) centred at (x * cell_size, y * cell_size)).
+    tabletop z = 0, cell (x, y) centred at (x * cell_size, y * cell_size)); ``tip_down``
+    keeps a bring-your-own arm's tool pointing down in the ``cartesian`` models.
     """
     model = action_model(actions)
     if not cell_size > 0:
@@ -90,7 +91,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
         name = arm or path.stem
         tip = tip_site or "tip"
         mount = tuple(float(v) for v in (base_pos or (0.0, 0.0, 0.0)))
-        yaw, kind, tip_down = float(base_yaw), "custom", False
+        yaw, kind, tip_down = float(base_yaw), "custom", bool(tip_down)
         step = joint_step or CUSTOM_JOINT_STEP
     else:
         if arm not in ARMS:

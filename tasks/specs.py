@@ -27,8 +27,16 @@ def resolve(spec: str | DiscreteRobot, *, xml_path=None, progress: bool = False,
     if ".xml" in spec:  # an arm file: PATH.xml or PATH.xml:ACTIONS
         path, _, actions = spec.rpartition(":") if not spec.endswith(".xml") else (spec, "", "")
         from armtransfer.tasks.arms import arm_robot
+        from armtransfer.tasks.generated import read_sidecar, robot_of
 
+        generated = read_sidecar(path)
+        if generated is not None and not arm_options.get("base_pos"):  # mounted as it was generated
+            return robot_of(path, generated, actions or "cartesian", progress=progress)
         return arm_robot(None, actions or "cartesian", xml_path=path, progress=progress, **arm_options)
+    if spec.startswith("gen:"):
+        from armtransfer.tasks.generated import resolve_generated
+
+        return resolve_generated(spec, progress=progress)
     name, _, actions = spec.partition(":")
     if name == CUSTOM:
         if xml_path is None:
@@ -46,5 +54,6 @@ def resolve(spec: str | DiscreteRobot, *, xml_path=None, progress: bool = False,
         raise UnknownArmError(f"unknown arm {name!r}; valid arms: {', '.join(ARMS)}, or {CUSTOM} with --arm-xml")
     raise UnknownRobotError(
         f"unknown robot {spec!r}; valid: {', '.join(sorted(GRID_ROBOTS))}, ARM[:ACTIONS] with ARM one of "
-        f"{', '.join(ARMS)} (see `armtransfer arms list`), or {CUSTOM}[:ACTIONS] with --arm-xml"
+        f"{', '.join(ARMS)} (see `armtransfer arms list`), PATH.xml[:ACTIONS], gen:FAMILY:DOF:SEED[:ACTIONS], "
+        f"or {CUSTOM}[:ACTIONS] with --arm-xml"
     )

@@ -8,13 +8,17 @@ import argparse
 from armtransfer.commands import common
 
 HELP = ("transfer a trajectory from one arm to another (default: planar2:joint -> ur5e_like:cartesian, "
-        "task 1); 'arms list' lists the arm robots")
+        "task 1); 'arms list' lists the arm robots; 'arms generate' draws arms from a family")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("action", nargs="?", choices=["list"],
-                        help="'list': compile (or load) every arm robot and report it; without it, "
-                             "run a transfer")
+    parser.add_argument("action", nargs="?", choices=["list", "generate"],
+                        help="'list': compile (or load) every arm robot and report it; 'generate': draw "
+                             "an arm from --family with --dof joints and --seed into --out; without "
+                             "either, run a transfer")
+    parser.add_argument("--family", default=None, help="arms generate: planar, spatial6 or spatial7")
+    parser.add_argument("--dof", type=common.positive_int, default=None,
+                        help="arms generate: joints (planar 2-7, spatial6 6, spatial7 7)")
     parser.add_argument("--arm-xml", metavar="PATH",
                         help="also list a bring-your-own MJCF serial arm with hinge joints")
     parser.add_argument("--tip-site", metavar="NAME", default="tip",
@@ -40,6 +44,8 @@ def run(args: argparse.Namespace) -> int:
     from armtransfer.ik.actions import ACTION_MODELS
     from armtransfer.errors import ArmModelError
 
+    if args.action == "generate":
+        return generate(args)
     if args.action != "list":
         from armtransfer import arm_transfer
 
@@ -98,3 +104,22 @@ def _solvable(robot, task) -> bool:
     except InvalidCellError:
         return False
     return robot.shortest_path(start, g) is not None
+
+
+def generate(args: argparse.Namespace) -> int:
+    """``arms generate --family F --dof N --seed S --out DIR``: one usable arm, or why not."""
+    from armtransfer.errors import ArmModelError
+    from armtransfer.models.generate import FAMILIES, check_family
+    from armtransfer.tasks.generated import generate_arm
+
+    if args.family is None or args.out is None:
+        raise ArmModelError(f"arms generate needs --family ({', '.join(FAMILIES)}), --dof and --out DIR")
+    dof = args.dof if args.dof is not None else FAMILIES.get(args.family, (None,))[0]
+    check_family(args.family, dof)
+    with common.phase("drawing and compiling"):
+        arm = generate_arm(args.family, dof, args.seed, args.out, progress=common.interactive())
+    for line in arm.rejected:
+        print(f"rejected {line}")
+    print(f"wrote {arm.xml_path} (draw {arm.draws}; reaches {100 * arm.reach:.1f}% of the free cells; "
+          f"every Table I task solvable); use it as the robot {arm.xml_path}:cartesian")
+    return 0
