@@ -88,7 +88,7 @@ def test_a_rejected_draw_is_redrawn_and_the_reasons_kept(tmp_path, monkeypatch):
 
     monkeypatch.setattr("armtransfer.tasks.generated.draw_arm", first_too_short)
     arm = generate_arm("planar", 2, 0, tmp_path)
-    assert arm.draws == 2 and len(arm.rejected) == 1
+    assert arm.draws >= 2 and len(arm.rejected) == arm.draws - 1 == len(calls) - 1
     assert arm.rejected[0].startswith("draw 1: the tip cannot get near Table I cell")
     assert read_sidecar(arm.xml_path)["rejected"] == arm.rejected
 
