@@ -63,18 +63,25 @@ def _join_xy_values(argv: list[str]) -> list[str]:
 def main(argv: list[str] | None = None) -> int:
     # Offscreen rendering needs the GL backend chosen before mujoco is first imported.
     os.environ.setdefault("MUJOCO_GL", "egl")
+    argv = sys.argv[1:] if argv is None else list(argv)
+    command = next((a for a in argv if a in COMMANDS), "")
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:  # Ctrl-C anywhere, start-up (imports, parsing) included
+        print(f"armtransfer{' ' + command if command else ''}: interrupted", file=sys.stderr)
+        return 130
+
+
+def _main(argv: list[str]) -> int:
     from armtransfer.errors import ArmTransferError
 
     parser = build_parser()
-    args = parser.parse_args(_join_xy_values(sys.argv[1:] if argv is None else list(argv)))
+    args = parser.parse_args(_join_xy_values(argv))
     try:
         return int(args._run(args) or 0)
     except ArmTransferError as err:
         print(f"armtransfer {args.command}: error: {err}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print(f"armtransfer {args.command}: interrupted", file=sys.stderr)
-        return 130
 
 
 if __name__ == "__main__":

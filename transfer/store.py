@@ -11,6 +11,7 @@ done. Temporary files a crash leaves behind start with '.' and are removed on op
 
 from __future__ import annotations
 
+import fcntl
 import json
 import os
 from pathlib import Path
@@ -20,6 +21,7 @@ from armtransfer.io import OutputError, write_json_atomic
 from armtransfer.learning.sweep import Sweep
 
 STORE_FORMAT = "armtransfer-store/1"
+LOCK = ".lock"
 
 
 class StoreError(ArmTransferError):
@@ -47,11 +49,12 @@ class ResultStore:
                     f"output directory {str(store.root)!r} holds another sweep "
                     f"({meta.get('name')!r}); choose a new --out"
                 )
-        else:
-            if store.root.exists() and any(p.name != ".lock" for p in store.root.iterdir()):
-                raise StoreError(
-                    f"output directory {str(store.root)!r} is not empty and holds no sweep; choose a new --out"
-                )
+        elif store.root.exists() and any(p.name != LOCK for p in store.root.iterdir()):
+            raise StoreError(
+                f"output directory {str(store.root)!r} is not empty and holds no sweep; choose a new --out"
+            )
+        store.lock()
+        if not meta_path.exists():
             write_json_atomic(meta_path, {"format": STORE_FORMAT, "name": sweep.name, "key": sweep.key,
                                           "spec": sweep.spec})
         for d in (store.runs_dir, store.failed_dir):
@@ -62,6 +65,29 @@ class ResultStore:
             for tmp in d.glob(".*.tmp"):
                 tmp.unlink(missing_ok=True)
         return store
+
+    def lock(self) -> None:
+        """Take the store for this process (an exclusive ``flock`` on DIR/.lock, held until the
+        process ends or :meth:`unlock`), so two sweeps never write one store; the second is
+        refused in one line. Temporary files are cleared only once the lock is held, so a live
+        writer's files are never deleted."""
+        try:
+            self.root.mkdir(parents=True, exist_ok=True)
+            fd = os.open(self.root / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as err:
+            raise OutputError(f"cannot write {str(self.root)!r}: {err.strerror}") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(fd)
+            raise StoreError(f"store {str(self.root)!r} is in use by another sweep; wait for it or choose "
+                             "another --out") from None
+        self._lock_fd = fd
+
+    def unlock(self) -> None:
+        if getattr(self, "_lock_fd", None) is not None:
+            os.close(self._lock_fd)  # closing the descriptor releases the flock
+            self._lock_fd = None
 
     @classmethod
     def open_existing(cls, root: str | os.PathLike) -> "ResultStore":

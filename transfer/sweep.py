@@ -94,7 +94,20 @@ def _check_number(where: str, value: object, lo: float, hi: float, integer: bool
     return value
 
 
-def normalise(raw: dict, where: str = "sweep file") -> dict:
+MAX_RUNS = 100_000
+"""A sweep larger than this is refused unless the limit is raised (``--max-runs``)."""
+
+
+def size(spec: dict) -> int:
+    """How many runs a normalised spec has, without listing them (at most; ``none`` ignores K)."""
+    n = len(spec["tasks"]) + len(spec["start_goal"])
+    for key in _AXES:
+        if key not in ("tasks", "start_goal"):
+            n *= len(spec[key])
+    return n
+
+
+def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS) -> dict:
     """Validate a parsed sweep file; returns the spec with every key filled in."""
     if set(raw) != {"sweep"} or not isinstance(raw.get("sweep"), dict):
         extra = sorted(set(raw) - {"sweep"})
@@ -149,6 +162,12 @@ def normalise(raw: dict, where: str = "sweep file") -> dict:
     for key in _AXES:
         if len(spec[key]) != len({json.dumps(v) for v in spec[key]}):
             raise SweepFileError(f"{w}: {key} lists a value twice")
+        if not spec[key] and key not in ("tasks", "start_goal"):
+            raise SweepFileError(f"{w}: {key} is empty; give at least one value")
+    n = size(spec)
+    if n > max_runs:
+        raise SweepFileError(f"{w}: the sweep has {n:,} runs, over the limit of {max_runs:,}; "
+                             "raise it with --max-runs")
     return spec
 
 
@@ -183,7 +202,7 @@ def expand(spec: dict) -> list[dict]:
     return [dict(r, key=k) for k, r in runs.items()]
 
 
-def load(path: str | os.PathLike) -> Sweep:
+def load(path: str | os.PathLike, max_runs: int = MAX_RUNS) -> Sweep:
     p = Path(path)
     where = f"sweep file {str(p)!r}"
     try:
@@ -192,7 +211,7 @@ def load(path: str | os.PathLike) -> Sweep:
         raise SweepFileError(f"cannot read {where}: {err.strerror}") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
         raise SweepFileError(f"{where} is not valid TOML: {str(err).splitlines()[0]}") from None
-    spec = normalise(raw, where)
+    spec = normalise(raw, where, max_runs)
     return Sweep(spec["name"], spec, tuple(expand(spec)))
 
 

@@ -7,6 +7,7 @@ import os
 
 from armtransfer.commands import common
 from armtransfer.execute import robot_specs
+from armtransfer.tasks.catalog import custom_task
 from armtransfer.executors import _import_ray, run_local, run_ray
 from armtransfer.tasks.specs import resolve
 from armtransfer.learning import sweep as sweeps
@@ -18,11 +19,13 @@ HELP = "Run a sweep file (TOML) into --out; re-running resumes, skipping finishe
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("sweep_file", metavar="SWEEP.toml", help="the sweep (see scripts/sweeps/)")
     p.add_argument("--out", required=True, help="result store directory")
+    p.add_argument("--max-runs", type=common.positive_int, default=sweeps.MAX_RUNS,
+                   help=f"refuse a sweep with more runs than this (default {sweeps.MAX_RUNS:,})")
     add_executor_arguments(p)
 
 
 def run(args: argparse.Namespace) -> int:
-    return run_sweep(sweeps.load(args.sweep_file), args)
+    return run_sweep(sweeps.load(args.sweep_file, args.max_runs), args)
 
 
 def add_executor_arguments(p: argparse.ArgumentParser) -> None:
@@ -31,22 +34,52 @@ def add_executor_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--workers", type=common.positive_int, default=None,
                    help="worker processes (default: all cores)")
     p.add_argument("--address", default=None, help="Ray cluster address (default: start a local instance)")
-    p.add_argument("--retries", type=int, default=2, help="retries of a run whose worker died (default 2)")
+    p.add_argument("--retries", type=common.non_negative_int, default=2,
+                   help="retries of a run whose worker died (default 2)")
 
 
 def run_sweep(sweep: sweeps.Sweep, args: argparse.Namespace) -> int:
     """Run every unfinished run of ``sweep`` into the store at ``args.out`` with the executor
-    the arguments name; returns the exit code (1 when a run failed)."""
+    the arguments name; returns the exit code (1 when a run failed). The whole sweep is
+    checked (every robot built, every task's cells checked for both robots) before anything
+    is written."""
     if args.executor == "ray":
         _import_ray()  # say how to install Ray before anything is written
+    robots = check_runs(sweep.runs)
     store = ResultStore.open_for(args.out, sweep)
+    try:
+        return _run_into(store, sweep, robots, args)
+    finally:
+        store.unlock()
+
+
+def check_runs(runs: list[dict]) -> dict:
+    """Every robot the runs name, built once (arms come from the on-disk cache) to be shared
+    with the workers; a robot that cannot be built, or a task cell it cannot start or end
+    at, is a one-line error naming the run's robot and task."""
+    if not runs:
+        raise sweeps.SweepFileError("the sweep has no runs")
+    robots = {spec: resolve(spec) for spec in robot_specs(runs)}
+    seen = set()
+    for run in runs:
+        key = (run["source"], run["target"], tuple(run["start"]), tuple(run["goal"]))
+        if key in seen:
+            continue
+        seen.add(key)
+        task = custom_task(tuple(run["start"]), tuple(run["goal"]))
+        start, goal = task.cells()
+        for spec in (run["source"], run["target"]):
+            robots[spec].start_state(start)
+            robots[spec].start_state(goal, what="goal")
+    return robots
+
+
+def _run_into(store: ResultStore, sweep: sweeps.Sweep, robots: dict, args: argparse.Namespace) -> int:
     todo = [r for r in sweep.runs if not store.is_done(r["key"])]
     print(f"sweep {sweep.name!r}: {len(sweep.runs)} runs, {len(sweep.runs) - len(todo)} already done, "
           f"{len(todo)} to run ({args.executor})")
     if not todo:
         return 0
-    # every robot is built once here (arms come from the on-disk cache) and shared with workers
-    robots = {spec: resolve(spec) for spec in robot_specs(todo)}
     failed: list[str] = []
     with common.progress_bar(len(todo), "sweep") as bar:
         def on_done(run, result, secs):

@@ -1,0 +1,97 @@
+"""A sweep is checked whole before anything is written, its store is locked, and Ctrl-C at
+start-up is one line."""
+
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from armtransfer.cli import main
+from armtransfer.learning import sweep as sweeps
+from armtransfer.learning.store import ResultStore
+
+GOOD = """[sweep]
+name = "guards"
+tasks = [1]
+pairs = [["coarse", "fine"]]
+methods = ["none"]
+seeds = [0]
+trials = 1
+"""
+
+
+def _refused(tmp_path, capsys, text, message, *extra):
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    out = tmp_path / "store"
+    assert main(["sweep", str(path), "--out", str(out), *extra]) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert not out.exists(), "nothing may be written for a rejected sweep"
+
+
+@pytest.mark.parametrize("change,message", [
+    (('pairs = [["coarse", "fine"]]', 'pairs = [["coarse", "octopus:joint"]]'), "unknown arm 'octopus'"),
+    (('pairs = [["coarse", "fine"]]', 'pairs = [["coarse", "nobody"]]'), "unknown robot 'nobody'"),
+    (("tasks = [1]", 'tasks = []\nstart_goal = [["0,0", "-3,0"]]'), "inside a wall"),
+    (("tasks = [1]", 'tasks = []\nstart_goal = [["0,0", "0,0"]]'), "start"),
+    (("seeds = [0]", "seeds = []"), "seeds is empty"),
+    (('methods = ["none"]', "methods = []"), "methods is empty"),
+])
+def test_a_bad_sweep_is_refused_before_the_store_exists(tmp_path, capsys, change, message):
+    _refused(tmp_path, capsys, GOOD.replace(*change), message)
+
+
+def test_a_grid_over_the_limit_is_refused_unless_raised(tmp_path, capsys):
+    big = GOOD.replace("seeds = [0]", f"seeds = {list(range(200))}").replace("tasks = [1]", "tasks = [1, 2, 3, 4]")
+    _refused(tmp_path, capsys, big, "the sweep has 800 runs, over the limit of 100", "--max-runs", "100")
+    # the size is counted without listing the runs: 10^9 runs are refused at once
+    huge = GOOD.replace("seeds = [0]", f"seeds = {list(range(1000))}").replace(
+        "methods = [\"none\"]", 'methods = ["none", "pseudo"]').replace("trials = 1", "trials = 1\nK = " + str(
+            [0.001 * k for k in range(1, 1001)]))
+    t0 = time.perf_counter()
+    _refused(tmp_path, capsys, huge, "over the limit of 100,000")
+    assert time.perf_counter() - t0 < 10
+    # 2 tasks x 3 seeds x the default methods (none, pseudo)
+    assert sweeps.size(sweeps.normalise({"sweep": {"tasks": [1, 2], "seeds": [0, 1, 2]}})) == 12
+
+
+def test_negative_retries_are_refused(tmp_path, capsys):
+    path = tmp_path / "s.toml"
+    path.write_text(GOOD)
+    with pytest.raises(SystemExit) as exc:
+        main(["sweep", str(path), "--out", str(tmp_path / "o"), "--retries", "-1"])
+    assert exc.value.code == 2
+    assert "--retries: must be an integer >= 0" in capsys.readouterr().err
+
+
+def test_a_second_sweep_on_a_store_in_use_is_refused_in_one_line(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text(GOOD)
+    out = tmp_path / "store"
+    holder = ResultStore.open_for(out, sweeps.load(path))  # this process holds the store
+    try:
+        proc = subprocess.run([sys.executable, "-m", "armtransfer.cli", "sweep", str(path), "--out", str(out)],
+                              capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 2
+        assert "is in use by another sweep" in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+        assert not list((out / "runs").glob("*.json"))
+    finally:
+        holder.unlock()
+    # released: the same sweep now runs, twice in a row in one process
+    assert main(["sweep", str(path), "--out", str(out)]) == 0
+    assert main(["sweep", str(path), "--out", str(out)]) == 0
+    assert len(list((out / "runs").glob("*.json"))) == 1
+
+
+@pytest.mark.parametrize("delay", [0.3, 0.8])
+def test_ctrl_c_during_start_up_is_one_line(tmp_path, delay):
+    proc = subprocess.Popen([sys.executable, "-m", "armtransfer.cli", "rooms", "--trials", "50"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(delay)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    assert err.strip() == "armtransfer rooms: interrupted"
