@@ -24,7 +24,7 @@ def test_fast_mode_writes_every_output_file(fast_run):
     code, out = fast_run
     assert code == 0
     names = sorted(p.name for p in out.iterdir())
-    assert names == ["learning_curves.png", "map.png", "results.json", "rollout.mp4", "table.md"]
+    assert names == ["learning_curves.png", "map.png", "results.json", "rollout.mp4", "table.md", "timings.json"]
     data = json.loads((out / "results.json").read_text())
     assert data["source"] == "planar2:joint" and data["target"] == "ur5e_like:cartesian"
     assert set(data["results"]) == {"none", "pseudo", "dense"}
@@ -41,14 +41,16 @@ def test_fast_mode_writes_every_output_file(fast_run):
     assert not list(out.parent.glob(".*.tmp"))  # the temporary directory was renamed away
 
 
-def test_same_seed_same_results(fast_run, tmp_path):
+def test_same_seed_same_results_byte_for_byte(fast_run, tmp_path):
+    """Timings and temporary paths stay out of results.json, so a re-run gives the same bytes."""
     code, out = fast_run
     again = tmp_path / "again"
-    assert main(["arms", "--fast", "--out", str(again), "--seed", "3", "--no-video"]) == 0
-    a = json.loads((out / "results.json").read_text())
-    b = json.loads((again / "results.json").read_text())
-    a.pop("rollout")
-    assert a == b
+    assert main(["arms", "--fast", "--out", str(again), "--seed", "3", "--json", str(tmp_path / "r.json")]) == 0
+    assert (out / "results.json").read_bytes() == (again / "results.json").read_bytes()
+    assert (tmp_path / "r.json").read_bytes() == (again / "results.json").read_bytes()
+    data = json.loads((again / "results.json").read_text())
+    assert data["rollout"]["video"] == "rollout.mp4" and (again / data["rollout"]["video"]).is_file()
+    assert json.loads((again / "timings.json").read_text())["rollout"]["seconds"] > 0
 
 
 def test_the_demo_script_has_a_fast_mode(tmp_path):
