@@ -150,6 +150,7 @@ def resolve_trajectories(specs: Sequence[TrajectorySpec], source: DiscreteRobot,
     for spec in specs:
         if isinstance(spec, Trajectory):
             trajectories.check_task(spec, start, goal)
+            trajectories.check_source(spec, source)
             out.append(spec)
         elif spec in ("optimal", "learned"):
             out.append(experiment.source_trajectory(spec, source, start, goal, config, seed))
@@ -159,6 +160,7 @@ def resolve_trajectories(specs: Sequence[TrajectorySpec], source: DiscreteRobot,
         elif isinstance(spec, (str, Path)):
             traj = trajectories.load(spec)
             trajectories.check_task(traj, start, goal)
+            trajectories.check_source(traj, source)
             out.append(traj)
         else:
             raise InvalidParameterError(

@@ -111,15 +111,30 @@ def check_writable(path: str | os.PathLike) -> None:
         raise OutputError(f"cannot write {str(p)!r}: it is a directory")
 
 
+def parse_json_bytes(raw: bytes) -> object:
+    """JSON from a file's bytes; ValueError with the reason (not UTF-8, not JSON, nested too
+    deeply) for anything else. Every JSON file this project reads goes through here."""
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        raise ValueError("is not UTF-8 text") from None
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as err:
+        raise ValueError(f"is not valid JSON (line {err.lineno}: {err.msg})") from None
+    except RecursionError:
+        raise ValueError("nests too deeply to be a file of this project") from None
+
+
 def read_json(path: str | os.PathLike, what: str, error: type[ArmTransferError]) -> object:
     """Parse a JSON file; an unreadable or malformed one raises ``error`` with one line
     naming ``what`` ("trajectory file", "mapping file", ...) and the problem."""
     p = Path(path)
     try:
-        text = p.read_text()
+        raw = p.read_bytes()
     except OSError as err:
         raise error(f"cannot read {what} {str(p)!r}: {err.strerror}") from None
     try:
-        return json.loads(text)
-    except json.JSONDecodeError as err:
-        raise error(f"{what} {str(p)!r} is not valid JSON (line {err.lineno}: {err.msg})") from None
+        return parse_json_bytes(raw)
+    except ValueError as err:
+        raise error(f"{what} {str(p)!r} {err}") from None

@@ -237,6 +237,14 @@ class ActionMapping:
                     f"has {robot.n_actions} actions"
                 )
 
+    def check_source(self, robot: DiscreteRobot) -> None:
+        """Every key is a sequence of the source robot's action indices."""
+        for k in self.entries:
+            if k and max(k) >= robot.n_actions:
+                raise InvalidMappingError(
+                    f"the mapping uses source action {max(k)} but robot {robot.name} has {robot.n_actions} actions"
+                )
+
     # -- names and JSON ------------------------------------------------------------------
 
     def names(self, seq: Sequence[int], side: str) -> str:
@@ -338,6 +346,7 @@ def load_for(path: str | os.PathLike, source: DiscreteRobot, target: DiscreteRob
         return ActionMapping.for_robots(source, target)
     m = ActionMapping.load(path)
     m.check_pair(source.name, target.name)
+    m.check_source(source)
     m.check_target(target)
     return m
 

@@ -12,12 +12,12 @@ done. Temporary files a crash leaves behind start with '.' and are removed on op
 from __future__ import annotations
 
 import fcntl
-import json
 import os
+import sys
 from pathlib import Path
 
 from armtransfer.errors import ArmTransferError
-from armtransfer.io import OutputError, write_json_atomic
+from armtransfer.io import OutputError, parse_json_bytes, write_json_atomic
 from armtransfer.learning.sweep import Sweep
 
 STORE_FORMAT = "armtransfer-store/1"
@@ -100,8 +100,8 @@ class ResultStore:
     def _read_meta(self) -> dict:
         path = self.root / "sweep.json"
         try:
-            meta = json.loads(path.read_text())
-        except (OSError, json.JSONDecodeError):
+            meta = parse_json_bytes(path.read_bytes())
+        except (OSError, ValueError):
             raise StoreError(f"{str(path)!r} is unreadable; this is not a sweep directory") from None
         if not isinstance(meta, dict) or meta.get("format") != STORE_FORMAT:
             raise StoreError(f"{str(path)!r} is not an armtransfer sweep")
@@ -116,14 +116,35 @@ class ResultStore:
         return self.runs_dir / f"{key}.json"
 
     def load_run(self, key: str) -> dict | None:
-        """A finished run, or None when it is absent or not whole (then it is redone)."""
+        """A finished run, or None when it is absent. A run file that cannot be read or has
+        the wrong shape is reported on stderr and set aside into DIR/bad/ (so the run is
+        redone), never fatal."""
+        path = self.run_path(key)
         try:
-            record = json.loads(self.run_path(key).read_text())
-        except (OSError, json.JSONDecodeError):
+            raw = path.read_bytes()
+        except FileNotFoundError:
             return None
-        if not isinstance(record, dict) or record.get("key") != key or "result" not in record:
-            return None
+        except OSError as err:
+            return self._set_aside(path, f"cannot be read ({err.strerror})")
+        try:
+            record = parse_json_bytes(raw)
+        except ValueError as err:
+            return self._set_aside(path, str(err))
+        problem = _run_problem(record, key)
+        if problem:
+            return self._set_aside(path, problem)
         return record
+
+    def _set_aside(self, path: Path, why: str) -> None:
+        bad = self.root / "bad"
+        try:
+            bad.mkdir(exist_ok=True)
+            os.replace(path, bad / path.name)
+            where = f"moved to {str(bad / path.name)!r}"
+        except OSError:
+            where = "left in place"
+        print(f"armtransfer: run file {str(path)!r} {why}; {where}, the run will be redone", file=sys.stderr)
+        return None
 
     def is_done(self, key: str) -> bool:
         return self.load_run(key) is not None
@@ -151,7 +172,32 @@ class ResultStore:
         out = []
         for path in sorted(self.failed_dir.glob("*.json")):
             try:
-                out.append(json.loads(path.read_text()))
-            except (OSError, json.JSONDecodeError):
+                record = parse_json_bytes(path.read_bytes())
+            except (OSError, ValueError):
                 continue
+            if isinstance(record, dict):
+                out.append(record)
         return out
+
+
+RESULT_LISTS = ("exploration_steps", "total_steps", "greedy_steps", "converged")
+
+
+def _run_problem(record: object, key: str) -> str | None:
+    """What is wrong with a run file's content (None: it is a whole run of ``key``)."""
+    if not isinstance(record, dict) or record.get("key") != key:
+        return f"is not a run record of {key}"
+    if not isinstance(record.get("config"), dict) or record["config"].get("key") != key:
+        return "has no configuration of its run"
+    result = record.get("result")
+    if not isinstance(result, dict):
+        return "has no result"
+    lengths = set()
+    for name in RESULT_LISTS:
+        values = result.get(name)
+        if not isinstance(values, list) or not all(v is None or isinstance(v, (int, float)) for v in values):
+            return f"has no list of numbers {name!r}"
+        lengths.add(len(values))
+    if len(lengths) != 1:
+        return "has result lists of different lengths"
+    return None

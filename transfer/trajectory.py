@@ -165,6 +165,15 @@ def load(path: str | os.PathLike, layout: Layout = ROOMS) -> Trajectory:
     return parse(data, layout, where=f"trajectory file {str(Path(path))!r}")
 
 
+def check_source(traj: Trajectory, robot: DiscreteRobot) -> None:
+    """The trajectory's action indices are actions of the robot said to have made it."""
+    bad = [a for a in traj.actions if not 0 <= a < robot.n_actions]
+    if bad:
+        raise InvalidTrajectoryError(
+            f"the trajectory has action index {bad[0]} but the source robot {robot.name} has "
+            f"{robot.n_actions} actions (0..{robot.n_actions - 1})")
+
+
 def check_task(traj: Trajectory, start_cell: int, goal_cell: int, layout: Layout = ROOMS) -> None:
     """A transferred trajectory must be for this task: same start and goal cells."""
     if traj.start != start_cell or traj.goal != goal_cell:
