@@ -68,11 +68,16 @@ def test_families_group_interpolation_against_extrapolation():
     assert matrix.family("ur5e_like:cartesian") == "spatial"
     cells = [matrix.Cell("coarse", "fine", "pseudo", 40.0, (30.0, 50.0), 1, 2, 2),
              matrix.Cell("coarse", "planar2:joint", "pseudo", 10.0, (0.0, 20.0), 1, 2, 2),
+             matrix.Cell("fine", "planar2:joint", "pseudo", -900.0, (-1200.0, -600.0), 1, 2, 2),
+             matrix.Cell("fine", "planar3:joint", "pseudo", 30.0, (20.0, 40.0), 1, 2, 2),
              matrix.Cell("fine", "fine", "pseudo", 20.0, (10.0, 30.0), 1, 2, 2)]
     rows = {r["group"]: r for r in matrix.family_rows(cells)}
-    assert rows["within family"]["mean_improvement"] == 40.0 and rows["within family"]["pairs"] == 1
-    assert rows["across families"]["mean_improvement"] == 10.0
-    assert rows["self"]["mean_improvement"] == 20.0
+    assert rows["within family"]["median_improvement"] == 40.0 and rows["within family"]["pairs"] == 1
+    across = rows["across families"]
+    # the median is not dragged to -287% by one failed pair; helped/hurt count the CIs
+    assert across["pairs"] == 3 and across["median_improvement"] == 10.0
+    assert across["helped"] == 1 and across["hurt"] == 1
+    assert rows["self"]["median_improvement"] == 20.0
 
 
 @pytest.mark.parametrize("args,message", [

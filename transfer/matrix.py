@@ -138,23 +138,28 @@ def _fmt(c: Cell | None) -> str:
 
 
 def family_rows(all_cells: list[Cell]) -> list[dict]:
-    """Per method: the mean improvement within families (interpolation), across families
-    (extrapolation) and robot to itself, with how many pairs each averages."""
+    """Per method and group (a robot to itself, within a family: interpolation, across
+    families: extrapolation): how many pairs, the median improvement (a mean would be ruled by
+    the few pairs where transfer fails badly), and how many pairs transfer helped or hurt with
+    95% confidence (CI above or below 0)."""
     rows = []
     for method in sorted({c.method for c in all_cells}):
-        groups: dict[str, list[float]] = {"self": [], "within family": [], "across families": []}
+        groups: dict[str, list[Cell]] = {"self": [], "within family": [], "across families": []}
         for c in all_cells:
             if c.method != method or c.improvement is None:
                 continue
             if c.source == c.target:
-                groups["self"].append(c.improvement)
+                groups["self"].append(c)
             elif family(c.source) == family(c.target):
-                groups["within family"].append(c.improvement)
+                groups["within family"].append(c)
             else:
-                groups["across families"].append(c.improvement)
-        for name, values in groups.items():
-            rows.append({"method": method, "group": name, "pairs": len(values),
-                         "mean_improvement": float(np.mean(values)) if values else None})
+                groups["across families"].append(c)
+        for name, members in groups.items():
+            values = [c.improvement for c in members]
+            rows.append({"method": method, "group": name, "pairs": len(members),
+                         "median_improvement": float(np.median(values)) if values else None,
+                         "helped": sum(c.ci95[0] > 0 for c in members),
+                         "hurt": sum(c.ci95[1] < 0 for c in members)})
     return rows
 
 
@@ -168,10 +173,11 @@ def markdown(all_cells: list[Cell], robots: list[str]) -> str:
                      + markdown_table(["source \\ target", *robots], rows))
     fam = family_rows(all_cells)
     parts.append("### By family: interpolation (within a family) against extrapolation (across)\n\n"
-                 + markdown_table(["method", "pairs", "group", "mean improvement"],
-                                  [[r["method"], str(r["pairs"]), r["group"],
-                                    "—" if r["mean_improvement"] is None else f"{r['mean_improvement']:.0f}%"]
-                                   for r in fam]))
+                 + markdown_table(["method", "group", "pairs", "median improvement", "helped (CI > 0)",
+                                   "hurt (CI < 0)"],
+                                  [[r["method"], r["group"], str(r["pairs"]),
+                                    "—" if r["median_improvement"] is None else f"{round(r['median_improvement']):d}%",
+                                    str(r["helped"]), str(r["hurt"])] for r in fam]))
     return "\n\n".join(parts)
 
 
