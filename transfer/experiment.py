@@ -144,26 +144,51 @@ def run_mapping(
     return res, learned
 
 
-def summarize(results: Sequence[MethodResult], baseline: str = "none") -> dict:
-    """The JSON ``results`` block: per method, per-trial lists, means, CIs, improvement."""
+def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int | None = None) -> dict:
+    """The JSON ``results`` block: per method, per-trial lists, means, CIs, improvement.
+
+    Exploration statistics count every trial (``metrics.exploration_stats``): one that never
+    reached the goal counts at the step cap, ``cap`` (default: the steps its first episode
+    ran before the cap stopped it, i.e. ``config.max_total_steps``), and the mean is then
+    flagged as a lower bound. Improvements are paired (common random numbers,
+    ``trial_rng``) when the baseline has as many trials, else independent."""
+
+    def cap_of(r: MethodResult) -> int:
+        if cap is not None:
+            return int(cap)
+        stopped = [abs(int(t.episode_steps[0])) for t in r.trials
+                   if t.exploration_steps is None and len(t.episode_steps)]
+        return max(stopped, default=0)
+
     by_name = {r.method: r for r in results}
     base = by_name.get(baseline)
     base_ex = base.column("exploration_steps") if base else None
-    base_mean = metrics.mean_ci(base_ex)[0] if base else None
     out: dict = {}
     for r in results:
         ex = r.column("exploration_steps")
-        mean, ci = metrics.mean_ci(ex)
+        c = max(cap_of(r), cap_of(base) if base else 0)
+        st = metrics.exploration_stats(ex, c)
         total = r.column("total_steps")
         greedy = r.column("greedy_steps")
         t_mean, t_ci = metrics.mean_ci(total)
         g_mean, g_ci = metrics.mean_ci(greedy)
+        imp = None
+        if r.method != baseline and base is not None:
+            imp = metrics.paired_improvement(base_ex, ex, c, paired=len(base_ex) == len(ex))
         entry = {
             "exploration_steps": ex,
-            "mean": mean,
-            "ci95": ci,
-            "improvement_percent": None if r.method == baseline else metrics.improvement_percent(base_mean, mean),
-            "improvement_ci95": None if r.method == baseline or base is None else metrics.improvement_ci(base_ex, ex),
+            "mean": st["mean"],
+            "ci95": st["ci95"],
+            "reached": st["reached"],
+            "cap": c,
+            "mean_is_lower_bound": st["mean_is_lower_bound"],
+            "median": st["median"],
+            "median_ci95": st["median_ci95"],
+            "median_ci_coverage": st["median_ci_coverage"],
+            "median_is_lower_bound": st["median_is_lower_bound"],
+            "improvement_percent": None if imp is None else imp["percent"],
+            "improvement_ci95": None if imp is None else imp["ci95"],
+            "improvement_design": None if imp is None else imp["design"],
             "greedy_steps": greedy,
             "greedy_mean": g_mean,
             "greedy_ci95": g_ci,
