@@ -138,3 +138,30 @@ def mapping_paths(
     ax.set_title(title)
     ax.legend(loc="lower right", fontsize=8)
     _save(fig, path)
+
+
+def task_layout(
+    wall_mask: np.ndarray,
+    lo: int,
+    tasks: list[tuple[str, tuple[int, int], tuple[int, int]]],
+    title: str,
+    path: str | os.PathLike,
+) -> None:
+    """Fig. 3 analog: the rooms map with each task's start (square) and goal (star)."""
+    fig, ax = plt.subplots(figsize=(6.5, 6.5))
+    hi = lo + wall_mask.shape[0] - 1
+    ax.imshow(wall_mask, origin="lower", cmap="Greys", extent=(lo - 0.5, hi + 0.5, lo - 0.5, hi + 0.5),
+              vmin=0, vmax=1.4)
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for k, (name, start, goal) in enumerate(tasks):
+        c = colors[k % len(colors)]
+        ax.plot(*start, "s", color=c, ms=9, label=f"{name}: start {start}")
+        ax.plot(*goal, "*", color=c, ms=14, label=f"{name}: goal {goal}")
+        ax.annotate(name.split()[-1], start, textcoords="offset points", xytext=(5, 5), color=c)
+        ax.annotate(name.split()[-1], goal, textcoords="offset points", xytext=(5, 5), color=c)
+    ax.set_xlim(lo - 0.5, hi + 0.5)
+    ax.set_ylim(lo - 0.5, hi + 0.5)
+    ax.set_aspect("equal")
+    ax.set_title(title)
+    ax.legend(loc="lower right", fontsize=7)
+    _save(fig, path)

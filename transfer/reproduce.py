@@ -1,4 +1,12 @@
-"""``armtransfer reproduce``: the paper's experiments on our rooms world, and report.md.
+"""``armtransfer reproduce``: runs the paper's experiments on our rooms world and returns
+their results as one JSON-able dict; ``reproduce_report`` writes report.md from it.
+
+The paper's protocol by default: the transferred trajectory is the source robot's
+converged greedy path after learning (``trajectory="learned"``; ``"optimal"``: its
+breadth-first shortest path), and the mapping of each task is learned from ONE converged
+trial of it (``mapping_from="single"``, the first converged one in trial order; ``"pooled"``:
+every converged trial). The other choice of each is run too, on coarse -> fine, for the
+report's comparison (``alternatives``).
 
 What runs (every number with a 95% confidence interval over ``trials`` trials):
   * Table II A-C: coarse -> fine, tasks 1-4, no transfer vs transfer (pseudo rewards);
@@ -21,9 +29,17 @@ from armtransfer.learning import beyond, experiment, metrics, paper
 from armtransfer.learning.mapping import ActionMapping, MacroTable
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.learning.report import fmt_ci, fmt_num, markdown_table
+from armtransfer.errors import InvalidParameterError
 
 TASKS = (1, 2, 3, 4)
+TRAJECTORIES = ("learned", "optimal")
+MAPPING_FROM = ("single", "pooled")
+
+
+def source_traj(task: int, source: str, kind: str, seed: int, config: LearnerConfig) -> trajectories.Trajectory:
+    """The trajectory the source robot hands over on a Table I task (``learned``/``optimal``)."""
+    start, goal = TABLE_I[task].cells()
+    return experiment.source_trajectory(kind, grid_robot(source), start, goal, config, seed)
 
 
 def _compare(
@@ -37,11 +53,12 @@ def _compare(
     wind: float = 0.0,
     traj: trajectories.Trajectory | None = None,
     tick: Callable[[], None] | None = None,
+    kind: str = "learned",
 ) -> dict:
     src, tgt = grid_robot(source), grid_robot(target)
     start, goal = TABLE_I[task].cells()
     if traj is None:
-        traj = trajectories.shortest(src, start, goal)
+        traj = source_traj(task, source, kind, seed, config)
     results = [
         experiment.run_method(m, tgt, start, goal, traj, trials, seed, config, wind=wind, on_trial=tick)
         for m in methods
@@ -55,6 +72,7 @@ def _compare(
         "target": target,
         "wind": wind,
         "distance": len(tgt.shortest_path(tgt.start_state(start), goal)) - 1,
+        "trajectory_kind": kind,
         "trajectory_length": len(traj),
         "trajectory_cells": len(traj) * src.cell_step,
         "results": summary,
@@ -63,7 +81,9 @@ def _compare(
 
 def plan(trials: int) -> int:
     """How many trials ``run_all`` runs (for progress bars)."""
-    return trials * (2 * len(TASKS) * 3 + len(paper.TABLE_IV_WAYPOINTS) + 1 + 3 * len(TASKS)) + beyond.plan(trials)
+    main = 2 * len(TASKS) * 3 + len(paper.TABLE_IV_WAYPOINTS) + 1 + 3 * len(TASKS)
+    alternatives = len(TASKS) + len(TASKS)  # pseudo with the other trajectory; the other mapping
+    return trials * (main + alternatives) + beyond.plan(trials)
 
 
 TOP_ENTRIES = 12
@@ -77,24 +97,37 @@ def mapping_protocol(
     config: LearnerConfig,
     wind: float = 0.0,
     tick: Callable[[], None] | None = None,
+    kind: str = "learned",
+    mapping_from: str = "single",
 ) -> dict:
-    """Tasks 1-4 in order with method ``mapping``: task k uses the mapping learned from the
-    converged trials of tasks 1..k-1 (task 1 has none, so it equals ``pseudo``)."""
+    """Tasks 1-4 in order with method ``mapping``: task k uses the mapping learned on tasks
+    1..k-1 (task 1 has none, so it equals ``pseudo``): from the first converged trial of
+    each task (``single``, the paper's) or from all its converged trials (``pooled``)."""
+    if mapping_from not in MAPPING_FROM:
+        raise InvalidParameterError(f"unknown mapping source {mapping_from!r}; valid: {', '.join(MAPPING_FROM)}")
     src, tgt = grid_robot(source), grid_robot(target)
     mapping = ActionMapping.for_robots(src, tgt)
-    out: dict = {"source": source, "target": target, "wind": wind, "tasks": {}}
+    out: dict = {"source": source, "target": target, "wind": wind, "tasks": {},
+                 "trajectory_kind": kind, "mapping_from": mapping_from}
     figure = None
     for t in TASKS:
         start, goal = TABLE_I[t].cells()
-        traj = trajectories.shortest(src, start, goal)
+        traj = source_traj(t, source, kind, seed, config)
         res, learned = experiment.run_mapping(tgt, start, goal, traj, mapping, trials, seed, config,
                                               wind=wind, on_trial=tick)
+        learned_from = [k for k, trial in enumerate(res.trials) if trial.converged]
+        if mapping_from == "single":
+            learned = mapping.copy()
+            learned_from = learned_from[:1]
+            for k in learned_from:
+                learned.learn_from(tgt, res.trials[k].greedy_path, traj)
         summary = experiment.summarize([res], baseline="")["mapping"]
         experiment.compact(summary)
         percent = [None if f is None else 100.0 * f for f in res.extra["mapped_fraction"]]
         e_mean, e_ci = metrics.mean_ci(percent)
         summary.update(mapped_percent_mean=e_mean, mapped_percent_ci95=e_ci,
-                       entries_before=len(mapping), entries_after=len(learned))
+                       entries_before=len(mapping), entries_after=len(learned),
+                       mapping_learned_from_trials=learned_from, trajectory_length=len(traj))
         out["tasks"][t] = summary
         # Fig. 7 candidate: the converged trial with the largest mapped fraction
         table = MacroTable(mapping, traj, tgt)
@@ -119,19 +152,33 @@ def _add_improvement(protocol: dict, baseline: dict) -> None:
     """Column F (Table V: E): improvement of the mapping runs over no transfer."""
     for t in TASKS:
         r, base = protocol["tasks"][t], baseline[t]["results"]["none"]
-        r["improvement_percent"] = metrics.improvement_percent(base["mean"], r["mean"])
-        r["improvement_ci95"] = metrics.improvement_ci(base["exploration_steps"], r["exploration_steps"])
+        _improve(r, base)
+
+
+def _improve(r: dict, base: dict) -> None:
+    """Improvement of entry ``r`` over ``base``, paired trial by trial (common random numbers)."""
+    cap = max(r.get("cap") or 0, base.get("cap") or 0)
+    imp = metrics.paired_improvement(base["exploration_steps"], r["exploration_steps"], cap,
+                                     paired=len(base["exploration_steps"]) == len(r["exploration_steps"]))
+    r["improvement_percent"], r["improvement_ci95"], r["improvement_design"] = imp["percent"], imp["ci95"], imp["design"]
 
 
 def run_all(
-    trials: int, seed: int, config: LearnerConfig, tick: Callable[[], None] | None = None
+    trials: int, seed: int, config: LearnerConfig, tick: Callable[[], None] | None = None,
+    trajectory: str = "learned", mapping_from: str = "single",
 ) -> dict:
-    out: dict = {"trials": trials, "seed": seed, "config": config.to_dict()}
+    if trajectory not in TRAJECTORIES:
+        raise InvalidParameterError(f"unknown trajectory kind {trajectory!r}; valid: {', '.join(TRAJECTORIES)}")
+    if mapping_from not in MAPPING_FROM:
+        raise InvalidParameterError(f"unknown mapping source {mapping_from!r}; valid: {', '.join(MAPPING_FROM)}")
+    out: dict = {"trials": trials, "seed": seed, "config": config.to_dict(),
+                 "trajectory": trajectory, "mapping_from": mapping_from}
     both = ("none", "pseudo")
-    out["table_ii"] = {t: _compare(t, "coarse", "fine", both, trials, seed, config, tick=tick) for t in TASKS}
-    out["table_v"] = {t: _compare(t, "fine", "coarse", both, trials, seed, config, tick=tick) for t in TASKS}
+    kw = dict(tick=tick, kind=trajectory)
+    out["table_ii"] = {t: _compare(t, "coarse", "fine", both, trials, seed, config, **kw) for t in TASKS}
+    out["table_v"] = {t: _compare(t, "fine", "coarse", both, trials, seed, config, **kw) for t in TASKS}
     out["wind"] = {
-        t: _compare(t, "coarse", "fine", both, trials, seed, config, wind=paper.WIND, tick=tick) for t in TASKS
+        t: _compare(t, "coarse", "fine", both, trials, seed, config, wind=paper.WIND, **kw) for t in TASKS
     }
     coarse = grid_robot("coarse")
     start, goal = TABLE_I[2].cells()
@@ -139,359 +186,36 @@ def run_all(
     for name, waypoints in paper.TABLE_IV_WAYPOINTS.items():
         traj = trajectories.via(coarse, start, goal, [ROOMS.cell(*w) for w in waypoints])
         methods = ("none", "pseudo") if name == "optimal" else ("pseudo",)
-        rows[name] = _compare(2, "coarse", "fine", methods, trials, seed, config, traj=traj, tick=tick)
+        rows[name] = _compare(2, "coarse", "fine", methods, trials, seed, config, traj=traj, tick=tick,
+                              kind="optimal" if name == "optimal" else f"detour {name}")
     base = rows["optimal"]["results"]["none"]
     for name, row in rows.items():
         r = row["results"]["pseudo"]
-        r["improvement_percent"] = metrics.improvement_percent(base["mean"], r["mean"])
-        r["improvement_ci95"] = metrics.improvement_ci(base["exploration_steps"], r["exploration_steps"])
+        _improve(r, base)
         r["greedy_improvement_percent"] = metrics.improvement_percent(base["greedy_mean"], r["greedy_mean"])
     out["table_iv"] = rows
-    out["mapping_coarse_fine"] = mapping_protocol("coarse", "fine", trials, seed, config, tick=tick)
+    mkw = dict(tick=tick, kind=trajectory, mapping_from=mapping_from)
+    out["mapping_coarse_fine"] = mapping_protocol("coarse", "fine", trials, seed, config, **mkw)
     _add_improvement(out["mapping_coarse_fine"], out["table_ii"])
-    out["mapping_fine_coarse"] = mapping_protocol("fine", "coarse", trials, seed, config, tick=tick)
+    out["mapping_fine_coarse"] = mapping_protocol("fine", "coarse", trials, seed, config, **mkw)
     _add_improvement(out["mapping_fine_coarse"], out["table_v"])
-    out["mapping_wind"] = mapping_protocol("coarse", "fine", trials, seed, config, wind=paper.WIND, tick=tick)
+    out["mapping_wind"] = mapping_protocol("coarse", "fine", trials, seed, config, wind=paper.WIND, **mkw)
     _add_improvement(out["mapping_wind"], out["wind"])
+    # the other protocol choices, coarse -> fine, for the report's comparison
+    other_kind = next(k for k in TRAJECTORIES if k != trajectory)
+    other_from = next(k for k in MAPPING_FROM if k != mapping_from)
+    alt_ii = {t: _compare(t, "coarse", "fine", ("pseudo",), trials, seed, config, tick=tick, kind=other_kind)
+              for t in TASKS}
+    for t in TASKS:
+        _improve(alt_ii[t]["results"]["pseudo"], out["table_ii"][t]["results"]["none"])
+    alt_map = mapping_protocol("coarse", "fine", trials, seed, config, tick=tick, kind=trajectory,
+                               mapping_from=other_from)
+    _add_improvement(alt_map, out["table_ii"])
+    out["alternatives"] = {"trajectory": other_kind, "table_ii": alt_ii,
+                           "mapping_from": other_from, "mapping_coarse_fine": alt_map}
     fine = grid_robot("fine")
     out["methods"] = beyond.run_methods(coarse, fine, trials, seed, config, tick=tick)
     out["oracle_text"], out["oracle"] = beyond.oracle_markdown(coarse, fine, trials, seed, config)
     return out
 
 
-# ----------------------------------------------------------------------------- report
-
-MAPPING_PROTOCOL_TEXT = (
-    "Protocol as the paper: tasks 1, 2, 3, 4 in this order; the mapping learned on task 1 is used on "
-    "task 2, the one accumulated over tasks 1-2 on task 3, and so on. Each task's trials all use the "
-    "mapping of the tasks before it; afterwards the mapping is updated from every converged trial's "
-    "greedy path. A key is learned between every two matched states (same cell) of the transferred "
-    "trajectory and the converged greedy path, the shorter target sequence wins. On a later task, a "
-    "robot at a trajectory cell whose upcoming key is mapped runs the mapped sequence as a macro "
-    "with probability 1 - epsilon, during the exploration phase (until the goal is first reached; "
-    "offered in every episode, macros keep the robot from ever trying the other actions along the "
-    "path: on tasks 2-4, coarse -> fine, none of 10 trials per task converged in 2000 episodes). "
-    "Method = pseudo rewards + macros."
-)
-
-
-def fig7_caption(fig: dict | None) -> str:
-    if fig is None:
-        return "No converged trial used a macro, so there is no Fig. 7 analog."
-    return (
-        f"Fig. 7 analog: task {fig['task']}, coarse -> fine, trial {fig['trial']} (the converged trial with "
-        f"the largest mapped share, {100 * fig['mapped_fraction']:.1f}% of its {len(fig['target_cells']) - 1} "
-        "steps). Dashed: the coarse robot's transferred trajectory; solid: the fine robot's converged "
-        "greedy path; thick: fragments equal to the macro available where they start."
-    )
-
-
-
-def _cell(mean: float | None, ci: list[float] | None, digits: int = 1) -> str:
-    return f"{fmt_num(mean, digits)} {fmt_ci(ci, digits)}"
-
-
-def _paper(x: float | None, digits: int = 1) -> str:
-    return "NA" if x is None else f"{x:,.{digits}f}"
-
-
-def _verdict(ours: float | None, ci: list[float] | None, theirs: float | None) -> str:
-    """Compare our improvement with the paper's: better / within CI / worse."""
-    if ours is None or theirs is None:
-        return ""
-    if ci is not None and ci[0] <= theirs <= ci[1]:
-        return "as paper (within CI)"
-    return "better than paper" if ours > theirs else "**worse than paper**"
-
-
-def table_ii_markdown(res: dict, paper_table: dict, title: str) -> str:
-    header = ["task", "distance", "A paper", "A ours [95% CI]", "B paper", "B ours [95% CI]",
-              "C paper %", "C ours % [95% CI]", "vs paper"]
-    rows = []
-    for t in TASKS:
-        r = res[t]["results"]
-        p = paper_table[t]
-        rows.append([
-            str(t),
-            str(res[t]["distance"]),
-            _paper(p["A"]),
-            _cell(r["none"]["mean"], r["none"]["ci95"]),
-            _paper(p["B"]),
-            _cell(r["pseudo"]["mean"], r["pseudo"]["ci95"]),
-            _paper(p["C"], 2),
-            _cell(r["pseudo"]["improvement_percent"], r["pseudo"]["improvement_ci95"]),
-            _verdict(r["pseudo"]["improvement_percent"], r["pseudo"]["improvement_ci95"], p["C"]),
-        ])
-    return f"### {title}\n\n" + markdown_table(header, rows)
-
-
-def table_iv_markdown(rows: dict) -> str:
-    header = ["trajectory", "length (cells) paper", "length (cells) ours", "A paper", "A ours [95% CI]",
-              "B paper %", "B ours % [95% CI]", "C paper", "C ours [95% CI]", "D paper %", "D ours %"]
-    out = []
-    base = rows["optimal"]["results"]["none"]
-    p0 = paper.TABLE_IV["no transfer"]
-    out.append(["no transfer", "NA", "NA", _paper(p0["A"]), _cell(base["mean"], base["ci95"]), "NA", "",
-                _paper(p0["C"]), _cell(base["greedy_mean"], base["greedy_ci95"]), "NA", ""])
-    for name, row in rows.items():
-        r = row["results"]["pseudo"]
-        p = paper.TABLE_IV[name]
-        out.append([
-            name,
-            str(p["distance"]),
-            str(row["trajectory_cells"]),
-            _paper(p["A"]),
-            _cell(r["mean"], r["ci95"]),
-            _paper(p["B"], 2),
-            _cell(r["improvement_percent"], r["improvement_ci95"]),
-            _paper(p["C"]),
-            _cell(r["greedy_mean"], r["greedy_ci95"]),
-            _paper(p["D"], 2),
-            fmt_num(r["greedy_improvement_percent"]),
-        ])
-    return (
-        "### Table IV: task 2, coarse -> fine, different transferred trajectories\n\n"
-        + markdown_table(header, out)
-        + "\n\nA: exploration steps with transfer; B: improvement over no transfer; C: greedy steps "
-        "of the converged policy; D: improvement of C. Our sets are the coarse robot's shortest "
-        "paths through waypoints "
-        + ", ".join(f"{k}: {v}" for k, v in paper.TABLE_IV_WAYPOINTS.items() if v)
-        + " (set 2 enters room 2 and comes back: a loop)."
-    )
-
-
-def wind_markdown(res: dict) -> str:
-    header = ["task", "no transfer [95% CI]", "transfer [95% CI]", "improvement % [95% CI]", "converged"]
-    rows = []
-    for t in TASKS:
-        r = res[t]["results"]
-        conv = r["pseudo"]["converged"]
-        rows.append([
-            str(t),
-            _cell(r["none"]["mean"], r["none"]["ci95"]),
-            _cell(r["pseudo"]["mean"], r["pseudo"]["ci95"]),
-            _cell(r["pseudo"]["improvement_percent"], r["pseudo"]["improvement_ci95"]),
-            f"{sum(conv)}/{len(conv)}",
-        ])
-    return (
-        f"### Wind (section IV.C, Fig. 6): coarse -> fine, wind {paper.WIND}\n\n"
-        + markdown_table(header, rows)
-        + "\n\nThe paper gives Fig. 6 only as a chart (not in its text), so there are no numbers to set beside these."
-    )
-
-
-def _entries_used(r: dict) -> str:
-    return f"{r['entries_before']}"
-
-
-def table_ii_mapping_markdown(res: dict) -> str:
-    header = ["task", "B ours (transfer)", "D paper", "D ours [95% CI]", "E paper %", "E ours % [95% CI]",
-              "F paper %", "F ours % [95% CI]", "F vs paper", "entries used"]
-    rows = []
-    for t in TASKS:
-        r = res["mapping_coarse_fine"]["tasks"][t]
-        b = res["table_ii"][t]["results"]["pseudo"]
-        p = paper.TABLE_II[t]
-        rows.append([
-            str(t),
-            fmt_num(b["mean"]),
-            _paper(p["D"]),
-            _cell(r["mean"], r["ci95"]),
-            _paper(p["E"], 2),
-            _cell(r["mapped_percent_mean"], r["mapped_percent_ci95"]) if r["mapped_percent_mean"] is not None else "NA",
-            _paper(p["F"], 2),
-            _cell(r["improvement_percent"], r["improvement_ci95"]),
-            _verdict(r["improvement_percent"], r["improvement_ci95"], p["F"]),
-            _entries_used(r),
-        ])
-    return (
-        "### Table II D-F: coarse -> fine with action sequence mapping (tasks 1 -> 2 -> 3 -> 4)\n\n"
-        + markdown_table(header, rows)
-        + "\n\nD: exploration steps with transfer and mapping; E: share of the converged greedy path's "
-        "steps that lie in a segment equal to a macro available on that task; F: improvement of D over "
-        "no transfer (A of the table above). Task k uses the mapping learned on tasks 1..k-1 (\"entries "
-        "used\"); task 1 has none, so D equals B there and E is NA, as in the paper."
-    )
-
-
-def table_v_mapping_markdown(res: dict) -> str:
-    header = ["task", "B ours (transfer)", "D paper", "D ours [95% CI]", "E paper %", "E ours % [95% CI]",
-              "E vs paper", "mapped % of final path [95% CI]", "entries used"]
-    rows = []
-    for t in TASKS:
-        r = res["mapping_fine_coarse"]["tasks"][t]
-        b = res["table_v"][t]["results"]["pseudo"]
-        p = paper.TABLE_V[t]
-        rows.append([
-            str(t),
-            fmt_num(b["mean"]),
-            _paper(p["D"]),
-            _cell(r["mean"], r["ci95"]),
-            _paper(p["E"], 2),
-            _cell(r["improvement_percent"], r["improvement_ci95"]),
-            _verdict(r["improvement_percent"], r["improvement_ci95"], p["E"]),
-            _cell(r["mapped_percent_mean"], r["mapped_percent_ci95"]) if r["mapped_percent_mean"] is not None else "NA",
-            _entries_used(r),
-        ])
-    return (
-        "### Table V D-E: fine -> coarse with action sequence mapping (tasks 1 -> 2 -> 3 -> 4)\n\n"
-        + markdown_table(header, rows)
-        + "\n\nD: exploration steps with transfer and mapping; E: improvement of D over no transfer. "
-        "The paper's Table V has no mapped-share column; ours is given for comparison with Table II E."
-    )
-
-
-def table_iii_markdown(protocol: dict, title: str) -> str:
-    m = ActionMapping.from_json(protocol["mapping"])
-    entries = sorted(m.entries.items(), key=lambda kv: (-kv[1].count, len(kv[0]), kv[0]))
-    rows = [[str(n + 1), m.names(k, "source"), m.names(e.target, "target"), str(e.count)]
-            for n, (k, e) in enumerate(entries[:TOP_ENTRIES])]
-    loops = [(k, e) for k, e in entries if not e.target]
-    text = (
-        f"### {title}\n\n"
-        + markdown_table(["#", f"{m.source} action index sequence", f"{m.target} mapped action sequence", "seen"],
-                         rows)
-        + f"\n\nThe {TOP_ENTRIES} most often seen of {len(m)} entries after task 4 (\"-\" is the empty "
-        "sequence, \"no action\")."
-    )
-    if loops:
-        text += " Keys mapped to no action: " + ", ".join(f"`{m.names(k, 'source')}`" for k, _ in loops[:8]) + "."
-    else:
-        text += (" No key maps to no action: the transferred trajectories are the source robot's shortest "
-                 "paths and have no loops (the hand-made tests check that a loop maps to no action).")
-    return text
-
-
-def wind_mapping_markdown(res: dict) -> str:
-    header = ["task", "no transfer [95% CI]", "transfer [95% CI]", "transfer + mapping [95% CI]",
-              "improvement % [95% CI]", "mapped % of final path", "converged"]
-    rows = []
-    for t in TASKS:
-        w = res["wind"][t]["results"]
-        r = res["mapping_wind"]["tasks"][t]
-        conv = r["converged"]
-        rows.append([
-            str(t),
-            _cell(w["none"]["mean"], w["none"]["ci95"]),
-            _cell(w["pseudo"]["mean"], w["pseudo"]["ci95"]),
-            _cell(r["mean"], r["ci95"]),
-            _cell(r["improvement_percent"], r["improvement_ci95"]),
-            fmt_num(r["mapped_percent_mean"]),
-            f"{sum(conv)}/{len(conv)}",
-        ])
-    return (
-        f"### Action sequence mapping under wind {paper.WIND} (coarse -> fine, tasks 1 -> 2 -> 3 -> 4)\n\n"
-        + markdown_table(header, rows)
-        + "\n\nUnder wind the mapping is learned the same way, from the converged greedy paths (which "
-        "are evaluated without wind), and reused the same way: a gust during a macro moves the robot "
-        "one cell to the right and the macro goes on from there (it is abandoned only when a step is "
-        "blocked). The paper gives no numbers for this case."
-        + _ratio_sentence(res["mapping_wind"], res["wind"], "under wind")
-    )
-
-
-def _ratio_sentence(protocol: dict, base: dict, where: str) -> str:
-    """A measured summary: D as a share of B (transfer alone) on the tasks that had a mapping."""
-    ratios = [
-        protocol["tasks"][t]["mean"] / base[t]["results"]["pseudo"]["mean"]
-        for t in TASKS[1:]
-        if protocol["tasks"][t]["mean"] and base[t]["results"]["pseudo"]["mean"]
-    ]
-    if not ratios:
-        return ""
-    return (
-        f" Measured here: {where}, on tasks {TASKS[1]}-{TASKS[-1]} the mapping leaves "
-        f"{100 * min(ratios):.1f}-{100 * max(ratios):.1f}% of the exploration steps of transfer alone."
-    )
-
-
-def report_markdown(res: dict, figures: dict[str, str]) -> str:
-    cfg = res["config"]
-    lines = [
-        "# Reproduction of Lakshmanan & Ravindran (2010) on our rooms world",
-        "",
-        f"{res['trials']} trials per cell (the paper: {paper.PAPER_TRIALS}), seed {res['seed']}. "
-        "Means with 95% t-intervals over trials; improvement intervals by the delta method. "
-        "Exploration steps = steps until the goal is first reached.",
-        "",
-        f"Learner: SARSA(lambda), alpha {cfg['alpha']}, gamma {cfg['gamma']}, lambda {cfg['lam']}, "
-        f"epsilon {cfg['epsilon']}, step reward {cfg['step_reward']}, goal reward {cfg['goal_reward']}, "
-        "K = half the farming bound -step_reward/n, Q = 0 initially.",
-        "",
-        table_ii_markdown(res["table_ii"], paper.TABLE_II, "Table II A-C: coarse (larger) -> fine robot"),
-        "",
-        f"![Fig. 4 analog]({figures['fig4']})",
-        "",
-        table_ii_markdown(res["table_v"], paper.TABLE_V, "Table V A-C: fine -> coarse (larger) robot"),
-        "",
-        f"![Fig. 5 analog]({figures['fig5']})",
-        "",
-        table_iv_markdown(res["table_iv"]),
-        "",
-        wind_markdown(res["wind"]),
-        "",
-        f"![Fig. 6 analog]({figures['fig6']})",
-        "",
-        "## Action sequence mapping (section III.C)",
-        "",
-        MAPPING_PROTOCOL_TEXT,
-        "",
-        table_ii_mapping_markdown(res),
-        "",
-        table_v_mapping_markdown(res),
-        "",
-        table_iii_markdown(res["mapping_coarse_fine"], "Table III analog: coarse -> fine mapping after tasks 1-4"),
-        "",
-        table_iii_markdown(res["mapping_fine_coarse"], "Table III analog: fine -> coarse mapping after tasks 1-4"),
-        "",
-        f"![Fig. 7 analog]({figures['fig7']})",
-        "",
-        fig7_caption(res["mapping_coarse_fine"]["figure"]),
-        "",
-        wind_mapping_markdown(res),
-        "",
-        "## Beyond the paper",
-        "",
-        beyond.methods_markdown(res["methods"]),
-        "",
-        res["oracle_text"],
-        "",
-        f"![All methods]({figures['methods']})",
-        "",
-        beyond.controls_markdown(res["methods"], res["config"]["max_total_steps"]),
-        "",
-        beyond.metrics_markdown(res["methods"]),
-        "",
-        "## Where we differ from the paper, and why",
-        "",
-        "- The rooms layout is ours: the paper's Fig. 3 is not in its text. Only the four tasks' "
-        "1-cell distances (20, 34, 40, 76) and rooms are matched; door positions, room shapes and "
-        "so the difficulty of each task differ.",
-        "- The paper does not state alpha, gamma, lambda, epsilon, the rewards, K or the trajectories "
-        "it transferred. We transfer the source robot's breadth-first shortest path and use the "
-        "parameters above; none were tuned to match the paper.",
-        "- Rows marked **worse than paper** have a smaller improvement than the paper's, outside our "
-        "95% interval. With a negative step reward and Q = 0, the learner already explores "
-        "systematically without transfer, and the pseudo reward, bounded below the farming limit "
-        "(step reward + n*K < 0), only makes trajectory states less costly; it cannot pull the agent "
-        "towards a trajectory it has not yet met, and a bonus below 1 per step barely changes which "
-        "untried action looks best. The paper's larger gains suggest a different reward scale or "
-        "exploration scheme, which its text does not give.",
-        "- Action sequence mapping helps far more here than in the paper (column F). Our macros run only in the exploration phase (the first episode) "
-        "with probability 1 - epsilon at every trajectory cell with a mapped key, and the keys our "
-        "shortest-path trajectories need most (`4`, `4 4`, `1`, ...) map to straight runs (`L L`, "
-        "`L L L L`, `F F`; Table III analog) that are right almost everywhere in open rooms, so the "
-        "robot mostly walks the trajectory. "
-        "The paper does not say how often or where it offered macros, nor how it scored 'useful' ones."
-        + _ratio_sentence(res["mapping_coarse_fine"], res["table_ii"], "coarse -> fine")
-        + _ratio_sentence(res["mapping_fine_coarse"], res["table_v"], "fine -> coarse"),
-        "- Column E (mapped share of the final path) is lower than the paper's: it counts only steps "
-        "in segments that equal, exactly, the macro offered where the segment starts; after many "
-        "later episodes without macros the converged path often reaches the same cells by another "
-        "order of moves. The paper does not define its E precisely.",
-        "- The paper reports means of 10 trials without intervals; with 10 trials our own intervals are "
-        "often +-30-50% of the mean, so single-digit differences between our numbers and the paper's "
-        "mean little. For a tighter estimate of one task, run `armtransfer rooms --task N --trials 300 "
-        "--no-controls`.",
-    ]
-    return "\n".join(lines) + "\n"
