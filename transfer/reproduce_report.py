@@ -251,8 +251,10 @@ def wind_mapping_markdown(res: dict) -> str:
         + markdown_table(header, rows)
         + "\n\nUnder wind the mapping is learned the same way, from the converged greedy paths (which "
         "are evaluated without wind), and reused the same way: a gust during a macro moves the robot "
-        "one cell to the right and the macro goes on from there (it is abandoned only when a step is "
-        "blocked). The paper gives no numbers for this case."
+        "one cell to the right and the macro goes on from there (it is abandoned only when the robot "
+        "observes that it did not move, after wind: it cannot tell a wall from a gust). The greedy paths "
+        "the mapping is learned from, and the converged counts, are rolled out without wind. The paper "
+        "gives no numbers for this case."
         + _ratio_sentence(res["mapping_wind"], res["wind"], "under wind")
     )
 
