@@ -180,7 +180,7 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int 
             "mean": st["mean"],
             "ci95": st["ci95"],
             "reached": st["reached"],
-            "cap": c,
+            "cap": c or None,
             "mean_is_lower_bound": st["mean_is_lower_bound"],
             "median": st["median"],
             "median_ci95": st["median_ci95"],

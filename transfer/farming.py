@@ -47,12 +47,13 @@ TIE_TOL = 1e-7
 
 
 @numba.njit(cache=True)
-def _value_iteration(nxt, wind_nxt, reward, terminal, gamma, wind, tol, max_iter, V):
-    """In-place VI on V; returns the number of sweeps. ``nxt``/``wind_nxt`` are [S, A]."""
-    S, A = nxt.shape
+def _value_iteration(nxt, wind_nxt, reward, terminal, gamma, wind, tol, max_iter, V, states):
+    """In-place VI on V over ``states`` (closed under successors); returns the number of
+    sweeps. ``nxt``/``wind_nxt`` are [S, A]."""
+    A = nxt.shape[1]
     for it in range(max_iter):
         diff = 0.0
-        for s in range(S):
+        for s in states:
             best = -np.inf
             for a in range(A):
                 t = nxt[s, a]
@@ -84,8 +85,12 @@ class FarmingResult:
 
 def shaped_q(robot: DiscreteRobot, goal_cell: int, bonus: np.ndarray, step_reward: float,
              goal_reward: float, gamma: float, wind: float = 0.0, tol: float = 1e-10,
-             max_iter: int = 1_000_000, V0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, int]:
-    """(Q*, V*, sweeps) of the task shaped by the per-state ``bonus`` (mode PSEUDO)."""
+             max_iter: int = 1_000_000, V0: np.ndarray | None = None,
+             start_state: int | None = None) -> tuple[np.ndarray, np.ndarray, int]:
+    """(Q*, V*, sweeps) of the task shaped by the per-state ``bonus`` (mode PSEUDO).
+
+    With ``start_state``, only the states reachable from it (by any action, with or
+    without wind) are solved; Q and V elsewhere are then meaningless."""
     if not 0.0 <= gamma < 1.0:
         raise InvalidParameterError(f"the exact farming check needs gamma in [0, 1), got {gamma}")
     if not 0.0 <= wind <= 1.0:
@@ -95,12 +100,28 @@ def shaped_q(robot: DiscreteRobot, goal_cell: int, bonus: np.ndarray, step_rewar
     terminal = robot.label == goal_cell
     reward = step_reward + np.asarray(bonus, dtype=np.float64) + np.where(terminal, goal_reward, 0.0)
     V = np.zeros(robot.n_states) if V0 is None else np.array(V0, dtype=np.float64)
-    sweeps = _value_iteration(nxt, wnxt, reward, terminal, float(gamma), float(wind), tol, max_iter, V)
+    states = (np.arange(robot.n_states) if start_state is None
+              else np.flatnonzero(reachable(robot, start_state, wind))).astype(np.int64)
+    sweeps = _value_iteration(nxt, wnxt, reward, terminal, float(gamma), float(wind), tol, max_iter, V, states)
     cont = np.where(terminal, 0.0, gamma * V)
     Q = reward[nxt] + cont[nxt]
     if wind > 0.0:
         Q = (1.0 - wind) * Q + wind * (reward[wnxt] + cont[wnxt])
     return Q, V, sweeps
+
+
+def reachable(robot: DiscreteRobot, start_state: int, wind: float = 0.0) -> np.ndarray:
+    """Boolean mask of the states reachable from ``start_state`` by any actions (and wind)."""
+    succ = robot.next_state if wind <= 0.0 else np.hstack([robot.next_state, robot.wind_state[robot.next_state]])
+    seen = np.zeros(robot.n_states, bool)
+    seen[start_state] = True
+    frontier = np.array([start_state])
+    while len(frontier):
+        nxt = np.unique(succ[frontier].reshape(-1))
+        nxt = nxt[~seen[nxt]]
+        seen[nxt] = True
+        frontier = nxt
+    return seen
 
 
 def trap_states(robot: DiscreteRobot, start_state: int, goal_cell: int, Q: np.ndarray,
@@ -142,7 +163,8 @@ def analyse(robot: DiscreteRobot, start_state: int, goal_cell: int, bonus: np.nd
             step_reward: float, goal_reward: float, gamma: float, wind: float = 0.0,
             V0: np.ndarray | None = None) -> FarmingResult:
     """Solve the shaped task and say whether its greedy policy can be trapped."""
-    Q, V, sweeps = shaped_q(robot, goal_cell, bonus, step_reward, goal_reward, gamma, wind, V0=V0)
+    Q, V, sweeps = shaped_q(robot, goal_cell, bonus, step_reward, goal_reward, gamma, wind, V0=V0,
+                            start_state=start_state)
     trap = trap_states(robot, start_state, goal_cell, Q, wind)
     return FarmingResult(len(trap) > 0, trap, V, sweeps)
 
