@@ -25,6 +25,15 @@ def fmt_reached(entry: dict) -> str:
     return f"{k}/{len(ex)}"
 
 
+def fmt_median(entry: dict, digits: int = 1) -> str:
+    """Median [order-statistic CI]; the CI's coverage is named when below 95% (fewer than 6
+    trials), and ``≥`` marks a median that censoring reached."""
+    cov = entry.get("median_ci_coverage")
+    note = f" ({100 * cov:.0f}% CI)" if cov is not None and cov < 0.95 else ""
+    return (("≥ " if entry.get("median_is_lower_bound") else "")
+            + f"{fmt_num(entry.get('median'), digits)} {fmt_ci(entry.get('median_ci95'), digits)}{note}")
+
+
 def markdown_table(header: list[str], rows: list[list[str]]) -> str:
     widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(header)]
     line = lambda cells: "| " + " | ".join(c.ljust(w) for c, w in zip(cells, widths)) + " |"  # noqa: E731
@@ -59,7 +68,7 @@ def method_table(results: dict) -> str:
                 fmt_reached(r),
                 fmt_mean(r),
                 fmt_ci(r["ci95"]),
-                ("≥ " if r.get("median_is_lower_bound") else "") + f"{fmt_num(med)} {fmt_ci(r.get('median_ci95'))}",
+                fmt_median(r),
                 fmt_num(r.get("improvement_percent")),
                 fmt_ci(r.get("improvement_ci95")),
                 fmt_num(r.get("greedy_mean")),

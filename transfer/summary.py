@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from armtransfer.learning import metrics
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.learning.report import fmt_ci, fmt_mean, fmt_num, markdown_table
+from armtransfer.learning.report import fmt_ci, fmt_mean, fmt_median, fmt_num, markdown_table
 from armtransfer.learning.sweep import group_key
 
 
@@ -63,6 +63,8 @@ def summarize(records: list[dict]) -> list[dict]:
                 "mean_is_lower_bound": st["mean_is_lower_bound"],
                 "median": st["median"],
                 "median_ci95": st["median_ci95"],
+                "median_ci_coverage": st["median_ci_coverage"],
+                "median_is_lower_bound": st["median_is_lower_bound"],
                 "greedy_mean": metrics.mean_ci(col["greedy_steps"])[0],
                 "total_mean": metrics.mean_ci(col["total_steps"])[0],
                 "converged": sum(bool(c) for c in col["converged"]),
@@ -103,7 +105,7 @@ def summary_markdown(rows: list[dict]) -> str:
     body = [[
         _task_name(r), f"{r['source']} -> {r['target']}", f"{r['wind']:g}", f"{r['epsilon']:g}", f"{r['lam']:g}",
         r["method"], f"{r['reached']}/{r['trials']}", f"{fmt_mean(r)} {fmt_ci(r['ci95'])}",
-        f"{fmt_num(r['median'])} {fmt_ci(r['median_ci95'])}",
+        fmt_median(r),
         "" if r["method"] == "none" else f"{fmt_num(r['improvement_percent'])} {fmt_ci(r['improvement_ci95'])}",
         fmt_num(r["greedy_mean"]), f"{r['converged']}/{r['trials']}",
     ] for r in rows]
