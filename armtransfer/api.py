@@ -18,7 +18,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from armtransfer.errors import InvalidParameterError, InvalidTaskError
-from armtransfer.learning import experiment, potentials
+from armtransfer.learning import experiment, farming, potentials
 from armtransfer.learning import methods as registry
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
@@ -112,14 +112,19 @@ def transfer(
             mapping_obj = load_mapping(mapping_path, src, tgt)
     shaped = any(registry.get(m).shaped for m in method_names)
     trajs = resolve_trajectories(specs, src, the_task, config, seed) if shaped else []
-    for m in method_names:  # a farmable K is refused before any learning
+    # every method's K, checked before any learning: a farmable method's K by value iteration
+    # over the shaped task (refused in one line naming the largest safe K; 'auto' is verified)
+    k_per_method = {}
+    for m in method_names:
         if registry.get(m).shaped:
-            registry.build_shaping(m, tgt, trajs, K, config.step_reward, beta=beta)
+            k_per_method[m] = farming.check_k(m, tgt, tgt.start_state(start_cell), goal_cell, trajs, K, config,
+                                              wind)
+            registry.build_shaping(m, tgt, trajs, k_per_method[m], config.step_reward, beta=beta)
 
     entries_before = 0 if mapping_obj is None else len(mapping_obj)
     runs, learned = experiment.run_all(
         src, tgt, start_cell, goal_cell, method_names, trajs, trials, seed, config,
-        wind=wind, K=K, beta=potentials.DENSE_BETA if beta is None else beta,
+        wind=wind, K=k_per_method, beta=potentials.DENSE_BETA if beta is None else beta,
         mapping=mapping_obj, max_span=max_span, controls=controls, tick=progress,
     )
     by_method = {r.method: r for r in runs if r.control is None}

@@ -115,7 +115,9 @@ def _run_into(args: argparse.Namespace, tmp: Path) -> dict:
     write_json_atomic(tmp / "results.json", out_json)
     write_text_atomic(tmp / "table.md", _table_md(out_json))
     curves = {m: r["episode_steps"] for m, r in out_json["results"].items()}
-    figures.learning_curves(curves, f"{source.name} -> {target.name}: steps per episode", tmp / "learning_curves.png")
+    greedy = {m: r["greedy_steps"] for m, r in out_json["results"].items()}
+    figures.learning_curves(curves, f"{source.name} -> {target.name}: steps per episode", tmp / "learning_curves.png",
+                            greedy=greedy)
     paths = _paths(out_json, source, target)
     traj_xy = [list(ROOMS.xy(c)) for c in paths["trajectory_cells"]] + [list(out_json["task"]["goal"])]
     figures.mapping_paths(ROOMS.wall_mask, ROOMS.lo, traj_xy, paths["target_xy"] or traj_xy, [],

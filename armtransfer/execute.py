@@ -11,7 +11,7 @@ import time
 
 from armtransfer.tasks.catalog import custom_task
 from armtransfer.tasks.robot import DiscreteRobot
-from armtransfer.learning import experiment
+from armtransfer.learning import experiment, methods
 from armtransfer.learning.config import LearnerConfig
 
 
@@ -37,7 +37,7 @@ def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
     source, target = robots[run["source"]], robots[run["target"]]
     config = learner_config(run)
     traj = None
-    if run["method"] != "none":
+    if methods.get(run["method"]).shaped:
         traj = experiment.source_trajectory(run["trajectory"], source, start, goal, config, run["seed"])
     res = experiment.run_method(
         run["method"], target, start, goal, traj, run["trials"], run["seed"], config,

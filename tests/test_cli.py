@@ -153,3 +153,36 @@ def test_reproduce_fast_mode_writes_report_figures_and_results(reproduce_fast):
     assert set(data["methods"]["1"]["results"]) >= {"none", "pseudo", "dense", "dense [shuffled]", "dense [random]"}
     for name in ("fig4_coarse_to_fine.png", "fig5_fine_to_coarse.png", "fig6_wind.png", "fig_methods.png"):
         assert (out / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_reproduce_follows_the_papers_protocol_by_default_and_reports_both(reproduce_fast):
+    code, out = reproduce_fast
+    assert code == 0
+    data = json.loads((out / "results.json").read_text())
+    assert data["trajectory"] == "learned" and data["mapping_from"] == "single"
+    assert data["table_ii"]["1"]["trajectory_kind"] == "learned"
+    alt = data["alternatives"]
+    assert alt["trajectory"] == "optimal" and alt["mapping_from"] == "pooled"
+    for t in ("2", "3", "4"):
+        assert len(data["mapping_coarse_fine"]["tasks"][t]["mapping_learned_from_trials"]) <= 1
+    report = (out / "report.md").read_text()
+    for needle in ("Table I: the tasks", "Fig. 3 analog", "The paper's protocol vs the alternatives",
+                   "mapping from pooled", "Lengths: optimal ours"):
+        assert needle in report, needle
+    assert (out / "fig3_layout.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # no sentence a run's numbers do not support: the old hard-coded claims are gone
+    for claim in ("none of 10 trials", "helps far more here than in the paper", "often +-30-50%",
+                  "the mean is over those r", "are the source robot's shortest paths and have no loops"):
+        assert claim not in report, claim
+    # nothing but the output directory is left beside it (the temporary directory was renamed)
+    assert [p.name for p in out.parent.iterdir()] == [out.name]
+
+
+def test_reproduce_refuses_a_non_empty_out_in_one_line(tmp_path, capsys):
+    out = tmp_path / "rep"
+    out.mkdir()
+    (out / "old.txt").write_text("x")
+    assert main(["reproduce", "--trials", "1", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "not empty" in err
+    assert [p.name for p in out.iterdir()] == ["old.txt"]

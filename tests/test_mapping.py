@@ -373,3 +373,42 @@ def test_macros_in_every_episode_keep_the_greedy_path_from_converging():
         conv_every += sarsa.learn(fine, start, g2, config, rng, shaping=shaping, macros=every).converged
     assert conv_first == 10
     assert conv_every == 0
+
+
+class _Macros:
+    """A macro table by hand: at state 0, the sequence of actions ``seq``."""
+
+    episodes = None
+
+    def __init__(self, n_states: int, seq: list[int]):
+        self.start = np.zeros(n_states, np.int64)
+        self.length = np.zeros(n_states, np.int64)
+        self.length[0] = len(seq)
+        self.actions = np.array(seq, np.int64)
+
+    def arrays(self, robot):
+        return self.start, self.length, self.actions
+
+
+@pytest.mark.parametrize("wind", [0.0, 1.0])
+def test_a_macro_is_abandoned_on_what_the_robot_observes_after_wind(wind):
+    """Action 0 runs into a wall at every state; the wind pushes one state on. Under wind 1
+    the robot always moves, so it never observes a blocked step and the whole macro runs;
+    without wind the macro is abandoned at its first, blocked step. Kernel and dense
+    reference agree bit for bit."""
+    from armtransfer.tasks.robot import DiscreteRobot
+
+    n = 6
+    nxt = np.array([[s, min(s + 1, n - 1)] for s in range(n)], np.int32)
+    robot = DiscreteRobot("wall-and-wind", nxt, np.minimum(np.arange(n) + 1, n - 1).astype(np.int32),
+                          np.arange(n, dtype=np.int32), ("W", "R"))
+    macros = _Macros(n, [0, 0, 0])
+    config = LearnerConfig(trace_cutoff=0.0, max_episodes=1, patience=1000, epsilon=0.0)
+    rng_seed = 4
+    fast = sarsa.learn(robot, 0, n - 1, config, np.random.default_rng(rng_seed), wind=wind,
+                       macros=macros, keep_q=True)
+    Q, steps = reference.learn(robot, 0, n - 1, config, np.random.default_rng(rng_seed), episodes=1,
+                               wind=wind, macros=macros)
+    assert fast.episode_steps.tolist() == steps
+    assert np.array_equal(fast.Q, Q)
+    assert fast.macro_steps[0] == (3 if wind == 1.0 else 1)

@@ -14,7 +14,7 @@ import numpy as np
 
 from armtransfer.errors import InvalidParameterError
 from armtransfer.tasks.robot import DiscreteRobot
-from armtransfer.learning import controls, methods, metrics, potentials, sarsa
+from armtransfer.learning import controls, farming, methods, metrics, potentials, sarsa
 from armtransfer.learning.controls import CONTROLS
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
@@ -93,11 +93,14 @@ def run_method(
     if trials < 1:
         raise InvalidParameterError(f"trials must be a positive integer, got {trials}")
     shaping = None
-    if methods.get(method).shaped:
+    start_state = target.start_state(start_cell)
+    m = methods.get(method)
+    if m.shaped:
         if traj is None:
             raise InvalidParameterError(f"method {method!r} needs a trajectory")
+        if m.farmable:  # the exact check: value iteration over this task ('auto' comes out verified)
+            K = farming.check_k(method, target, start_state, goal_cell, traj, K, config, wind)
         shaping = methods.build_shaping(method, target, traj, K, config.step_reward, beta=beta)
-    start_state = target.start_state(start_cell)
     out = MethodResult(method, control=control)
     for trial in range(trials):
         res = sarsa.learn(
@@ -153,26 +156,51 @@ def run_mapping(
     return res, learned
 
 
-def summarize(results: Sequence[MethodResult], baseline: str = "none") -> dict:
-    """The JSON ``results`` block: per method, per-trial lists, means, CIs, improvement."""
+def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int | None = None) -> dict:
+    """The JSON ``results`` block: per method, per-trial lists, means, CIs, improvement.
+
+    Exploration statistics count every trial (``metrics.exploration_stats``): one that never
+    reached the goal counts at the step cap, ``cap`` (default: the steps its first episode
+    ran before the cap stopped it, i.e. ``config.max_total_steps``), and the mean is then
+    flagged as a lower bound. Improvements are paired (common random numbers,
+    ``trial_rng``) when the baseline has as many trials, else independent."""
+
+    def cap_of(r: MethodResult) -> int:
+        if cap is not None:
+            return int(cap)
+        stopped = [abs(int(t.episode_steps[0])) for t in r.trials
+                   if t.exploration_steps is None and len(t.episode_steps)]
+        return max(stopped, default=0)
+
     by_name = {r.label: r for r in results}
     base = by_name.get(baseline)
     base_ex = base.column("exploration_steps") if base else None
-    base_mean = metrics.mean_ci(base_ex)[0] if base else None
     out: dict = {}
     for r in results:
         ex = r.column("exploration_steps")
-        mean, ci = metrics.mean_ci(ex)
+        c = max(cap_of(r), cap_of(base) if base else 0)
+        st = metrics.exploration_stats(ex, c)
         total = r.column("total_steps")
         greedy = r.column("greedy_steps")
         t_mean, t_ci = metrics.mean_ci(total)
         g_mean, g_ci = metrics.mean_ci(greedy)
+        imp = None
+        if r.label != baseline and base is not None:
+            imp = metrics.paired_improvement(base_ex, ex, c, paired=len(base_ex) == len(ex))
         entry = {
             "exploration_steps": ex,
-            "mean": mean,
-            "ci95": ci,
-            "improvement_percent": None if r.label == baseline else metrics.improvement_percent(base_mean, mean),
-            "improvement_ci95": None if r.label == baseline or base is None else metrics.improvement_ci(base_ex, ex),
+            "mean": st["mean"],
+            "ci95": st["ci95"],
+            "reached": st["reached"],
+            "cap": c or None,
+            "mean_is_lower_bound": st["mean_is_lower_bound"],
+            "median": st["median"],
+            "median_ci95": st["median_ci95"],
+            "median_ci_coverage": st["median_ci_coverage"],
+            "median_is_lower_bound": st["median_is_lower_bound"],
+            "improvement_percent": None if imp is None else imp["percent"],
+            "improvement_ci95": None if imp is None else imp["ci95"],
+            "improvement_design": None if imp is None else imp["design"],
             "greedy_steps": greedy,
             "greedy_mean": g_mean,
             "greedy_ci95": g_ci,
@@ -248,7 +276,7 @@ def run_all(
     seed: int,
     config: LearnerConfig,
     wind: float = 0.0,
-    K: float | str | None = "auto",
+    K: float | str | None | dict = "auto",
     beta: float = potentials.DENSE_BETA,
     mapping: ActionMapping | None = None,
     max_span: int = DEFAULT_MAX_SPAN,
@@ -256,7 +284,7 @@ def run_all(
     tick: Callable[[], None] | None = None,
 ) -> tuple[list[MethodResult], ActionMapping | None]:
     """Every method on one task, then (``controls``) every reward-only method again with each
-    control trajectory. Returns the results in that order and, for ``mapping``, the mapping
+    control trajectory. ``K`` is one K for every method or a dict of K per method. Returns the results in that order and, for ``mapping``, the mapping
     updated from this task's converged trials."""
     chosen = [methods.get(m) for m in method_names]
     if any(m.shaped for m in chosen) and not trajs:
@@ -265,8 +293,12 @@ def run_all(
         raise InvalidParameterError("method 'mapping' takes exactly one trajectory")
     results: list[MethodResult] = []
     learned = None
-    kw = dict(wind=wind, K=K, on_trial=tick)
+
+    def k_of(name: str):
+        return K.get(name, "auto") if isinstance(K, dict) else K
+
     for m in chosen:
+        kw = dict(wind=wind, K=k_of(m.name), on_trial=tick)
         if m.macros:
             if mapping is None:
                 mapping = ActionMapping.for_robots(source, target)
@@ -280,9 +312,9 @@ def run_all(
         for kind in CONTROLS:
             fake = control_trajectories(kind, source, trajs, seed)
             for m in chosen:
-                if m.name in SHAPING_METHODS:
+                if m.name in SHAPING_METHODS:  # the same K as the real trajectory's
                     results.append(run_method(m.name, target, start_cell, goal_cell, fake, trials, seed, config,
-                                              beta=beta, control=kind, **kw))
+                                              beta=beta, control=kind, wind=wind, K=k_of(m.name), on_trial=tick))
     return results, learned
 
 

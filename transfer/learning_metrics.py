@@ -25,7 +25,9 @@ TAIL = 10
 
 
 def curve(episode_steps, greedy_steps: int | None, horizon: int = HORIZON) -> np.ndarray:
-    """The first ``horizon`` episodes' steps, padded with the converged greedy length."""
+    """The first ``horizon`` episodes' steps, padded with the converged greedy length (an
+    unconverged trial: its last episode's steps). The one definition of a trial's learning
+    curve: ``figures.learning_curves`` averages these, so a converged trial keeps counting."""
     steps = np.abs(np.asarray(episode_steps, dtype=np.float64))[:horizon]
     if len(steps) < horizon:
         pad = greedy_steps if greedy_steps is not None else (steps[-1] if len(steps) else 0.0)

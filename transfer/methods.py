@@ -23,6 +23,11 @@ from armtransfer.learning.shaping import Shaping
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.robot import DiscreteRobot
 
+HALF_BOUND = 0.5
+"""K='auto' of a method without its own ``auto_k`` starts at this fraction of the farming
+bound -step_reward/n (a farmable method's is then verified by value iteration, see
+``armtransfer.learning.farming``)."""
+
 Builder = Callable[[DiscreteRobot, list[Trajectory], float, float], Shaping]
 """(robot, trajectories, K, beta) -> the shaping arrays."""
 
@@ -55,7 +60,7 @@ class Method:
                 raise InvalidParameterError("K='auto' needs a negative step reward (it is scaled by -step_reward)")
             if self.auto_k is not None:
                 return self.auto_k * -step_reward
-            return 0.5 * farming_bound(step_reward, trajs)
+            return HALF_BOUND * farming_bound(step_reward, trajs)
         try:
             k = float(K)
         except (TypeError, ValueError):

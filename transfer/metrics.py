@@ -1,4 +1,12 @@
-"""Summaries over trials: means with 95% confidence intervals, and improvement in percent."""
+"""Summaries over trials: means with 95% confidence intervals, and improvement in percent.
+
+Exploration steps are *censored*: a trial that never reaches the goal stops at the step cap
+(``LearnerConfig.max_total_steps``) and has no exploration count (None). Dropping such
+trials flatters a method that sometimes fails, so :func:`exploration_stats` and
+:func:`paired_improvement` count them at the cap: the mean is then a lower bound of the
+true mean (``mean_is_lower_bound``), and the median is given with a distribution-free
+confidence interval, which censoring affects only when it reaches the upper half.
+"""
 
 from __future__ import annotations
 
@@ -6,28 +14,24 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
+from scipy import stats
 
-# Two-sided 95% quantiles of Student's t for df = 1..30; above 30 the normal 1.96 is close.
-_T95 = (
-    12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228,
-    2.201, 2.179, 2.160, 2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086,
-    2.080, 2.074, 2.069, 2.064, 2.060, 2.056, 2.052, 2.048, 2.045, 2.042,
-)
+PAIRED_DESIGN = "paired: methods share random streams trial by trial (common random numbers)"
+INDEPENDENT_DESIGN = "independent samples"
 
 
 def t95(df: int) -> float:
-    """The two-sided 95% Student t quantile for ``df`` degrees of freedom."""
+    """The two-sided 95% Student t quantile for ``df`` degrees of freedom (nan for df < 1)."""
     if df < 1:
         return math.nan
-    if df <= len(_T95):
-        return _T95[df - 1]
-    # Cornish-Fisher expansion around the normal quantile; within 1e-3 for df > 30
-    z = 1.959964
-    return z + (z**3 + z) / (4 * df) + (5 * z**5 + 16 * z**3 + 3 * z) / (96 * df**2)
+    return float(stats.t.ppf(0.975, df))
 
 
 def mean_ci(values: Sequence[float | None]) -> tuple[float | None, list[float] | None]:
-    """Mean and 95% t-interval of the values that are not None (None when none are)."""
+    """Mean and 95% t-interval of the values that are not None (None when none are).
+
+    For quantities defined only for some trials (e.g. greedy path lengths of converged
+    trials). Exploration steps are censored: use :func:`exploration_stats`."""
     xs = np.array([v for v in values if v is not None], dtype=np.float64)
     if len(xs) == 0:
         return None, None
@@ -38,6 +42,59 @@ def mean_ci(values: Sequence[float | None]) -> tuple[float | None, list[float] |
     return m, [m - half, m + half]
 
 
+def censor(values: Sequence[int | float | None], cap: float) -> np.ndarray:
+    """The values with None (the goal not reached within ``cap`` steps) counted at ``cap``."""
+    return np.array([cap if v is None else v for v in values], dtype=np.float64)
+
+
+def median_ci(xs: np.ndarray, level: float = 0.95) -> tuple[list[float] | None, float | None]:
+    """Distribution-free interval [x_(l), x_(n+1-l)] for the median, from the binomial
+    B(n, 1/2): the largest l whose coverage 1 - 2 P(B <= l-1) is at least ``level``.
+    Below n = 6 no l reaches 95%: then the range [min, max] and its smaller coverage.
+    Returns (interval, its exact coverage)."""
+    n = len(xs)
+    if n == 0:
+        return None, None
+    x = np.sort(xs)
+    best = 1
+    for l in range(1, n // 2 + 1):
+        if 1.0 - 2.0 * stats.binom.cdf(l - 1, n, 0.5) >= level:
+            best = l
+        else:
+            break
+    coverage = float(1.0 - 2.0 * stats.binom.cdf(best - 1, n, 0.5))
+    return [float(x[best - 1]), float(x[n - best])], coverage
+
+
+def exploration_stats(values: Sequence[int | None], cap: int) -> dict:
+    """Censoring-honest statistics of exploration steps (None: goal not reached in ``cap``).
+
+    mean and ci95 (t interval) are over all trials with unreached ones counted at ``cap``;
+    when any is unreached they are lower bounds (``mean_is_lower_bound``). The median and
+    its order-statistic interval are exact unless censoring reaches them
+    (``median_is_lower_bound``)."""
+    n = len(values)
+    reached = sum(v is not None for v in values)
+    out = {"n": n, "reached": reached, "censored": reached < n, "cap": cap,
+           "mean": None, "ci95": None, "mean_is_lower_bound": reached < n,
+           "median": None, "median_ci95": None, "median_ci_coverage": None,
+           "median_is_lower_bound": False}
+    if n == 0:
+        return out
+    xs = censor(values, cap)
+    mean = float(xs.mean())
+    if n == 1:
+        ci = [mean, mean]
+    else:
+        half = t95(n - 1) * float(xs.std(ddof=1)) / math.sqrt(n)
+        ci = [mean - half, mean + half]
+    med = float(np.median(xs))
+    mci, cov = median_ci(xs)
+    out.update(mean=mean, ci95=ci, median=med, median_ci95=mci, median_ci_coverage=cov,
+               median_is_lower_bound=bool(reached < n and med >= cap))
+    return out
+
+
 def improvement_percent(baseline: float | None, value: float | None) -> float | None:
     """Percentage improvement of ``value`` over ``baseline`` (fewer steps is better)."""
     if baseline is None or value is None or baseline == 0:
@@ -45,19 +102,53 @@ def improvement_percent(baseline: float | None, value: float | None) -> float | 
     return 100.0 * (baseline - value) / baseline
 
 
-def improvement_ci(
-    baseline: Sequence[float | None], values: Sequence[float | None]
-) -> list[float] | None:
-    """95% interval of the improvement in percent, by the delta method on the ratio of means.
+def paired_improvement(base: Sequence[int | None], other: Sequence[int | None], cap: int,
+                       paired: bool = True) -> dict:
+    """Improvement in percent of ``other``'s mean over ``base``'s, 100 (1 - mean(o)/mean(b)),
+    both censored at ``cap``, with a 95% interval.
 
-    improvement = 100 (1 - mean(values)/mean(baseline)); the two samples are independent.
-    """
-    b = np.array([v for v in baseline if v is not None], dtype=np.float64)
-    x = np.array([v for v in values if v is not None], dtype=np.float64)
-    if len(b) < 2 or len(x) < 2 or b.mean() == 0:
-        return None
-    r = x.mean() / b.mean()
-    var_r = r**2 * (x.var(ddof=1) / len(x) / x.mean() ** 2 + b.var(ddof=1) / len(b) / b.mean() ** 2)
-    df = min(len(b), len(x)) - 1
-    half = t95(df) * math.sqrt(var_r)
-    return [100.0 * (1 - (r + half)), 100.0 * (1 - (r - half))]
+    ``paired``: trial i of both came from the same random stream (common random numbers,
+    ``experiment.trial_rng``), so the interval is the delta method on the paired residuals
+    d_i = o_i - r b_i (r the ratio of means), var(r) ~ var(d) / (n mean(b)^2), t with n-1
+    df. Otherwise the two samples are independent: delta method on both variances.
+    ``censored`` says a cap entered either mean (then the percent is that of the censored
+    means, not of the true ones)."""
+    b = censor(base, cap)
+    o = censor(other, cap)
+    if paired and len(b) != len(o):
+        raise ValueError(f"a paired comparison needs as many trials in both ({len(b)} vs {len(o)})")
+    out = {"percent": None, "ci95": None, "design": PAIRED_DESIGN if paired else INDEPENDENT_DESIGN,
+           "n": [len(b), len(o)], "censored": bool(any(v is None for v in base) or any(v is None for v in other))}
+    if len(b) == 0 or len(o) == 0 or b.mean() == 0:
+        return out
+    r = float(o.mean() / b.mean())
+    out["percent"] = 100.0 * (1.0 - r)
+    if paired:
+        n = len(b)
+        if n < 2:
+            return out
+        d = o - r * b
+        se = math.sqrt(float(d.var(ddof=1)) / n) / float(b.mean())
+        df = n - 1
+    else:
+        if len(b) < 2 or len(o) < 2:
+            return out
+        se = r * math.sqrt(o.var(ddof=1) / len(o) / o.mean() ** 2 + b.var(ddof=1) / len(b) / b.mean() ** 2) \
+            if o.mean() > 0 else math.sqrt(o.var(ddof=1) / len(o)) / b.mean()
+        df = min(len(b), len(o)) - 1
+    half = t95(df) * se
+    out["ci95"] = [100.0 * (1.0 - (r + half)), 100.0 * (1.0 - (r - half))]
+    return out
+
+
+def improvement_ci(
+    baseline: Sequence[float | None], values: Sequence[float | None], cap: int | None = None
+) -> list[float] | None:
+    """95% interval of the improvement in percent. With ``cap``: censored at it and paired
+    when the lengths agree (see :func:`paired_improvement`); without: the trials that
+    reached the goal, independent samples (kept for old callers)."""
+    if cap is not None:
+        return paired_improvement(baseline, values, cap, paired=len(baseline) == len(values))["ci95"]
+    b = [v for v in baseline if v is not None]
+    x = [v for v in values if v is not None]
+    return paired_improvement(b, x, 0, paired=False)["ci95"]

@@ -52,7 +52,8 @@ def learn(
 
     ``macros`` (a ``transfer.mapping.MacroTable``): at a state with a macro, when none is
     running, one draw u and the macro's target sequence runs when u < 1 - epsilon; its
-    steps are ordinary steps; it is abandoned when a step is blocked, and then the next
+    steps are ordinary steps; it is abandoned when a step is blocked (the robot did not move,
+    observed after wind), and then the next
     action is epsilon-greedy without a macro draw.
     """
     seq_at: dict[int, list[int]] = {}
@@ -84,9 +85,9 @@ def learn(
         while True:  # repeat
             # Take action a and observe next state s' and reward r
             s2 = int(robot.next_state[s, a])
-            blocked = s2 == s
             if wind > 0.0 and rng.random() < wind:
                 s2 = int(robot.wind_state[s2])
+            blocked = s2 == s  # observed: the robot did not move (after wind)
             steps += 1
             terminal = robot.label[s2] == goal_cell
             r = config.step_reward + (config.goal_reward if terminal else 0.0)

@@ -11,6 +11,29 @@ def fmt_ci(ci: list[float] | None, digits: int = 1) -> str:
     return "n/a" if ci is None else f"[{ci[0]:,.{digits}f}, {ci[1]:,.{digits}f}]"
 
 
+def fmt_mean(entry: dict, digits: int = 1) -> str:
+    """A summary entry's mean exploration steps, as a lower bound (``>= x``) when some trial
+    never reached the goal and counts at the step cap."""
+    text = fmt_num(entry.get("mean"), digits)
+    return f"≥ {text}" if entry.get("mean_is_lower_bound") and entry.get("mean") is not None else text
+
+
+def fmt_reached(entry: dict) -> str:
+    """``reached k/n``: how many trials reached the goal at all."""
+    ex = entry.get("exploration_steps", [])
+    k = entry.get("reached", sum(x is not None for x in ex))
+    return f"{k}/{len(ex)}"
+
+
+def fmt_median(entry: dict, digits: int = 1) -> str:
+    """Median [order-statistic CI]; the CI's coverage is named when below 95% (fewer than 6
+    trials), and ``≥`` marks a median that censoring reached."""
+    cov = entry.get("median_ci_coverage")
+    note = f" ({100 * cov:.0f}% CI)" if cov is not None and cov < 0.95 else ""
+    return (("≥ " if entry.get("median_is_lower_bound") else "")
+            + f"{fmt_num(entry.get('median'), digits)} {fmt_ci(entry.get('median_ci95'), digits)}{note}")
+
+
 def markdown_table(header: list[str], rows: list[list[str]]) -> str:
     widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(header)]
     line = lambda cells: "| " + " | ".join(c.ljust(w) for c, w in zip(cells, widths)) + " |"  # noqa: E731
@@ -19,34 +42,45 @@ def markdown_table(header: list[str], rows: list[list[str]]) -> str:
 
 
 def method_table(results: dict) -> str:
-    """One row per method: exploration steps (mean, 95% CI, over the trials that reached the
-    goal), improvement, greedy steps, total steps, and how many trials reached and converged."""
+    """One row per method: exploration steps over ALL trials (an unreached trial counts at
+    the step cap, and the mean is then marked as a lower bound ``≥``), its 95% CI, the
+    median with its 95% CI, improvement (with its design), greedy steps, total steps, and
+    how many trials reached the goal and converged."""
     header = [
         "method",
+        "reached",
         "exploration steps",
         "95% CI",
+        "median [95% CI]",
         "improvement %",
         "improvement 95% CI",
         "greedy steps",
         "steps to converge",
-        "reached",
         "converged",
     ]
     rows = []
     for method, r in results.items():
         conv = r.get("converged", [])
-        ex = r.get("exploration_steps", [])
+        med = r.get("median")
         rows.append(
             [
                 method,
-                fmt_num(r["mean"]),
+                fmt_reached(r),
+                fmt_mean(r),
                 fmt_ci(r["ci95"]),
+                fmt_median(r),
                 fmt_num(r.get("improvement_percent")),
                 fmt_ci(r.get("improvement_ci95")),
                 fmt_num(r.get("greedy_mean")),
                 fmt_num(r.get("total_mean"), 0),
-                f"{sum(x is not None for x in ex)}/{len(ex)}",
                 f"{sum(bool(c) for c in conv)}/{len(conv)}",
             ]
         )
-    return markdown_table(header, rows)
+    designs = {r.get("improvement_design") for r in results.values()} - {None}
+    table = markdown_table(header, rows)
+    if any(r.get("mean_is_lower_bound") for r in results.values()):
+        table += ("\n\n≥: some trials never reached the goal; they count at the step cap, so the mean "
+                  "is a lower bound.")
+    if designs:
+        table += "\n\nImprovement CIs: " + "; ".join(sorted(designs)) + "."
+    return table

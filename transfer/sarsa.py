@@ -22,7 +22,8 @@ The random stream, in the order it is drawn (the dense reference draws the same)
   1. choosing an action at a state with a macro (``transfer.mapping``), when no macro is
      running: one draw u, the macro runs when u < 1 - epsilon. A running macro supplies
      its next action without a draw; it ends after its last action, or is abandoned when
-     a step is blocked (s' == s before wind). Right after an abandoned macro the next
+     a step is blocked: the robot did not move, s' == s observed after wind (the robot
+     cannot tell a wall from a gust that pushed it back). Right after an abandoned macro the next
      action is Algorithm 1's (no draw for a macro), so a macro blocked at its first step
      is not retried at once; after a macro that ran to its end, a macro at the state
      reached may start (macros chain);
@@ -209,9 +210,9 @@ def _run_trial(
             limit = max_episode_steps
         while steps < limit:
             s2 = next_state[s, a]
-            blocked = s2 == s
             if wind_p > 0.0 and rng.random() < wind_p:
                 s2 = wind_state[s2]
+            blocked = s2 == s  # what the robot observes: it did not move (after wind)
             steps += 1
             terminal = label[s2] == goal
             r = r_step
