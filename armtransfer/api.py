@@ -110,6 +110,8 @@ def transfer(
 
                 check_writable(mapping_path)
             mapping_obj = load_mapping(mapping_path, src, tgt)
+        if mapping_obj is not None:
+            mapping_obj.check_new_task(start_cell, goal_cell, tgt.layout)
     shaped = any(registry.get(m).shaped for m in method_names)
     trajs = resolve_trajectories(specs, src, the_task, config, seed) if shaped else []
     # every method's K, checked before any learning: a farmable method's K by value iteration

@@ -7,6 +7,7 @@ import pytest
 
 from armtransfer.cli import main
 from armtransfer.errors import InvalidMappingError
+from armtransfer.tasks.catalog import table_task
 from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.tasks.layout import ROOMS, Layout
 from armtransfer.learning import experiment, reference, methods, rewards, sarsa
@@ -412,3 +413,19 @@ def test_a_macro_is_abandoned_on_what_the_robot_observes_after_wind(wind):
     assert fast.episode_steps.tolist() == steps
     assert np.array_equal(fast.Q, Q)
     assert fast.macro_steps[0] == (3 if wind == 1.0 else 1)
+
+
+def test_a_mapping_is_refused_on_a_task_it_was_learned_on(tmp_path, capsys):
+    path = tmp_path / "m.json"
+    assert main(["rooms", "--method", "mapping", "--mapping", str(path), "--trials", "2", "--no-controls",
+                 "--task", "1"]) == 0
+    assert json.loads(path.read_text())["tasks"] == [list(table_task(1).cells())]
+    capsys.readouterr()
+    before = path.read_bytes()
+    assert main(["rooms", "--method", "mapping", "--mapping", str(path), "--trials", "1", "--task", "1"]) == 2
+    err = capsys.readouterr().err
+    assert "the mapping was learned on this task, (0, 0) -> (-8, 12)" in err and len(err.strip().splitlines()) == 1
+    assert path.read_bytes() == before
+    assert main(["rooms", "--method", "mapping", "--mapping", str(path), "--trials", "1", "--no-controls",
+                 "--task", "2"]) == 0
+    assert json.loads(path.read_text())["tasks"] == [list(table_task(t).cells()) for t in (1, 2)]

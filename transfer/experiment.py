@@ -142,6 +142,7 @@ def run_mapping(
         wind=wind, K=K, macros=table if len(table) else None, on_trial=on_trial,
     )
     learned = mapping.copy()
+    learned.learned_on(start_cell, goal_cell)
     fractions = []
     for t in res.trials:
         fractions.append(table.mapped_fraction(target, t.greedy_path) if t.converged else None)

@@ -165,6 +165,21 @@ class ActionMapping:
     source_actions: tuple[str, ...] = ()
     target_actions: tuple[str, ...] = ()
     entries: dict[tuple[int, ...], Entry] = field(default_factory=dict)
+    tasks: list[tuple[int, int]] = field(default_factory=list)
+    """The (start cell, goal cell) of every task the entries were learned on: reusing the mapping
+    on one of them would evaluate transfer with knowledge of the task itself."""
+
+    def learned_on(self, start_cell: int, goal_cell: int) -> None:
+        if (start_cell, goal_cell) not in self.tasks:
+            self.tasks.append((int(start_cell), int(goal_cell)))
+
+    def check_new_task(self, start_cell: int, goal_cell: int, layout) -> None:
+        """One line refusing a task this mapping was learned on."""
+        if (start_cell, goal_cell) in self.tasks:
+            raise InvalidMappingError(
+                f"the mapping was learned on this task, {layout.xy(start_cell)} -> {layout.xy(goal_cell)}, so "
+                "reusing it would evaluate transfer with knowledge of the task itself; use it on another task "
+                "or start a new mapping file")
 
     @staticmethod
     def for_robots(source: DiscreteRobot, target: DiscreteRobot) -> "ActionMapping":
@@ -215,7 +230,7 @@ class ActionMapping:
     def copy(self) -> "ActionMapping":
         return ActionMapping(
             self.source, self.target, self.source_actions, self.target_actions,
-            {k: Entry(e.target, e.count) for k, e in self.entries.items()},
+            {k: Entry(e.target, e.count) for k, e in self.entries.items()}, list(self.tasks),
         )
 
     # -- robot pair checks -------------------------------------------------------------
@@ -264,6 +279,7 @@ class ActionMapping:
             "target": self.target,
             "source_actions": list(self.source_actions),
             "target_actions": list(self.target_actions),
+            "tasks": [list(t) for t in self.tasks],
             "entries": [
                 {
                     "key": list(k),
@@ -304,6 +320,12 @@ class ActionMapping:
             return tuple(v)
 
         m = ActionMapping(data["source"], data["target"], names("source_actions"), names("target_actions"))
+        tasks = data.get("tasks", [])
+        if not isinstance(tasks, list) or not all(
+                isinstance(t, list) and len(t) == 2 and all(isinstance(c, int) and not isinstance(c, bool) and c >= 0
+                                                            for c in t) for t in tasks):
+            raise InvalidMappingError(f"{where}: 'tasks' must be a list of [start cell, goal cell] ids")
+        m.tasks = [tuple(t) for t in tasks]
         entries = data.get("entries")
         if not isinstance(entries, list):
             raise InvalidMappingError(f"{where}: 'entries' must be a list")
