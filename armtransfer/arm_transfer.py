@@ -82,8 +82,13 @@ def run(args: argparse.Namespace) -> int:
         from armtransfer.ik.render import video_format
 
         video_format(args.render, None)
+    common.check_arm_flags(args)
+    with common.phase("compiling arms"):  # before anything is written: a bad arm writes nothing
+        options = arm_options(args)
+        source = resolve(args.source, xml_path=args.arm_xml, progress=common.interactive(), **options)
+        target = resolve(args.target, xml_path=args.arm_xml, progress=common.interactive(), **options)
     with staged_directory(out) as tmp:
-        result = _run_into(args, tmp)
+        result = _run_into(args, tmp, source, target)
         if args.json:
             write_json_atomic(args.json, result["json"])
         if args.render and result["video"]:
@@ -97,16 +102,12 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _run_into(args: argparse.Namespace, tmp: Path) -> dict:
+def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target: DiscreteRobot) -> dict:
     kwargs = {**common.transfer_kwargs(args), **_fast_overrides(args)}
     if args.source_planner == "learn" and not args.trajectory:
         kwargs["trajectory"] = ["learned"]
     elif not args.trajectory:
         kwargs["trajectory"] = ["optimal"]
-    with common.phase("compiling arms"):
-        options = arm_options(args)
-        source = resolve(args.source, xml_path=args.arm_xml, progress=common.interactive(), **options)
-        target = resolve(args.target, xml_path=args.arm_xml, progress=common.interactive(), **options)
     total = experiment.count_trials(args.method, kwargs["trials"], kwargs["controls"])
     with common.progress_bar(total, "learning") as bar:
         result = api.transfer(source, target, progress=bar.update, **kwargs)

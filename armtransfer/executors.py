@@ -29,6 +29,35 @@ def _worker_init() -> None:
     # one thread per worker process: the workers are the parallelism
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
         os.environ.setdefault(var, "1")
+    _die_with_parent()
+
+
+def _die_with_parent() -> None:
+    """A worker ends when the sweep that started it is killed (even by SIGKILL), instead of
+    living on as an orphan: Linux's PR_SET_PDEATHSIG sends it SIGTERM when its parent dies.
+    Elsewhere a thread watches the parent's pid and ends the worker."""
+    parent = os.getppid()
+    try:
+        import ctypes
+        import signal
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        PR_SET_PDEATHSIG = 1
+        if libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGTERM), 0, 0, 0) == 0:
+            if os.getppid() != parent:  # the parent died before the call
+                os._exit(1)
+            return
+    except (OSError, AttributeError):
+        pass
+    import threading
+    import time
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(1.0)
+        os._exit(1)
+
+    threading.Thread(target=watch, daemon=True).start()
 
 
 def run_local(
@@ -108,6 +137,30 @@ def _import_ray():
     return ray
 
 
+RAY_CONNECT_TIMEOUT = 10.0
+"""Seconds to wait for a Ray address to answer before saying it cannot be reached."""
+
+
+def _check_reachable(address: str) -> None:
+    """Fail in one line within ``RAY_CONNECT_TIMEOUT`` when nothing answers at ``address``
+    (``host:port`` or ``ray://host:port``); ``ray.init`` alone would retry for minutes."""
+    if address == "auto":
+        return
+    target = address.split("://", 1)[-1]
+    host, _, port = target.rpartition(":")
+    try:
+        port_number = int(port)
+    except ValueError:
+        raise ExecutorError(f"a Ray address is HOST:PORT or ray://HOST:PORT, got {address!r}") from None
+    import socket
+
+    try:
+        with socket.create_connection((host or "127.0.0.1", port_number), timeout=RAY_CONNECT_TIMEOUT):
+            pass
+    except OSError as err:
+        raise ExecutorError(f"cannot reach Ray at {address!r}: {err.strerror or err}") from None
+
+
 def run_ray(
     runs: list[dict], robots: dict[str, DiscreteRobot], workers: int | None, address: str | None,
     on_done: Done, on_failed: Failed, retries: int = 2,
@@ -120,6 +173,7 @@ def run_ray(
     if not ray.is_initialized():
         try:
             if address:
+                _check_reachable(address)
                 ray.init(address=address, log_to_driver=False, configure_logging=False)
             else:
                 ray.init(num_cpus=workers or os.cpu_count(), include_dashboard=False,

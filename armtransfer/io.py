@@ -84,31 +84,46 @@ def staged_directory(out: str | os.PathLike, flag: str = "--out") -> Iterator[Pa
     exists only complete, whatever stops the run (an error, Ctrl-C, a kill before the rename)."""
     out = Path(out)
     check_output_dir(out, flag)
+    created = out.parent  # the highest directory this creates, removed again if the run fails
+    while not created.parent.exists():
+        created = created.parent
+    made = not created.exists()
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
         tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
     except OSError as err:
         raise OutputError(f"cannot write {str(out)!r}: {err.strerror}") from None
+    done = False
     try:
         yield tmp
         if out.exists():
             out.rmdir()  # empty, checked before
         os.replace(tmp, out)
+        done = True
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+        if made and not done:
+            shutil.rmtree(created, ignore_errors=True)
 
 
 def check_writable(path: str | os.PathLike) -> None:
-    """Fail early (before any work) when ``path`` cannot be created."""
+    """Fail early (before any work) when ``path`` cannot be created: its nearest existing
+    directory must take a new file (tried for real: permission bits say nothing for root or
+    for special file systems such as /proc)."""
     p = Path(path)
-    parent = p.parent if str(p.parent) else Path(".")
-    probe = parent
-    while not probe.exists():
-        probe = probe.parent
-    if not probe.is_dir() or not os.access(probe, os.W_OK):
-        raise OutputError(f"cannot write {str(p)!r}: {str(probe)!r} is not a writable directory")
     if p.is_dir():
         raise OutputError(f"cannot write {str(p)!r}: it is a directory")
+    probe = p.parent if str(p.parent) else Path(".")
+    while not probe.exists():
+        probe = probe.parent
+    if not probe.is_dir():
+        raise OutputError(f"cannot write {str(p)!r}: {str(probe)!r} is not a directory")
+    try:
+        with tempfile.TemporaryFile(dir=probe):
+            pass
+    except OSError as err:
+        raise OutputError(f"cannot write {str(p)!r}: {str(probe)!r} does not take new files "
+                          f"({err.strerror or err})") from None
 
 
 def parse_json_bytes(raw: bytes) -> object:

@@ -80,8 +80,8 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
     keeps a bring-your-own arm's tool pointing down in the ``cartesian`` models.
     """
     model = action_model(actions)
-    if not cell_size > 0:
-        raise ArmModelError(f"cell size must be positive, got {cell_size}")
+    if not (np.isfinite(cell_size) and cell_size > 0):
+        raise ArmModelError(f"cell size must be a positive number of metres, got {cell_size}")
     if xml_path is not None:
         path = Path(xml_path)
         try:
@@ -120,6 +120,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
     start = time.perf_counter()
     arrays = None
     if cache:
+        _check_cache_dir()
         arrays, status = _cache.load(robot_name, key)
     if arrays is None:
         if progress:
@@ -149,6 +150,21 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
         layout=layout,
         arm=description,
     )
+
+
+def _check_cache_dir() -> None:
+    """The arm cache must take files before any compiling starts (one line otherwise)."""
+    from armtransfer.errors import OutputError
+    from armtransfer.io import check_writable
+
+    root = _cache.cache_dir()
+    try:
+        if root.exists() and not root.is_dir():
+            raise OutputError(f"{str(root)!r} is not a directory")
+        check_writable(root / "probe.npz")
+    except OutputError as err:
+        raise OutputError(f"the arm cache cannot be used ({err}); set ARMTRANSFER_CACHE to a writable "
+                          "directory, or pass --no-cache") from None
 
 
 def _sha(data: bytes) -> str:

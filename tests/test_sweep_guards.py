@@ -1,10 +1,12 @@
 """A sweep is checked whole before anything is written, its store is locked, and Ctrl-C at
 start-up is one line."""
 
+import os
 import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 
@@ -95,3 +97,52 @@ def test_ctrl_c_during_start_up_is_one_line(tmp_path, delay):
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == 130, err
     assert err.strip() == "armtransfer rooms: interrupted"
+
+
+def test_an_unreachable_ray_address_fails_fast_in_one_line(tmp_path, capsys):
+    pytest.importorskip("ray")
+    path = tmp_path / "s.toml"
+    path.write_text(GOOD)
+    out = tmp_path / "store"
+    t0 = time.perf_counter()
+    code = main(["sweep", str(path), "--out", str(out), "--executor", "ray", "--address", "127.0.0.1:1"])
+    assert code == 2 and time.perf_counter() - t0 < 30
+    err = capsys.readouterr().err
+    assert "cannot reach Ray at '127.0.0.1:1'" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def _session_processes(sid: int) -> list[int]:
+    """Live processes of session ``sid`` (from /proc: field 6 of stat is the session)."""
+    out = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[3]) == sid and fields[0] != "Z":
+            out.append(int(stat.parent.name))
+    return out
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc")
+def test_killing_only_the_sweep_leaves_no_orphaned_workers(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text(GOOD.replace("seeds = [0]", f"seeds = {list(range(40))}").replace("trials = 1", "trials = 3"))
+    out = tmp_path / "store"
+    proc = subprocess.Popen([sys.executable, "-m", "armtransfer.cli", "sweep", str(path), "--out", str(out),
+                             "--workers", "2"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            start_new_session=True)
+    deadline = time.time() + 120
+    while time.time() < deadline and len(list((out / "runs").glob("*.json"))) < 2:
+        time.sleep(0.05)
+    assert len(_session_processes(proc.pid)) >= 3, "the driver and its two workers should be running"
+    os.kill(proc.pid, signal.SIGKILL)  # the parent only, not its workers
+    proc.wait()
+    deadline = time.time() + 20
+    while time.time() < deadline and _session_processes(proc.pid):
+        time.sleep(0.2)
+    left = _session_processes(proc.pid)
+    for pid in left:  # do not leave them behind even when the check fails
+        os.kill(pid, signal.SIGKILL)
+    assert left == []

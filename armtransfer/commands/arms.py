@@ -50,6 +50,7 @@ def run(args: argparse.Namespace) -> int:
         from armtransfer import arm_transfer
 
         return arm_transfer.run(args)
+    common.check_arm_flags(args)
     from armtransfer.tasks.arms import arm_robot, robot_specs
     from armtransfer.tasks.catalog import TABLE_I
 

@@ -178,8 +178,25 @@ def parse_base_pos(text: str | None):
         return None
     try:
         values = tuple(float(v) for v in text.split(","))
-        if len(values) != 3:
+        if len(values) != 3 or not all(math.isfinite(v) for v in values):
             raise ValueError
     except ValueError:
-        raise ArmModelError(f"--base-pos must be three numbers 'X,Y,Z', got {text!r}") from None
+        raise ArmModelError(f"--base-pos must be three finite numbers 'X,Y,Z' (metres), got {text!r}") from None
     return values
+
+
+def check_arm_flags(args: argparse.Namespace) -> None:
+    """The arm flags of ``arms``: a finite positive cell size, and the bring-your-own arm's
+    options only with --arm-xml (they would be silently ignored otherwise)."""
+    if not (math.isfinite(args.cell_size) and args.cell_size > 0):
+        raise ArmModelError(f"--cell-size must be a positive number of metres, got {args.cell_size!r}")
+    if not getattr(args, "arm_xml", None):
+        given = [flag for flag, value, default in (("--base-pos", args.base_pos, None),
+                                                   ("--base-yaw", args.base_yaw, 0.0),
+                                                   ("--tip-site", args.tip_site, "tip")) if value != default]
+        if given:
+            raise ArmModelError(f"{given[0]} goes with --arm-xml PATH (a bring-your-own arm)")
+    else:
+        parse_base_pos(args.base_pos)
+    if not math.isfinite(args.base_yaw):
+        raise ArmModelError(f"--base-yaw must be a finite number of radians, got {args.base_yaw!r}")

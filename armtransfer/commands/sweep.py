@@ -8,7 +8,7 @@ import os
 from armtransfer.commands import common
 from armtransfer.execute import robot_specs
 from armtransfer.tasks.catalog import custom_task
-from armtransfer.executors import _import_ray, run_local, run_ray
+from armtransfer.executors import _check_reachable, _import_ray, run_local, run_ray
 from armtransfer.tasks.specs import resolve
 from armtransfer.learning import sweep as sweeps
 from armtransfer.learning.store import ResultStore
@@ -45,6 +45,8 @@ def run_sweep(sweep: sweeps.Sweep, args: argparse.Namespace) -> int:
     is written."""
     if args.executor == "ray":
         _import_ray()  # say how to install Ray before anything is written
+        if args.address:
+            _check_reachable(args.address)
     robots = check_runs(sweep.runs)
     store = ResultStore.open_for(args.out, sweep)
     try:
