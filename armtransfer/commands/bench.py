@@ -10,7 +10,7 @@ import time
 
 import numpy as np
 
-from armtransfer.commands.common import positive_int
+from armtransfer.commands.common import non_negative_int, positive_int
 from armtransfer.tasks.catalog import table_task
 from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.learning import sarsa
@@ -24,10 +24,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--steps", type=positive_int, default=2_000_000,
                    help="learner steps per repeat, at least (default 2,000,000)")
     p.add_argument("--repeats", type=positive_int, default=5, help="timed repeats (default 5)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=non_negative_int, default=0, help="random seed, >= 0 (default 0)")
     p.add_argument("--baseline-steps", type=positive_int, default=2_000,
                    help="steps per repeat of the plain-Python baseline, at least (default 2,000)")
-    p.add_argument("--baseline-repeats", type=int, default=3, help="baseline repeats (default 3; 0 skips it)")
+    p.add_argument("--baseline-repeats", type=non_negative_int, default=3, help="baseline repeats (default 3; 0 skips it)")
     p.add_argument("--json", default=None, metavar="PATH", help="write the figures as JSON here")
 
 

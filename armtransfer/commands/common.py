@@ -68,7 +68,7 @@ def add_method_arguments(p: argparse.ArgumentParser, default: list[str] | None =
     p.add_argument("--no-controls", action="store_true",
                    help="skip the control runs (each reward-only method again with a shuffled and a "
                         "random trajectory)")
-    p.add_argument("--beta", type=float, default=potentials.DENSE_BETA,
+    p.add_argument("--beta", type=non_negative_float, default=potentials.DENSE_BETA,
                    help=f"method dense: indices lost per cell from the trajectory (default {potentials.DENSE_BETA})")
     p.add_argument("--mapping", default=None, metavar="PATH",
                    help="with --method mapping: the action sequence mapping to reuse (created when "
@@ -105,6 +105,13 @@ def add_config_arguments(p: argparse.ArgumentParser) -> None:
                        type=positive_int if integer else finite_float,
                        help=f"{f.metadata['help']} (default {f.default:,})" if integer
                        else f"{f.metadata['help']} (default {f.default:g})")
+
+
+def non_negative_float(text: str) -> float:
+    value = finite_float(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be a finite number >= 0, got {text!r}")
+    return value
 
 
 def finite_float(text: str) -> float:

@@ -7,15 +7,12 @@ place only when complete: ``--out`` never holds half a run. A non-empty ``--out`
 from __future__ import annotations
 
 import argparse
-import os
-import shutil
-import tempfile
+import datetime as _dt
 import time
 from pathlib import Path
 
 from armtransfer.commands import common
-from armtransfer.errors import OutputError
-from armtransfer.io import check_writable, write_json_atomic, write_text_atomic
+from armtransfer.io import check_output_dir, staged_directory, write_json_atomic, write_text_atomic
 from armtransfer.learning import beyond, figures
 from armtransfer.learning import reproduce as rep
 from armtransfer.learning import reproduce_report as rr
@@ -31,11 +28,12 @@ NAMES = {"fig3": "fig3_layout.png", "fig4": "fig4_coarse_to_fine.png", "fig5": "
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--out", default="runs/reproduce",
-                   help="output directory, absent or empty (default runs/reproduce)")
+    p.add_argument("--out", default=None,
+                   help="output directory, absent or empty; written whole or not at all "
+                        "(default runs/reproduce-<timestamp>)")
     p.add_argument("--trials", type=common.positive_int, default=30,
                    help="trials per table cell (default 30; the paper used 10)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=common.non_negative_int, default=0, help="random seed, >= 0 (default 0)")
     p.add_argument("--max-total-steps", type=common.positive_int, default=LearnerConfig.max_total_steps,
                    help="steps per trial at most, over all its episodes; a trial that has not reached "
                         f"the goal by then counts at this cap (default {LearnerConfig.max_total_steps:,})")
@@ -60,14 +58,6 @@ def _bars(res: dict, extra: dict | None = None) -> tuple[dict, dict]:
         series["transfer + mapping"] = ([e["mean"] for e in entries], [e["ci95"] for e in entries])
         lower["transfer + mapping"] = [bool(e.get("mean_is_lower_bound")) for e in entries]
     return series, lower
-
-
-def _prepare_out(out: Path) -> Path:
-    if out.exists() and (not out.is_dir() or any(out.iterdir())):
-        raise OutputError(f"output directory {str(out)!r} exists and is not empty; choose a new --out")
-    check_writable(out / "report.md")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    return Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
 
 
 def _write(res: dict, tmp: Path) -> None:
@@ -104,21 +94,15 @@ def _write(res: dict, tmp: Path) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    out = Path(args.out)
-    tmp = _prepare_out(out)
-    try:
-        config = LearnerConfig(max_total_steps=args.max_total_steps)
-        t0 = time.perf_counter()
-        with common.progress_bar(rep.plan(args.trials), "reproduce") as bar:
-            res = rep.run_all(args.trials, args.seed, config, tick=bar.update,
-                              trajectory=args.trajectory, mapping_from=args.mapping_from)
+    out = Path(args.out) if args.out else Path("runs") / _dt.datetime.now().strftime("reproduce-%Y%m%d-%H%M%S")
+    check_output_dir(out)  # before the long run, not after
+    config = LearnerConfig(max_total_steps=args.max_total_steps)
+    t0 = time.perf_counter()
+    with common.progress_bar(rep.plan(args.trials), "reproduce") as bar:
+        res = rep.run_all(args.trials, args.seed, config, tick=bar.update,
+                          trajectory=args.trajectory, mapping_from=args.mapping_from)
+    with staged_directory(out) as tmp:  # out appears only complete
         _write(res, tmp)
-        if out.exists():
-            out.rmdir()  # empty, checked before
-        os.replace(tmp, out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
     print(f"wrote {out / 'report.md'} ({time.perf_counter() - t0:.0f} s)")
     print(rr.table_ii_markdown(res["table_ii"], rr.paper.TABLE_II, "Table II A-C: coarse -> fine"))
     print()
