@@ -163,26 +163,39 @@ def _entries_used(r: dict) -> str:
     return f"{r['entries_before']}"
 
 
+def _mapping_rows(res: dict, protocol: str, table: str, paper_table: dict, improvement_col: str,
+                  columns: list[str]) -> list[list[str]]:
+    """The rows of a mapping table (Table II D-F or V D-E): every cell by name, then
+    ``columns`` picks and orders them. ``improvement_col`` is the paper's column that holds
+    the improvement of D (F in Table II, E in Table V)."""
+    rows = []
+    for t in TASKS:
+        r = res[protocol]["tasks"][t]
+        p = paper_table[t]
+        mapped = (_cell(r["mapped_percent_mean"], r["mapped_percent_ci95"])
+                  if r["mapped_percent_mean"] is not None else "NA")
+        cells = {
+            "task": str(t),
+            "B ours": fmt_mean(res[table][t]["results"]["pseudo"]),
+            "D paper": _paper(p["D"]),
+            "D ours": _steps(r),
+            "E paper": _paper(p["E"], 2),
+            "F paper": _paper(p.get("F"), 2),
+            "mapped": mapped,
+            "improvement": _cell(r["improvement_percent"], r["improvement_ci95"]),
+            "verdict": _verdict(r["improvement_percent"], r["improvement_ci95"], p[improvement_col]),
+            "entries": _entries_used(r),
+        }
+        rows.append([cells[c] for c in columns])
+    return rows
+
+
 def table_ii_mapping_markdown(res: dict) -> str:
     header = ["task", "B ours (transfer)", "D paper", "D ours [95% CI]", "E paper %", "E ours % [95% CI]",
               "F paper %", "F ours % [95% CI]", "F vs paper", "entries used"]
-    rows = []
-    for t in TASKS:
-        r = res["mapping_coarse_fine"]["tasks"][t]
-        b = res["table_ii"][t]["results"]["pseudo"]
-        p = paper.TABLE_II[t]
-        rows.append([
-            str(t),
-            fmt_mean(b),
-            _paper(p["D"]),
-            _steps(r),
-            _paper(p["E"], 2),
-            _cell(r["mapped_percent_mean"], r["mapped_percent_ci95"]) if r["mapped_percent_mean"] is not None else "NA",
-            _paper(p["F"], 2),
-            _cell(r["improvement_percent"], r["improvement_ci95"]),
-            _verdict(r["improvement_percent"], r["improvement_ci95"], p["F"]),
-            _entries_used(r),
-        ])
+    rows = _mapping_rows(res, "mapping_coarse_fine", "table_ii", paper.TABLE_II, "F",
+                         ["task", "B ours", "D paper", "D ours", "E paper", "mapped", "F paper", "improvement",
+                          "verdict", "entries"])
     return (
         "### Table II D-F: coarse -> fine with action sequence mapping (tasks 1 -> 2 -> 3 -> 4)\n\n"
         + markdown_table(header, rows)
@@ -196,22 +209,9 @@ def table_ii_mapping_markdown(res: dict) -> str:
 def table_v_mapping_markdown(res: dict) -> str:
     header = ["task", "B ours (transfer)", "D paper", "D ours [95% CI]", "E paper %", "E ours % [95% CI]",
               "E vs paper", "mapped % of final path [95% CI]", "entries used"]
-    rows = []
-    for t in TASKS:
-        r = res["mapping_fine_coarse"]["tasks"][t]
-        b = res["table_v"][t]["results"]["pseudo"]
-        p = paper.TABLE_V[t]
-        rows.append([
-            str(t),
-            fmt_mean(b),
-            _paper(p["D"]),
-            _steps(r),
-            _paper(p["E"], 2),
-            _cell(r["improvement_percent"], r["improvement_ci95"]),
-            _verdict(r["improvement_percent"], r["improvement_ci95"], p["E"]),
-            _cell(r["mapped_percent_mean"], r["mapped_percent_ci95"]) if r["mapped_percent_mean"] is not None else "NA",
-            _entries_used(r),
-        ])
+    rows = _mapping_rows(res, "mapping_fine_coarse", "table_v", paper.TABLE_V, "E",
+                         ["task", "B ours", "D paper", "D ours", "E paper", "improvement", "verdict", "mapped",
+                          "entries"])
     return (
         "### Table V D-E: fine -> coarse with action sequence mapping (tasks 1 -> 2 -> 3 -> 4)\n\n"
         + markdown_table(header, rows)
