@@ -44,8 +44,3 @@ def action_model(name: str) -> ActionModel:
             f"unknown action model {name!r}; valid action models: {', '.join(ACTION_MODELS)}"
         )
     return ACTION_MODELS[name]
-
-
-def joint_action(action: int) -> tuple[int, int]:
-    """(joint index, sign) of a ``joint`` action index."""
-    return action // 2, (1 if action % 2 == 0 else -1)

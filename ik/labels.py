@@ -29,11 +29,6 @@ def cells_of_xy(xy: np.ndarray, cell: float, layout: Layout) -> np.ndarray:
     return layout.ids_of(np.rint(np.asarray(xy)[..., :2] / cell))
 
 
-def cell_centre(cell_id: int, cell: float, layout: Layout) -> np.ndarray:
-    x, y = layout.xy(int(cell_id))
-    return np.array([x * cell, y * cell])
-
-
 class Labeller:
     """mink forward kinematics of one arm scene: tip position and shared-cell label."""
 

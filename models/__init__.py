@@ -64,7 +64,3 @@ ARMS: dict[str, ArmInfo] = {
                           mount_yaw=math.pi / 2, tip_down=True,
                           notes="Franka Panda DH; beside the table, 0.40 m in front of its centre"),
 }
-
-
-def arm_names() -> list[str]:
-    return list(ARMS)
