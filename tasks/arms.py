@@ -11,6 +11,7 @@ the exact MuJoCo scene, as ``armtransfer.ik.replay`` does).
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 from pathlib import Path
@@ -27,6 +28,8 @@ from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.ik.workspace import DEFAULT_CELL, WALL_HEIGHT
 
 CUSTOM_JOINT_STEP = 0.05
+SIDECAR_FORMAT = "armtransfer-generated-arm/1"
+"""The JSON ``armtransfer arms generate`` writes beside an arm: its mount and tool."""
 
 
 def parse_robot_spec(spec: str) -> tuple[str, str]:
@@ -83,6 +86,11 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
     if not (np.isfinite(cell_size) and cell_size > 0):
         raise ArmModelError(f"cell size must be a positive number of metres, got {cell_size}")
     if xml_path is not None:
+        generated = read_sidecar(xml_path) if base_pos is None else None
+        if generated is not None:  # mounted as it was generated, unless told otherwise
+            base_pos, base_yaw = tuple(generated["mount_pos"]), float(generated["mount_yaw"])
+            tip_down = generated["tip_down"] if tip_down is None else tip_down
+            joint_step = joint_step or generated["joint_step"]
         path = Path(xml_path)
         try:
             xml_bytes = path.read_bytes()
@@ -165,6 +173,18 @@ def _check_cache_dir() -> None:
     except OutputError as err:
         raise OutputError(f"the arm cache cannot be used ({err}); set ARMTRANSFER_CACHE to a writable "
                           "directory, or pass --no-cache") from None
+
+
+def read_sidecar(xml_path: str | os.PathLike) -> dict | None:
+    """The generator's JSON beside an arm file, or None when there is none."""
+    from armtransfer.io import parse_json_bytes
+
+    path = Path(xml_path).with_suffix(".json")
+    try:
+        data = parse_json_bytes(path.read_bytes())
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) and data.get("format") == SIDECAR_FORMAT else None
 
 
 def _sha(data: bytes) -> str:

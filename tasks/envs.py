@@ -129,7 +129,7 @@ def make_rooms_env(
 _ARM_OPTIONS = ("cell_size", "xml_path", "tip_site", "base_pos", "base_yaw", "joint_step", "cache")
 
 
-def make_arm_rooms_env(arm: str = "planar2", actions: str = "joint", task: int | None = 1,
+def make_arm_rooms_env(arm: str | None = None, actions: str = "joint", task: int | None = 1,
                        start: tuple[int, int] | None = None,
                        goal: tuple[int, int] | None = None, **kwargs: Any) -> RobotRoomsEnv:
     """Entry point of ``armtransfer/ArmRooms-v0``: an arm robot (compiled or loaded from the
@@ -137,8 +137,8 @@ def make_arm_rooms_env(arm: str = "planar2", actions: str = "joint", task: int |
     from armtransfer.tasks.arms import arm_robot, parse_robot_spec
 
     robot_kwargs = {k: kwargs.pop(k) for k in _ARM_OPTIONS if k in kwargs}
-    if robot_kwargs.get("xml_path") is None:
-        arm, actions = parse_robot_spec(f"{arm}:{actions}")
+    if robot_kwargs.get("xml_path") is None:  # a built-in arm, planar2 by default
+        arm, actions = parse_robot_spec(f"{arm or 'planar2'}:{actions}")
     the_task = custom_task(start, goal) if start is not None and goal is not None else table_task(task)
     return RobotRoomsEnv(arm_robot(arm, actions, **robot_kwargs), the_task, **kwargs)
 

@@ -18,7 +18,6 @@ spec anywhere: ``out_dir/<name>/<name>.xml:cartesian`` (its mount is read from t
 
 from __future__ import annotations
 
-import json
 import os
 import tempfile
 from dataclasses import dataclass
@@ -30,11 +29,11 @@ from armtransfer.errors import ArmModelError, ArmTransferError
 from armtransfer.io import staged_directory, write_json_atomic, write_text_atomic
 from armtransfer.ik.workspace import DEFAULT_CELL
 from armtransfer.models.generate import ArmDraw, check_family, draw_arm, planar_tip_cells, with_home
+from armtransfer.tasks.arms import SIDECAR_FORMAT, read_sidecar
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.layout import ROOMS
 
 MAX_DRAWS = 12
-SIDECAR_FORMAT = "armtransfer-generated-arm/1"
 
 
 @dataclass(frozen=True)
@@ -147,16 +146,6 @@ def sidecar(draw: ArmDraw, seed: int, index: int, rejected: list[str], reach: fl
             "draw": index + 1, "params": draw.params, "mount_pos": list(draw.mount_pos),
             "mount_yaw": draw.mount_yaw, "tip_down": draw.tip_down, "kind": draw.kind,
             "joint_step": draw.joint_step, "reach": round(reach, 4), "rejected": rejected}
-
-
-def read_sidecar(xml_path: str | os.PathLike) -> dict | None:
-    """The generator's JSON beside an arm file, or None when there is none."""
-    path = Path(xml_path).with_suffix(".json")
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, ValueError):
-        return None
-    return data if isinstance(data, dict) and data.get("format") == SIDECAR_FORMAT else None
 
 
 def readme(draw: ArmDraw, seed: int, index: int, rejected: list[str], reach: float) -> str:

@@ -27,11 +27,7 @@ def resolve(spec: str | DiscreteRobot, *, xml_path=None, progress: bool = False,
     if ".xml" in spec:  # an arm file: PATH.xml or PATH.xml:ACTIONS
         path, _, actions = spec.rpartition(":") if not spec.endswith(".xml") else (spec, "", "")
         from armtransfer.tasks.arms import arm_robot
-        from armtransfer.tasks.generated import read_sidecar, robot_of
 
-        generated = read_sidecar(path)
-        if generated is not None and not arm_options.get("base_pos"):  # mounted as it was generated
-            return robot_of(path, generated, actions or "cartesian", progress=progress)
         return arm_robot(None, actions or "cartesian", xml_path=path, progress=progress, **arm_options)
     if spec.startswith("gen:"):
         from armtransfer.tasks.generated import resolve_generated

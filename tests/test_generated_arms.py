@@ -127,3 +127,21 @@ def test_arms_generate_writes_the_arm(tmp_path, capsys):
     assert main(["arms", "generate", "--family", "planar", "--dof", "2", "--seed", "3", "--out", str(tmp_path)]) == 0
     assert "gen_planar2_s3.xml:cartesian" in capsys.readouterr().out
     assert np.isfinite(read_sidecar(tmp_path / "gen_planar2_s3" / "gen_planar2_s3.xml")["reach"])
+
+
+def test_an_arm_file_keeps_its_generated_mount_everywhere(generated):
+    """As xml_path (the API, ArmRooms-v0) and as a spec, a generated arm is mounted as generated."""
+    import gymnasium as gym
+
+    from armtransfer.tasks.arms import arm_robot
+    from armtransfer.tasks.envs import register_envs
+
+    arm = generated["spatial6"]
+    side = read_sidecar(arm.xml_path)
+    robot = arm_robot(None, "cartesian", xml_path=arm.xml_path)
+    assert robot.arm.mount == tuple(side["mount_pos"]) and robot.arm.yaw == side["mount_yaw"]
+    register_envs()
+    env = gym.make("armtransfer/ArmRooms-v0", xml_path=str(arm.xml_path), actions="cartesian", task=1)
+    assert env.unwrapped.robot.arm.mount == robot.arm.mount
+    assert env.unwrapped.robot.name == f"{arm.name}:cartesian"
+    env.close()
