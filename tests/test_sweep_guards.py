@@ -41,6 +41,7 @@ def _refused(tmp_path, capsys, text, message, *extra):
     (("tasks = [1]", 'tasks = []\nstart_goal = [["0,0", "0,0"]]'), "start"),
     (("seeds = [0]", "seeds = []"), "seeds is empty"),
     (('methods = ["none"]', "methods = []"), "methods is empty"),
+    (('methods = ["none"]', 'methods = ["none", "pseudo"]\nK = [0.2]'), "K=0.2 can be farmed for pseudo"),
 ])
 def test_a_bad_sweep_is_refused_before_the_store_exists(tmp_path, capsys, change, message):
     _refused(tmp_path, capsys, GOOD.replace(*change), message)

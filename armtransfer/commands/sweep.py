@@ -11,6 +11,7 @@ from armtransfer.tasks.catalog import custom_task
 from armtransfer.executors import _check_reachable, _import_ray, run_local, run_ray
 from armtransfer.tasks.specs import resolve
 from armtransfer.learning import sweep as sweeps
+from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.store import ResultStore
 
 HELP = "Run a sweep file (TOML) into --out; re-running resumes, skipping finished runs."
@@ -73,7 +74,32 @@ def check_runs(runs: list[dict]) -> dict:
         for spec in (run["source"], run["target"]):
             robots[spec].start_state(start)
             robots[spec].start_state(goal, what="goal")
+    _check_farming_bounds(runs, robots)
     return robots
+
+
+def _check_farming_bounds(runs: list[dict], robots: dict) -> None:
+    """A numeric K of a farmable method that is farmable whatever trajectory the source hands
+    over: any trajectory is at least as long as the source's shortest path, n, and K >= the
+    bound -step_reward/n already pays more than a step. (The exact check, by value iteration on
+    the trajectory actually handed over, runs with each run.)"""
+    from armtransfer.learning import methods, trajectory
+
+    shortest: dict[tuple, int] = {}
+    for run in runs:
+        if run["K"] in (None, "auto") or not methods.get(run["method"]).farmable:
+            continue
+        key = (run["source"], tuple(run["start"]), tuple(run["goal"]))
+        if key not in shortest:
+            start, goal = custom_task(tuple(run["start"]), tuple(run["goal"])).cells()
+            shortest[key] = trajectory.shortest(robots[run["source"]], start, goal).n
+        n = max(shortest[key], 1)
+        step = LearnerConfig.from_options({k: run[k] for k in LearnerConfig.options() if k in run}).step_reward
+        if step + n * float(run["K"]) >= 0:
+            raise sweeps.SweepFileError(
+                f"K={run['K']:g} can be farmed for {run['method']} on {run['source']} -> {run['target']} "
+                f"(task {run['task'] or run['start']}): any trajectory has n >= {n}, so K must stay below "
+                f"{-step / n:.6g}")
 
 
 def _run_into(store: ResultStore, sweep: sweeps.Sweep, robots: dict, args: argparse.Namespace) -> int:
