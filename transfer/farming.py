@@ -249,10 +249,13 @@ def largest_safe_k(robot: DiscreteRobot, start_state: int, goal_cell: int,
 
 def auto_k(robot: DiscreteRobot, start_state: int, goal_cell: int,
            trajs: Trajectory | Sequence[Trajectory], config, wind: float = 0.0) -> float:
-    """K='auto' for pseudo/mapping, verified safe by VI: min(half the old bound,
-    SAFETY_FRACTION x the largest safe K); halved until VI accepts it (when not monotone)."""
+    """K='auto' for pseudo/mapping, verified safe by VI: half the old bound when value
+    iteration finds it safe (one solve, the usual case); otherwise min(half the old bound,
+    SAFETY_FRACTION x the largest safe K), halved until VI accepts it (when not monotone)."""
     trajs = rewards.as_list(trajs)
     half = methods.HALF_BOUND * rewards.farming_bound(config.step_reward, trajs)
+    if not is_farmable(robot, start_state, goal_cell, trajs, half, config, wind):
+        return half
     safe = largest_safe_k(robot, start_state, goal_cell, trajs, config, wind)
     k = min(half, SAFETY_FRACTION * safe.k)
     for _ in range(60):
