@@ -40,11 +40,6 @@ from armtransfer.ik.scene import ArmScene, build_scene
 from armtransfer.errors import ArmTransferError
 from armtransfer.ik.description import ArmDescription
 
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never imported
-    from armtransfer.tasks.layout import Layout
-
 SEGMENT_SECONDS = 0.1
 SETTLE_SECONDS = 0.3
 BANDWIDTH_HZ = 8.0

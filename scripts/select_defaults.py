@@ -19,7 +19,7 @@ import numpy as np
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.tasks.layout import ROOMS
-from armtransfer.learning import potentials, methods, rewards, sarsa
+from armtransfer.learning import potentials, methods, sarsa
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.experiment import trial_rng

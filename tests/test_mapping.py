@@ -10,7 +10,7 @@ from armtransfer.errors import InvalidMappingError
 from armtransfer.tasks.catalog import table_task
 from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.tasks.layout import ROOMS, Layout
-from armtransfer.learning import experiment, reference, methods, rewards, sarsa
+from armtransfer.learning import experiment, reference, methods, sarsa
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import ActionMapping, MacroTable, chain, load_for

@@ -61,7 +61,6 @@ def method_table(results: dict) -> str:
     rows = []
     for method, r in results.items():
         conv = r.get("converged", [])
-        med = r.get("median")
         rows.append(
             [
                 method,

@@ -20,7 +20,6 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 
 from armtransfer.errors import InvalidTrajectoryError
 from armtransfer.tasks.layout import ROOMS, Layout
