@@ -7,6 +7,10 @@ to the fine robot, and prints, for every candidate value, the geometric mean ove
 pairs of exploration steps / optimal distance (first episode only, 20 trials per pair).
 
     python scripts/select_defaults.py            # about two minutes on 2 cores
+    python scripts/select_defaults.py --method guided --pairs 6 --trials 10
+
+For ``guided`` the held-out pairs are drawn for each of coarse -> fine, fine -> coarse and
+planar2:joint <-> ur5e_like:cartesian, with the source's shortest path as the trajectory.
 """
 
 from __future__ import annotations
@@ -69,6 +73,81 @@ def score(method: str, params: dict, pairs, trials: int) -> float:
     return float(np.exp(np.mean(np.log(ratios))))
 
 
+GUIDED = [{"window": w, "reach": r, "knn": k}
+          for w, r, k in itertools.product((1.0, 2.0, 4.0), (0.0, 1.0, 1.5), (1, 3, 8))]
+"""Candidates for method ``guided`` (transfer.guide: WINDOW, REACH, KNN)."""
+GUIDED_PAIRS = [("coarse", "fine"), ("fine", "coarse"),
+                ("planar2:joint", "ur5e_like:cartesian"), ("ur5e_like:cartesian", "planar2:joint")]
+
+
+def _robot(spec: str):
+    if ":" in spec:
+        from armtransfer.tasks.specs import resolve
+        return resolve(spec)
+    return grid_robot(spec)
+
+
+def guided_held_out(n: int, seed: int) -> dict:
+    """For each robot pair of GUIDED_PAIRS: n held-out start/goal pairs that both robots can
+    do, at least 20 target steps apart, none a Table I task; with the source's shortest path."""
+    table = {(t.start, t.goal) for t in TABLE_I.values()}
+    out = {}
+    for src_name, dst_name in GUIDED_PAIRS:
+        src, dst = _robot(src_name), _robot(dst_name)
+        rng = np.random.default_rng(seed)
+        cells = np.intersect1d(np.unique(src.label), np.unique(dst.label))
+        cells = [int(c) for c in cells if all(v % 2 == 0 for v in ROOMS.xy(int(c)))]
+        tasks = []
+        tries = 0
+        while len(tasks) < n and tries < 10_000:
+            tries += 1
+            s, g = (int(c) for c in rng.choice(cells, 2, replace=False))
+            if (ROOMS.xy(s), ROOMS.xy(g)) in table:
+                continue
+            path = dst.shortest_path(dst.start_state(s), g)
+            if path is None or len(path) - 1 < 20 or src.shortest_path(src.start_state(s), g) is None:
+                continue
+            tasks.append((s, g, trajectories.shortest(src, s, g), len(path) - 1))
+        out[(src_name, dst_name)] = (dst, tasks)
+    return out
+
+
+def score_guided(params: dict, held: dict, trials: int, cap: int = 50_000) -> dict:
+    """Geometric mean over the held-out tasks of first-exposure steps / optimal distance, per
+    robot pair and overall (an unreached trial counts at the cap)."""
+    from armtransfer.learning import guide
+    from armtransfer.learning.shaping import MODE_NONE
+
+    config = LearnerConfig(max_episodes=1, max_total_steps=cap)
+    per = {}
+    for key, (dst, tasks) in held.items():
+        ratios = []
+        for s, g, traj, optimal in tasks:
+            gd = guide.build(dst, [traj], **params)
+            n = dst.n_states
+            shaping = Shaping(MODE_NONE, np.zeros(n), np.full(n, -1, np.int64), np.zeros(n), 0.0, guide=gd)
+            for t in range(trials):
+                res = sarsa.learn(dst, dst.start_state(s), g, config, trial_rng(12345, t), shaping=shaping)
+                ratios.append((res.exploration_steps or cap) / optimal)
+        per[key] = float(np.exp(np.mean(np.log(ratios))))
+    per["all"] = float(np.exp(np.mean(np.log(list(per.values())))))
+    return per
+
+
+def select_guided(pairs: int, trials: int, seed: int) -> None:
+    held = guided_held_out(pairs, seed)
+    for key, (_, tasks) in held.items():
+        print(f"guided held-out {key[0]} -> {key[1]}:", [(ROOMS.xy(s), ROOMS.xy(g)) for s, g, _, _ in tasks])
+    results = []
+    for c in GUIDED:
+        per = score_guided(c, held, trials)
+        results.append((per["all"], c))
+        print(f"guided       {c}: " + ", ".join(f"{k if k == 'all' else '->'.join(k)} {v:.2f}x"
+                                            for k, v in per.items()), flush=True)
+    best = min(results, key=lambda x: x[0])
+    print(f"-> guided: best {best[1]} ({best[0]:.2f} x optimal, geometric mean over the pairs)", flush=True)
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--pairs", type=int, default=8)
@@ -76,6 +155,10 @@ def main() -> None:
     p.add_argument("--seed", type=int, default=2026)
     p.add_argument("--method", nargs="*", default=None, help="only these methods")
     args = p.parse_args()
+    if args.method and "guided" in args.method:
+        select_guided(args.pairs, args.trials, args.seed)
+        if args.method == ["guided"]:
+            return
     pairs = held_out_pairs(args.pairs, args.seed)
     print("held-out pairs:", [(ROOMS.xy(s), ROOMS.xy(g)) for s, g in pairs])
     for method, cands in CANDIDATES.items():

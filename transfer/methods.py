@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from armtransfer.errors import InvalidParameterError
-from armtransfer.learning import potentials
+from armtransfer.learning import guide, potentials
 from armtransfer.learning import shaping as modes
 from armtransfer.learning.rewards import as_list, farming_bound, longest_n, union_index
 from armtransfer.learning.shaping import Shaping
@@ -98,6 +98,13 @@ def _dense(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float)
     return Shaping(modes.MODE_POTENTIAL, np.zeros(robot.n_states), ids, phi, k)
 
 
+def _guided(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
+    # no reward term: Algorithm 1's updates unchanged; the model only breaks its ties
+    _, ids = union_index(robot, trajs)
+    n = robot.n_states
+    return Shaping(modes.MODE_NONE, np.zeros(n), ids, np.zeros(n), k, guide=guide.build(robot, trajs))
+
+
 METHODS: dict[str, Method] = {
     m.name: m
     for m in (
@@ -114,6 +121,9 @@ METHODS: dict[str, Method] = {
                paper=False, build=_progress, auto_k=30.0),
         Method("dense", "potential from the progress along the trajectory and the distance to it",
                paper=False, build=_dense, auto_k=potentials.DENSE_K),
+        Method("guided", "a model of what robot 2's own actions do to its cell, learned while it "
+               "explores, breaks the ties of epsilon-greedy towards the trajectory's next cells",
+               paper=False, build=_guided, auto_k=0.0),
     )
 }
 """Every method, ``none`` first. The order is the order of reports."""

@@ -25,6 +25,110 @@ def _egreedy(q_row: np.ndarray, eps: float, rng: np.random.Generator) -> int:
     return ties[int(rng.random() * len(ties))]
 
 
+class GuideModel:
+    """The model of method ``guided`` (``transfer.guide``), written out plainly: what robot 2
+    learns of its own actions, its predictions and its tie-breaking."""
+
+    def __init__(self, guide, n_states: int, n_actions: int):
+        self.g = guide
+        self.window, self.reach = guide.params[0], guide.params[1]
+        self.knn, self.memory = int(guide.params[2]), int(guide.params[3])
+        self.sums: dict[tuple[int, int], list[float]] = {}  # (s, a) -> [sum dx, sum dy, count]
+        self.tried_at: list[list[int]] = [[] for _ in range(n_actions)]  # states, in order
+        self.n_traj = len(guide.tstart) - 1
+        self.prog = [0] * self.n_traj
+
+    def cells(self, t: int) -> range:
+        return range(int(self.g.tstart[t]), int(self.g.tstart[t + 1]))
+
+    def start_episode(self, s: int) -> None:
+        self.prog = [int(self.g.tstart[t]) for t in range(self.n_traj)]
+        self.reached(s)
+
+    def reached(self, s: int) -> None:
+        g = self.g
+        x, y = g.lxy[s]
+        for t in range(self.n_traj):
+            i0 = self.prog[t]
+            for j in self.cells(t):
+                if j <= i0:
+                    continue
+                if g.trem[i0] - g.trem[j] > self.window + self.reach:
+                    break
+                if np.sqrt((g.tx[j] - x) * (g.tx[j] - x) + (g.ty[j] - y) * (g.ty[j] - y)) <= self.reach:
+                    self.prog[t] = j
+
+    def observe(self, s: int, a: int, s2: int) -> None:
+        g = self.g
+        entry = self.sums.get((s, a))
+        if entry is None:
+            entry = self.sums[(s, a)] = [0.0, 0.0, 0]
+            self.tried_at[a].append(s)
+        entry[0] += g.lxy[s2][0] - g.lxy[s][0]
+        entry[1] += g.lxy[s2][1] - g.lxy[s][1]
+        entry[2] += 1
+
+    def predict(self, s: int, a: int):
+        if (s, a) in self.sums:
+            sx, sy, n = self.sums[(s, a)]
+            return sx / n, sy / n
+        tried = self.tried_at[a]
+        if not tried:
+            return None
+        # the most recent `memory` states, in the kernel's ring-buffer slot order
+        slots: dict[int, int] = {}
+        for i, u in enumerate(tried):
+            slots[i % self.memory] = u
+        recent = [slots[k] for k in sorted(slots)]
+        f = self.g.feat
+
+        def dist(u: int) -> float:
+            d = 0.0
+            for c in range(f.shape[1]):
+                d += (f[u, c] - f[s, c]) * (f[u, c] - f[s, c])
+            return d
+
+        order = sorted(range(len(recent)), key=lambda i: (dist(recent[i]), i))
+        near = order[: min(self.knn, len(recent))]
+        sx = sy = 0.0
+        for i in near:
+            ex, ey, n = self.sums[(recent[i], a)]
+            sx += ex / n
+            sy += ey / n
+        return sx / len(near), sy / len(near)
+
+    def score(self, x: float, y: float) -> float:
+        g = self.g
+        best = np.inf
+        for t in range(self.n_traj):
+            i0 = self.prog[t]
+            for j in self.cells(t):
+                if j < i0:
+                    continue
+                if g.trem[i0] - g.trem[j] > self.window:
+                    break
+                v = np.sqrt((g.tx[j] - x) * (g.tx[j] - x) + (g.ty[j] - y) * (g.ty[j] - y)) + g.trem[j]
+                best = min(best, v)
+        return best
+
+    def egreedy(self, q_row: np.ndarray, s: int, eps: float, rng: np.random.Generator) -> int:
+        n_actions = len(q_row)
+        if rng.random() < eps:
+            return int(rng.random() * n_actions)
+        best = q_row.max()
+        ties = [a for a in range(n_actions) if q_row[a] == best]
+        x, y = self.g.lxy[s]
+        scores = {}
+        for a in ties:
+            p = self.predict(s, a)
+            scores[a] = -np.inf if p is None else self.score(x + p[0], y + p[1])
+        low = min(scores.values())
+        keep = [a for a in ties if scores[a] == low]
+        if len(keep) == 1:
+            return keep[0]
+        return keep[int(rng.random() * len(keep))]
+
+
 def pseudo_reward(robot: DiscreteRobot, traj: Trajectory | None, K: float, s2: int) -> float:
     """r'(s') = i*K if s' is labelled s_ti, i = 1..n (the largest such i), else 0."""
     if traj is None:
@@ -47,6 +151,8 @@ def learn(
     K: float = 0.0,
     wind: float = 0.0,
     macros=None,
+    guide=None,
+    trace: list | None = None,
 ) -> tuple[np.ndarray, list[int]]:
     """Run ``episodes`` episodes; returns (Q, steps per episode).
 
@@ -55,7 +161,11 @@ def learn(
     steps are ordinary steps; it is abandoned when a step is blocked (the robot did not move,
     observed after wind), and then the next
     action is epsilon-greedy without a macro draw.
+
+    ``guide`` (a ``transfer.guide.Guide``, method ``guided``): its model breaks the ties of
+    epsilon-greedy (:class:`GuideModel`). ``trace``, when given, gets every state visited.
     """
+    model = None if guide is None else GuideModel(guide, robot.n_states, robot.n_actions)
     seq_at: dict[int, list[int]] = {}
     if macros is not None:
         m_start, m_len, m_actions = macros.arrays(robot)
@@ -71,6 +181,8 @@ def learn(
         if may_start and s in seq_at and rng.random() < 1.0 - config.epsilon:
             seq = seq_at[s]
             return seq[0], seq[1:], True
+        if model is not None:
+            return model.egreedy(Q[s], s, config.epsilon, rng), [], False
         return _egreedy(Q[s], config.epsilon, rng), [], False
 
     alpha, gamma = config.alpha, config.gamma
@@ -80,6 +192,10 @@ def learn(
     for _ in range(episodes):
         e = np.zeros_like(Q)  # Initialize e(s, a) = 0 for all s, a
         s = start_state  # Initialize s, a
+        if model is not None:
+            model.start_episode(s)
+        if trace is not None:
+            trace.append(s)
         a, pending, from_macro = choose(s, [], True)
         steps = 0
         while True:  # repeat
@@ -89,6 +205,11 @@ def learn(
                 s2 = int(robot.wind_state[s2])
             blocked = s2 == s  # observed: the robot did not move (after wind)
             steps += 1
+            if model is not None:
+                model.observe(s, a, s2)
+                model.reached(s2)
+            if trace is not None:
+                trace.append(s2)
             terminal = robot.label[s2] == goal_cell
             r = config.step_reward + (config.goal_reward if terminal else 0.0)
             # Choose a' from s' using the epsilon-greedy policy derived from Q

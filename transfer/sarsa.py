@@ -30,6 +30,9 @@ The random stream, in the order it is drawn (the dense reference draws the same)
   2. epsilon-greedy: one draw u; if u < epsilon one more draw picks the action as
      floor(u2 * n_actions); otherwise, when k > 1 actions tie for the largest Q, one more
      draw picks the floor(u2 * k)-th of them in index order;
+     With a guide (method ``guided``, ``transfer.guide``) the tie is first narrowed by the
+     model to the actions of the lowest score, m of them; the extra draw is made only when
+     m > 1 and picks the floor(u2 * m)-th of them in index order (no other draw is added);
   3. wind, only when its probability p > 0: one draw after every move, pushing when < p.
 """
 
@@ -43,6 +46,7 @@ import numpy as np
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.learning.config import LearnerConfig
 
+from armtransfer.learning import guide as _guide
 from armtransfer.learning.shaping import (  # noqa: E402  (the kernel's shaping modes)
     MODE_FIRST_VISIT,
     MODE_NONE,
@@ -80,7 +84,8 @@ def _egreedy(Q, s, n_actions, eps, rng):
 
 
 @numba.njit(cache=True, inline="always")
-def _choose(Q, s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start, macro_len, macro_actions):
+def _choose(Q, s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start, macro_len, macro_actions,
+            guided, g, gm):
     """The next action at s: the running macro's next step; else a new macro starting at s
     (one draw, runs when < 1 - epsilon); else epsilon-greedy. Returns (action, in_macro,
     m_pos, m_end, 1 for a macro step else 0); m_pos/m_end index the flat macro actions."""
@@ -89,6 +94,8 @@ def _choose(Q, s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start, macr
     if may_start and macro_len[s] > 0 and rng.random() < 1.0 - eps:
         m_pos = macro_start[s]
         return macro_actions[m_pos], True, m_pos + 1, m_pos + macro_len[s], 1
+    if guided:
+        return _guide.egreedy(Q, s, eps, rng, g, gm), False, m_pos, m_end, 0
     return _egreedy(Q, s, Q.shape[1], eps, rng), False, m_pos, m_end, 0
 
 
@@ -167,6 +174,8 @@ def _run_trial(
     max_episode_steps,
     patience,
     rng,
+    g,
+    gm,
     Q,
     episode_steps,
     greedy_len,
@@ -191,6 +200,7 @@ def _run_trial(
     converged_episode = -1
     episodes = 0
     has_macros = macro_actions.shape[0] > 0
+    guided = g[5].shape[0] > 1  # the guide has at least one trajectory (transfer.guide)
     for ep in range(max_episodes):
         use_macros = has_macros and ep < macro_episodes
         # reset traces
@@ -199,9 +209,11 @@ def _run_trial(
         n_tr = 0
         s = start
         best = 0.0
+        if guided:
+            _guide.reset_progress(g, gm, s)
         # choose the first action (m_pos: position in the running macro, m_end: its end)
         a, in_macro, m_pos, m_end, macro_used = _choose(
-            Q, s, eps, rng, False, 0, 0, use_macros, macro_start, macro_len, macro_actions
+            Q, s, eps, rng, False, 0, 0, use_macros, macro_start, macro_len, macro_actions, guided, g, gm
         )
         steps = 0
         reached = False
@@ -214,6 +226,9 @@ def _run_trial(
                 s2 = wind_state[s2]
             blocked = s2 == s  # what the robot observes: it did not move (after wind)
             steps += 1
+            if guided:  # robot 2 records what its move did to the label it perceives
+                _guide.observe(g, gm, s, a, s2)
+                _guide.update_progress(g, gm, s2)
             terminal = label[s2] == goal
             r = r_step
             if terminal:
@@ -234,7 +249,7 @@ def _run_trial(
                 # right after an abandoned macro, Algorithm 1 chooses (no immediate retry)
                 a2, in_macro, m_pos, m_end, used = _choose(
                     Q, s2, eps, rng, in_macro, m_pos, m_end, use_macros and not abandoned,
-                    macro_start, macro_len, macro_actions,
+                    macro_start, macro_len, macro_actions, guided, g, gm,
                 )
                 macro_used += used
                 q_next = Q[s2, a2]
@@ -344,6 +359,12 @@ def learn(
     n = robot.n_states
     sh = shaping if shaping is not None else Shaping.none(n)
     m_episodes = None
+    guide = getattr(sh, "guide", None)
+    if guide is None:
+        g, gm = _guide.inactive(robot.n_actions)
+    else:
+        g = _guide.as_tuple(guide)
+        gm = _guide.model_arrays(n, robot.n_actions, guide.memory, len(guide.tstart) - 1)
     if macros is None:
         m_start = np.zeros(n, np.int64)
         m_len = np.zeros(n, np.int64)
@@ -365,7 +386,7 @@ def learn(
         config.alpha, config.gamma, config.lam, config.epsilon,
         config.step_reward, config.goal_reward, float(wind), config.trace_cutoff,
         config.max_episodes, config.max_total_steps, config.max_episode_steps, config.patience,
-        rng, Q, episode_steps, greedy_len, macro_steps, path_buf, prev_path,
+        rng, g, gm, Q, episode_steps, greedy_len, macro_steps, path_buf, prev_path,
     )
     episode_steps = episode_steps[:episodes].copy()
     first = int(episode_steps[0]) if episodes and episode_steps[0] > 0 else None

@@ -31,6 +31,9 @@ class Shaping:
     traj_index: np.ndarray  # int64 [S]: an id of the trajectory cell a state is on, -1 elsewhere
     phi: np.ndarray  # float64 [S]: potential, for potential-based methods
     K: float = 0.0
+    guide: object | None = None
+    """Optional ``armtransfer.learning.guide.Guide``: a model of robot 2's own actions that
+    breaks the ties of epsilon-greedy (method ``guided``); None: ties are broken at random."""
 
     @staticmethod
     def potential(phi: np.ndarray, K: float = 0.0) -> "Shaping":

@@ -1,0 +1,268 @@
+"""Method ``guided``: robot 2 learns, while it explores, what its own actions do to its label,
+and uses that to break Algorithm 1's ties towards the next cells of the transferred trajectory.
+
+Why: with Q = 0 at the start and a step reward of -1, every untried action ties at the top of
+Q. Algorithm 1 breaks such a tie at random, so at a new state robot 2 does not know which of
+its actions leads on along the trajectory until it has tried them there. Here the tie is
+broken by a model robot 2 learns of itself; Algorithm 1's updates are unchanged, so the
+greedy path still converges as SARSA(lambda)'s does.
+
+The model (all of it from what robot 2 observes):
+  * After every move s --a--> s' it records the displacement of its label, xy(label[s']) -
+    xy(label[s]), for the pair (s, a) (a running mean: with wind the push is part of what it
+    sees), and remembers s among the last ``memory`` states at which it tried a.
+  * The predicted displacement of a at s is the recorded mean when (s, a) was tried; else the
+    mean over the ``knn`` states nearest to s, in robot 2's own configuration space, at which
+    a was tried (for an arm its joint configuration ``arm.qpos``; for a grid robot its cell):
+    the same action moves the tip by about the same cells in neighbouring configurations.
+    An action never tried anywhere is predicted to be the best (optimistic), so each action
+    is tried once early.
+  * Progress along a trajectory: the furthest index whose cell the label came within
+    ``reach`` cells of in this episode. The score of a predicted label position q is
+    min over the trajectory cells c_j ahead of that index, within ``window`` cells of
+    trajectory length, of |q - c_j| + (the trajectory's length from c_j to its end); lower is
+    better. With several trajectories the smallest score counts.
+  * Among the actions of largest Q, those of the lowest score are kept; one draw picks among
+    them when more than one is left.
+
+A wrong prediction (a wall, a joint limit, a cell the robot cannot reach) costs one step:
+the pair is then tried, its Q falls below the untried ones, and the next tie is broken among
+the rest -- the learner's own exploration is the fallback. The model never reads the robot's
+transition table nor the map; the kernel reads ``next_state`` only to take the move chosen.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from armtransfer.errors import InvalidParameterError
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.learning.trajectory import Trajectory
+
+WINDOW = 2.0
+"""Cells of trajectory length ahead of the progress index that the score looks at."""
+REACH = 1.0
+"""A trajectory cell counts as reached when the label comes within this many cells."""
+KNN = 8
+"""Neighbours in configuration space a prediction for an untried pair averages."""
+MEMORY = 256
+"""States per action remembered for the neighbour search (the most recent).
+
+WINDOW, REACH and KNN were chosen on held-out start/goal pairs for coarse <-> fine and
+planar2:joint <-> ur5e_like:cartesian (``scripts/select_defaults.py --method guided``), never
+on Table I; MEMORY was not tuned."""
+
+
+@dataclass(frozen=True, eq=False)
+class Guide:
+    """The arrays the kernel's tie-breaking model reads (see the module docstring)."""
+
+    feat: np.ndarray  # float64 [S, D]: robot 2's own configuration of each of its states
+    lxy: np.ndarray  # float64 [S, 2]: the xy of the label robot 2 perceives at each state
+    tx: np.ndarray  # float64 [T]: the trajectory cells' x (its goal last), trajectories one after another
+    ty: np.ndarray  # float64 [T]
+    trem: np.ndarray  # float64 [T]: trajectory length (cells) from this cell to its end
+    tstart: np.ndarray  # int64 [n_traj + 1]: where each trajectory starts in tx/ty/trem
+    params: np.ndarray  # float64 [4]: window, reach, knn, memory
+
+    @property
+    def memory(self) -> int:
+        return int(self.params[3])
+
+
+def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW, reach: float = REACH,
+          knn: int = KNN, memory: int = MEMORY) -> Guide:
+    """The guide for ``robot`` following ``trajs`` (one or several)."""
+    if not (np.isfinite(window) and window >= 0 and np.isfinite(reach) and reach >= 0):
+        raise InvalidParameterError(f"window and reach must be non-negative numbers, got {window}, {reach}")
+    if int(knn) < 1 or int(memory) < 1:
+        raise InvalidParameterError(f"knn and memory must be positive integers, got {knn}, {memory}")
+    layout = robot.layout
+    lxy = layout.xy_of(robot.label).astype(np.float64).reshape(-1, 2)
+    if robot.arm is not None:
+        feat = np.asarray(robot.arm.qpos, dtype=np.float64).reshape(robot.n_states, -1)
+    else:
+        feat = lxy.copy()
+    xs, ys, rem, starts = [], [], [], [0]
+    for t in trajs:
+        cells = [*t.cells, t.goal]  # s_t0 .. s_tn and the goal s_tg
+        c = np.array([layout.xy(int(cell)) for cell in cells], dtype=np.float64).reshape(-1, 2)
+        seg = np.sqrt(((c[1:] - c[:-1]) ** 2).sum(axis=1))
+        r = np.concatenate([np.cumsum(seg[::-1])[::-1], [0.0]]) if len(seg) else np.zeros(1)
+        xs.append(c[:, 0])
+        ys.append(c[:, 1])
+        rem.append(r)
+        starts.append(starts[-1] + len(c))
+    return Guide(
+        feat=np.ascontiguousarray(feat), lxy=np.ascontiguousarray(lxy),
+        tx=np.concatenate(xs), ty=np.concatenate(ys), trem=np.concatenate(rem),
+        tstart=np.array(starts, np.int64),
+        params=np.array([float(window), float(reach), float(int(knn)), float(int(memory))]),
+    )
+
+
+def inactive(n_actions: int) -> tuple:
+    """(guide tuple, model tuple) for a trial without a guide: empty arrays of the right types."""
+    g = (np.zeros((0, 1)), np.zeros((0, 2)), np.zeros(0), np.zeros(0), np.zeros(0),
+         np.zeros(1, np.int64), np.array([0.0, 0.0, 1.0, 1.0]))
+    return g, model_arrays(0, n_actions, 1, 1)
+
+
+def as_tuple(g: Guide) -> tuple:
+    return (g.feat, g.lxy, g.tx, g.ty, g.trem, g.tstart, g.params)
+
+
+def model_arrays(n_states: int, n_actions: int, memory: int, n_traj: int) -> tuple:
+    """What the model learns during a trial: (displacement sums [S, A, 2], counts [S, A],
+    remembered states [A, memory], pushes per action [A], progress index per trajectory)."""
+    return (np.zeros((n_states, n_actions, 2)), np.zeros((n_states, n_actions), np.int64),
+            np.zeros((n_actions, memory), np.int64), np.zeros(n_actions, np.int64),
+            np.zeros(max(n_traj, 1), np.int64))
+
+
+@numba.njit(cache=True)
+def reset_progress(g, gm, s):
+    """At an episode's start: progress at each trajectory's first cell, then what s reaches."""
+    tstart = g[5]
+    prog = gm[4]
+    for t in range(tstart.shape[0] - 1):
+        prog[t] = tstart[t]
+    update_progress(g, gm, s)
+
+
+@numba.njit(cache=True)
+def update_progress(g, gm, s):
+    """Advance each trajectory's progress index to the furthest cell within reach of s's
+    label, looking up to ``window + reach`` cells of trajectory length ahead."""
+    lxy, tx, ty, trem, tstart, params = g[1], g[2], g[3], g[4], g[5], g[6]
+    prog = gm[4]
+    reach = params[1]
+    horizon = params[0] + reach
+    x = lxy[s, 0]
+    y = lxy[s, 1]
+    for t in range(tstart.shape[0] - 1):
+        i0 = prog[t]
+        for j in range(i0 + 1, tstart[t + 1]):
+            if trem[i0] - trem[j] > horizon:
+                break
+            dx = tx[j] - x
+            dy = ty[j] - y
+            if np.sqrt(dx * dx + dy * dy) <= reach:
+                prog[t] = j
+
+
+@numba.njit(cache=True)
+def observe(g, gm, s, a, s2):
+    """Record the move s --a--> s2 (s2: the state whose label robot 2 perceives after it)."""
+    lxy, params = g[1], g[6]
+    dsum, dcnt, buf, bufn = gm[0], gm[1], gm[2], gm[3]
+    dsum[s, a, 0] += lxy[s2, 0] - lxy[s, 0]
+    dsum[s, a, 1] += lxy[s2, 1] - lxy[s, 1]
+    if dcnt[s, a] == 0:
+        memory = int(params[3])
+        buf[a, bufn[a] % memory] = s
+        bufn[a] += 1
+    dcnt[s, a] += 1
+
+
+@numba.njit(cache=True)
+def predict(g, gm, s, a):
+    """(known, dx, dy): the predicted label displacement of a at s; known is False when a
+    was never tried anywhere."""
+    feat, params = g[0], g[6]
+    dsum, dcnt, buf, bufn = gm[0], gm[1], gm[2], gm[3]
+    if dcnt[s, a] > 0:
+        return True, dsum[s, a, 0] / dcnt[s, a], dsum[s, a, 1] / dcnt[s, a]
+    memory = int(params[3])
+    n = min(bufn[a], memory)
+    if n == 0:
+        return False, 0.0, 0.0
+    k = min(int(params[2]), n)
+    dist = np.empty(n)
+    for i in range(n):
+        u = buf[a, i]
+        d = 0.0
+        for c in range(feat.shape[1]):
+            diff = feat[u, c] - feat[s, c]
+            d += diff * diff
+        dist[i] = d
+    taken = np.zeros(n, np.bool_)
+    sx = 0.0
+    sy = 0.0
+    for _ in range(k):
+        best = -1
+        for i in range(n):
+            if not taken[i] and (best < 0 or dist[i] < dist[best]):
+                best = i
+        taken[best] = True
+        u = buf[a, best]
+        sx += dsum[u, a, 0] / dcnt[u, a]
+        sy += dsum[u, a, 1] / dcnt[u, a]
+    return True, sx / k, sy / k
+
+
+@numba.njit(cache=True)
+def score(g, gm, x, y):
+    """How far (cells) a label at (x, y) is from the goal along the trajectories ahead."""
+    tx, ty, trem, tstart, params = g[2], g[3], g[4], g[5], g[6]
+    prog = gm[4]
+    window = params[0]
+    best = np.inf
+    for t in range(tstart.shape[0] - 1):
+        i0 = prog[t]
+        for j in range(i0, tstart[t + 1]):
+            if trem[i0] - trem[j] > window:
+                break
+            dx = tx[j] - x
+            dy = ty[j] - y
+            v = np.sqrt(dx * dx + dy * dy) + trem[j]
+            if v < best:
+                best = v
+    return best
+
+
+@numba.njit(cache=True)
+def egreedy(Q, s, eps, rng, g, gm):
+    """Algorithm 1's epsilon-greedy with the model breaking ties among the best-Q actions.
+
+    Draws: u; if u < eps one more draw picks floor(u2 * n_actions); otherwise, when k > 1
+    actions tie for the largest Q, the model keeps those of the lowest score, and when m > 1
+    remain one more draw picks the floor(u2 * m)-th of them in index order."""
+    n_actions = Q.shape[1]
+    if rng.random() < eps:
+        return int(rng.random() * n_actions)
+    best = Q[s, 0]
+    for a in range(1, n_actions):
+        if Q[s, a] > best:
+            best = Q[s, a]
+    lxy = g[1]
+    x = lxy[s, 0]
+    y = lxy[s, 1]
+    sc = np.full(n_actions, np.inf)
+    low = np.inf
+    for a in range(n_actions):
+        if Q[s, a] == best:
+            known, dx, dy = predict(g, gm, s, a)
+            v = score(g, gm, x + dx, y + dy) if known else -np.inf
+            sc[a] = v
+            if v < low:
+                low = v
+    m = 0
+    first = -1
+    for a in range(n_actions):
+        if Q[s, a] == best and sc[a] == low:
+            if first < 0:
+                first = a
+            m += 1
+    if m == 1:
+        return first
+    k = int(rng.random() * m)
+    for a in range(n_actions):
+        if Q[s, a] == best and sc[a] == low:
+            if k == 0:
+                return a
+            k -= 1
+    return n_actions - 1  # unreachable
