@@ -58,9 +58,9 @@ class TransferReward(gym.Wrapper, gym.utils.RecordConstructorArgs):
                 f"TransferReward needs one of armtransfer's environments (no {', '.join(missing)} on "
                 f"{type(base).__name__})")
         m = registry.get(method)
-        if not m.shaped:
-            shaped = [name for name, x in registry.METHODS.items() if x.shaped]
-            raise InvalidParameterError(f"method {method!r} adds no reward; valid methods: {', '.join(shaped)}")
+        if m.name not in registry.REWARD_ONLY:
+            why = "adds no reward" if not m.shaped else "changes how the learner chooses actions, not a reward"
+            raise InvalidParameterError(f"method {method!r} {why}; valid methods: {', '.join(registry.REWARD_ONLY)}")
         if not (isinstance(gamma, (int, float)) and 0.0 <= gamma <= 1.0):
             raise InvalidParameterError(f"gamma must be in [0, 1], got {gamma!r}")
         self.robot = base.robot

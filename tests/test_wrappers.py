@@ -23,7 +23,7 @@ from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.wrappers import TransferReward
 
 register_envs()
-SHAPED = [name for name, m in registry.METHODS.items() if m.shaped]
+SHAPED = list(registry.REWARD_ONLY)
 
 
 def _egreedy(Q, s, eps, rng):
@@ -136,6 +136,7 @@ def test_trajectory_files_and_several_trajectories(tmp_path, traj):
 @pytest.mark.parametrize("kwargs,message", [
     (dict(method="nope"), "unknown method 'nope'; valid methods:"),
     (dict(method="none"), "adds no reward; valid methods: pseudo"),
+    (dict(method="guided"), "changes how the learner chooses actions"),
     (dict(K=5.0), "can be farmed"),
     (dict(gamma=2.0), "gamma must be in [0, 1]"),
 ])

@@ -48,6 +48,9 @@ class Method:
     """A state bonus that a loop could collect forever: K is checked against farming."""
     macros: bool = False
     """Runs the action sequence mapping's macros (needs exactly one trajectory)."""
+    chooses: bool = False
+    """Changes how the learner chooses actions, not only its rewards (so no reward wrapper can
+    give it to another learner)."""
 
     @property
     def shaped(self) -> bool:
@@ -123,12 +126,15 @@ METHODS: dict[str, Method] = {
                paper=False, build=_dense, auto_k=potentials.DENSE_K),
         Method("guided", "a model of what robot 2's own actions do to its cell, learned while it "
                "explores, breaks the ties of epsilon-greedy towards the trajectory's next cells",
-               paper=False, build=_guided, auto_k=0.0),
+               paper=False, build=_guided, auto_k=0.0, chooses=True),
     )
 }
 """Every method, ``none`` first. The order is the order of reports."""
 
 SHAPED = tuple(name for name, m in METHODS.items() if m.shaped and not m.macros)
+
+REWARD_ONLY = tuple(name for name, m in METHODS.items() if m.shaped and not m.chooses)
+"""The methods whose transfer is a reward term alone (what ``armtransfer.wrappers`` can add)."""
 """The methods that are a reward term only (controls run these)."""
 
 
