@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-_SOURCES = ("ik/compile.py", "ik/solve.py", "ik/scene.py", "ik/labels.py", "tasks/workspace.py")
+_SOURCES = ("ik/compile.py", "ik/solve.py", "ik/scene.py", "ik/labels.py", "ik/workspace.py", "ik/tool.py")
 _ROOT = Path(__file__).resolve().parent.parent
 
 

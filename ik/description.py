@@ -2,7 +2,7 @@
 
 A discrete arm robot (``armtransfer.tasks.arms``) carries one of these as ``robot.arm``.
 It holds everything needed to rebuild the exact MuJoCo scene the robot was compiled in
-(``xml_path``, ``tip_site``, ``mount``, ``yaw``, ``cell_size``, ``layout``) and the joint
+(``xml_path``, ``tool``, ``mount``, ``yaw``, ``cell_size``, ``layout``) and the joint
 configuration and tip position of every state, so a path can be replayed in physics.
 """
 
@@ -13,6 +13,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from armtransfer.ik.tool import Tool
+
 if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never imported
     from armtransfer.tasks.layout import Layout
 
@@ -20,7 +22,8 @@ if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never impor
 @dataclass(frozen=True, eq=False)
 class ArmDescription:
     name: str
-    """The arm's name: a built-in arm, or a bring-your-own arm's file stem."""
+    """The arm's name: a built-in arm, or a bring-your-own arm's MJCF ``model`` attribute
+    (its file stem when it has none), or the name the user gave it."""
     actions: str
     """The action model: ``joint``, ``cartesian`` or ``cartesian2``."""
     dof: int
@@ -42,9 +45,20 @@ class ArmDescription:
     mount: tuple[float, float, float]
     yaw: float
     xml_path: str
-    tip_site: str
+    tool: Tool
+    """The tool point: a site or body of the arm file and an offset in its frame."""
     joint_step: float | None
     """Lattice step of the ``joint`` action model (rad); None for cartesian models."""
     layout: Layout
     lattice: Any = None
     """The ``joint`` model's lattice indices per state, when it has one."""
+    mount_source: str = "given"
+    """Where the mount came from: ``built-in``, ``given``, ``generated`` or ``automatic``."""
+    chain: tuple[str, ...] = ()
+    """The arm's joints from the base to the tool, as named in the arm file."""
+    held: tuple[tuple[str, float], ...] = ()
+    """Joints off that chain (fingers, jaws) and the home value each is held at."""
+
+    @property
+    def tip_site(self) -> str | None:
+        return self.tool.site

@@ -174,7 +174,7 @@ def arm_of(robot) -> ArmDescription:
 def robot_scene(robot) -> ArmScene:
     """The MuJoCo scene ``robot`` (a discrete arm robot) was compiled in, rebuilt from its arm."""
     arm = arm_of(robot)
-    return build_scene(arm.xml_path, arm.tip_site, arm.mount, arm.yaw, arm.cell_size, layout=arm.layout)
+    return build_scene(arm.xml_path, arm.tool, arm.mount, arm.yaw, arm.cell_size, layout=arm.layout)
 
 
 def _dedupe(cells: Sequence[int]) -> list[int]:

@@ -1,48 +1,77 @@
-"""An arm attached to the tabletop workspace with ``dm_control.mjcf``, compiled to MuJoCo.
+"""An arm attached to the tabletop workspace with MuJoCo's ``MjSpec``, compiled to MuJoCo.
 
-The arm's own MJCF is loaded, renamed ``arm`` (so every arm element is ``arm/<name>`` in
-the scene), stripped of its keyframes (the scene keeps the arm's ``home`` separately) and
-attached to the workspace at the arm's mounting pose.
+Any MJCF serial arm works as it is, MuJoCo Menagerie files included (class names with
+``/``, a ``meshdir`` beside the file, ``general`` actuators, grippers driven by tendons):
+
+- **The tool point** is a :class:`~armtransfer.ik.tool.Tool`: a site or a body of the file
+  and an offset in its own frame. With an offset (or a body) the scene gets a site of its own
+  there, ``tool_tip``, whose z axis is the tool's axis (the offset's direction).
+- **The arm is the chain of joints from the base to the tool.** Joints off that chain
+  (fingers, jaws) are held at their home value: each is removed and its body fixed where
+  that value puts it, so it is not a degree of freedom. Joint types are read from the
+  compiled model, default classes resolved. Tendons, equality constraints and sensors
+  that refer to a removed joint go with it.
+- **Actuators.** Position servos (an affine bias) on chain joints are kept, one per joint;
+  every other actuator is dropped, and a chain joint left without one gets a servo of the
+  scene's own, ``servo_<joint>``. So a replay can drive every chain joint, whatever
+  actuators the file has.
+- The file's keyframes are dropped (the scene keeps the arm's home separately), its options
+  are the scene's, and the whole arm is attached under the prefix ``arm/`` at its mounting
+  pose.
 """
 
 from __future__ import annotations
 
 import hashlib
 import math
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
 
 from armtransfer.errors import ArmModelError
+from armtransfer.ik.tool import Tool
 from armtransfer.ik.workspace import DEFAULT_CELL, WALL_HEIGHT, build_workspace
-
-from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never imported
     from armtransfer.tasks.layout import Layout
 
 PREFIX = "arm/"
+TOOL_SITE = "tool_tip"
+SERVO_KP = 100.0
+"""Stiffness of a servo the scene adds (N m/rad); a replay retunes every servo anyway."""
 
 
 @dataclass(frozen=True)
 class ArmScene:
     model: mujoco.MjModel
     xml: str
-    """The composed scene's MJCF (what the cache key hashes)."""
+    """The composed scene's MJCF."""
     tip: str
     """Full name of the tool-tip site in the scene."""
     home: np.ndarray
+    """The chain joints' home configuration."""
     lower: np.ndarray
     upper: np.ndarray
     env_geoms: np.ndarray
     """Boolean mask over geoms: True for table and wall geoms."""
     arm_geoms: np.ndarray
+    """Boolean mask over geoms: True for the arm's geoms that move with a joint (a base fixed
+    to the world may stand on the table; only moving parts can strike it)."""
     cell: float
     layout: Layout
     planar: bool
     """All joint axes vertical: the tip moves in a horizontal plane at a fixed height."""
+    name: str = "arm"
+    """The MJCF ``model`` attribute of the arm file."""
+    chain: tuple[str, ...] = ()
+    """The arm's joints, base to tool (names in the arm file)."""
+    held: tuple[tuple[str, float], ...] = ()
+    """Joints off the chain and the home value each is held at."""
+    tool: Tool = Tool()
 
     @property
     def nq(self) -> int:
@@ -52,88 +81,269 @@ class ArmScene:
         return hashlib.sha256(self.xml.encode()).hexdigest()
 
 
-def _load_arm(xml_path: Path):
-    from dm_control import mjcf
+def _first_line(err: BaseException) -> str:
+    text = str(err).strip()
+    return text.splitlines()[0] if text else type(err).__name__
 
-    path = Path(xml_path)
+
+def _load_arm(path: Path) -> tuple[mujoco.MjSpec, mujoco.MjModel]:
     if not path.is_file():
         raise ArmModelError(f"cannot read arm MJCF {str(path)!r}: no such file")
     try:
-        mujoco.MjModel.from_xml_path(str(path))
-        arm = mjcf.from_path(str(path))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            spec = mujoco.MjSpec.from_file(str(path))
+            model = spec.compile()
     except Exception as err:  # noqa: BLE001 - any parse failure is a bad input file
-        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-        raise ArmModelError(f"cannot load arm MJCF {str(path)!r}: {first}") from None
-    return arm
+        raise ArmModelError(f"cannot load arm MJCF {str(path)!r}: {_first_line(err)}") from None
+    return spec, model
 
 
-def arm_home(xml_path: Path) -> np.ndarray:
-    """The arm's ``home`` keyframe qpos, else its qpos0 clipped into the joint ranges."""
-    model = mujoco.MjModel.from_xml_path(str(xml_path))
+def _name(model: mujoco.MjModel, obj: mujoco.mjtObj, i: int) -> str:
+    return mujoco.mj_id2name(model, obj, i) or ""
+
+
+def _home_qpos(model: mujoco.MjModel) -> np.ndarray:
+    """The ``home`` keyframe's qpos, else qpos0, clipped into the joint ranges."""
     key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, "home")
     q = model.key_qpos[key].copy() if key >= 0 else model.qpos0.copy()
-    limited = model.jnt_limited.astype(bool)
-    lo, hi = model.jnt_range[:, 0], model.jnt_range[:, 1]
-    adr = model.jnt_qposadr
-    q[adr[limited]] = np.clip(q[adr[limited]], lo[limited], hi[limited])
+    for j in range(model.njnt):
+        kind = model.jnt_type[j]
+        if model.jnt_limited[j] and (kind == mujoco.mjtJoint.mjJNT_HINGE or kind == mujoco.mjtJoint.mjJNT_SLIDE):
+            a = model.jnt_qposadr[j]
+            q[a] = np.clip(q[a], *model.jnt_range[j])
     return q
 
 
-def build_scene(xml_path: Path, tip_site: str = "tip", mount_pos=(0.0, 0.0, 0.0),
+def arm_home(xml_path: Path) -> np.ndarray:
+    """The arm file's ``home`` keyframe qpos (every joint), else its qpos0, clipped."""
+    return _home_qpos(_load_arm(Path(xml_path))[1])
+
+
+def _tip_body(model: mujoco.MjModel, tool: Tool, where: str) -> int:
+    if tool.site is not None:
+        sid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, tool.site)
+        if sid < 0:
+            names = [n for n in (_name(model, mujoco.mjtObj.mjOBJ_SITE, i) for i in range(model.nsite)) if n]
+            raise ArmModelError(f"arm MJCF {where} has no site {tool.site!r}; its sites: "
+                                f"{', '.join(names) if names else 'none (use --tip-body)'}")
+        return int(model.site_bodyid[sid])
+    bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, tool.body)
+    if bid <= 0:
+        names = [n for n in (_name(model, mujoco.mjtObj.mjOBJ_BODY, i) for i in range(1, model.nbody)) if n]
+        raise ArmModelError(f"arm MJCF {where} has no body {tool.body!r}; its bodies: "
+                            f"{', '.join(names) if names else 'none'}")
+    return bid
+
+
+def _chain(model: mujoco.MjModel, tip_body: int, where: str) -> list[int]:
+    """Joint ids on the bodies from the tool's body up to the world, in qpos order."""
+    bodies = set()
+    b = tip_body
+    while b > 0:
+        bodies.add(b)
+        b = int(model.body_parentid[b])
+    joints = sorted((j for j in range(model.njnt) if model.jnt_bodyid[j] in bodies),
+                    key=lambda j: model.jnt_qposadr[j])
+    if not joints:
+        raise ArmModelError(f"arm MJCF {where} has no joint between its base and the tool")
+    kinds = {int(mujoco.mjtJoint.mjJNT_SLIDE): "slide", int(mujoco.mjtJoint.mjJNT_BALL): "ball"}
+    for j in joints:
+        if model.jnt_type[j] != mujoco.mjtJoint.mjJNT_HINGE:
+            raise ArmModelError(
+                f"arm MJCF {where}: joint {_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) or j} on the chain from the "
+                f"base to the tool is a {kinds.get(int(model.jnt_type[j]), 'free')} joint; only hinge joints "
+                "are supported")
+    return joints
+
+
+def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    out = np.empty(4)
+    mujoco.mju_mulQuat(out, np.asarray(a, dtype=float), np.asarray(b, dtype=float))
+    return out
+
+
+def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    out = np.empty(3)
+    mujoco.mju_rotVecQuat(out, np.asarray(v, dtype=float), np.asarray(q, dtype=float))
+    return out
+
+
+def _axis_quat(axis: np.ndarray, angle: float) -> np.ndarray:
+    out = np.empty(4)
+    mujoco.mju_axisAngle2Quat(out, np.asarray(axis, dtype=float), float(angle))
+    return out
+
+
+def _hold(spec: mujoco.MjSpec, model: mujoco.MjModel, joints: list[int], q: np.ndarray, where: str) -> None:
+    """Remove ``joints`` and fix each one's body where its value in ``q`` puts it."""
+    by_body: dict[int, list[int]] = {}
+    for j in joints:
+        by_body.setdefault(int(model.jnt_bodyid[j]), []).append(j)
+    for b, js in by_body.items():
+        name = _name(model, mujoco.mjtObj.mjOBJ_BODY, b)
+        body = spec.body(name) if name else None
+        if body is None:
+            raise ArmModelError(f"arm MJCF {where}: the body of joint "
+                                f"{_name(model, mujoco.mjtObj.mjOBJ_JOINT, js[0]) or js[0]} needs a name")
+        pos, quat = model.body_pos[b].copy(), model.body_quat[b].copy()
+        for j in sorted(js):
+            a = model.jnt_qposadr[j]
+            axis, anchor = model.jnt_axis[j], model.jnt_pos[j]
+            kind = model.jnt_type[j]
+            if kind == mujoco.mjtJoint.mjJNT_SLIDE:
+                pos = pos + _rotate(quat, axis * q[a])
+                continue
+            rot = _axis_quat(axis, q[a]) if kind == mujoco.mjtJoint.mjJNT_HINGE else q[a:a + 4] / np.linalg.norm(q[a:a + 4])
+            pos = pos + _rotate(quat, anchor - _rotate(rot, anchor))
+            quat = _quat_mul(quat, rot)
+        body.pos = pos
+        body.quat = quat
+        body.alt.type = mujoco.mjtOrientation.mjORIENTATION_QUAT
+        for j in js:
+            spec.delete(spec.joint(_name(model, mujoco.mjtObj.mjOBJ_JOINT, j)))
+
+
+def _prune(spec: mujoco.MjSpec, model: mujoco.MjModel, removed: set[int]) -> None:
+    """Drop tendons, equalities and sensors that refer to removed joints, and keyframes."""
+    gone_tendons = set()
+    for t in range(model.ntendon):
+        adr, num = model.tendon_adr[t], model.tendon_num[t]
+        if any(model.wrap_type[w] == mujoco.mjtWrap.mjWRAP_JOINT and model.wrap_objid[w] in removed
+               for w in range(adr, adr + num)):
+            gone_tendons.add(t)
+    for e in reversed(range(model.neq)):
+        kind, o1, o2 = model.eq_type[e], model.eq_obj1id[e], model.eq_obj2id[e]
+        if (kind == mujoco.mjtEq.mjEQ_JOINT and (o1 in removed or o2 in removed)) or (
+                kind == mujoco.mjtEq.mjEQ_TENDON and (o1 in gone_tendons or o2 in gone_tendons)):
+            spec.delete(spec.equalities[e])
+    for t in sorted(gone_tendons, reverse=True):
+        spec.delete(spec.tendons[t])
+    for s in list(spec.sensors):
+        spec.delete(s)
+    for k in list(spec.keys):
+        spec.delete(k)
+
+
+def _actuators(spec: mujoco.MjSpec, model: mujoco.MjModel, chain: list[int]) -> list[int]:
+    """Keep one position servo per chain joint, drop every other actuator; returns the chain
+    joints left without one."""
+    keep: dict[int, int] = {}
+    for a in range(model.nu):
+        j = int(model.actuator_trnid[a, 0])
+        if (model.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT and j in chain and j not in keep
+                and model.actuator_biastype[a] == mujoco.mjtBias.mjBIAS_AFFINE
+                and abs(model.actuator_gear[a, 0] - 1.0) < 1e-9):
+            keep[j] = a
+    for a in reversed(range(model.nu)):
+        if a not in keep.values():
+            spec.delete(spec.actuators[a])
+    return [j for j in chain if j not in keep]
+
+
+def _tool_site(spec: mujoco.MjSpec, model: mujoco.MjModel, tool: Tool, tip_body: int) -> str:
+    """The site the scene uses as the tool tip (added when the tool has an offset or is a body)."""
+    if tool.site is not None and not tool.has_offset:
+        return tool.site
+    if tool.site is not None:
+        sid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, tool.site)
+        frame_pos, frame_quat = model.site_pos[sid].copy(), model.site_quat[sid].copy()
+    else:
+        frame_pos, frame_quat = np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])
+    offset = np.array(tool.offset)
+    quat = frame_quat
+    if tool.has_offset:  # the tool's z axis along the offset, from the frame to the tip
+        turn = np.empty(4)
+        mujoco.mju_quatZ2Vec(turn, offset / np.linalg.norm(offset))
+        quat = _quat_mul(frame_quat, turn)
+    name = TOOL_SITE
+    existing = {_name(model, mujoco.mjtObj.mjOBJ_SITE, i) for i in range(model.nsite)}
+    while name in existing:
+        name += "_"
+    body_name = _name(model, mujoco.mjtObj.mjOBJ_BODY, tip_body)
+    body = spec.body(body_name) if body_name else None
+    if body is None:
+        raise ArmModelError("the tool's body needs a name in the arm MJCF")
+    body.add_site(name=name, pos=frame_pos + _rotate(frame_quat, offset), quat=quat, size=[0.004, 0, 0],
+                  rgba=[0.9, 0.2, 0.2, 1.0], group=4)
+    return name
+
+
+def _copy_options(src: mujoco.MjSpec, dst: mujoco.MjSpec) -> None:
+    """The scene's physics options win: copy them onto the arm so attaching raises no conflict."""
+    for attr in dir(src.option):
+        if attr.startswith("_"):
+            continue
+        try:
+            setattr(dst.option, attr, getattr(src.option, attr))
+        except (AttributeError, TypeError):
+            pass
+
+
+def build_scene(xml_path: Path, tool: Tool | str = "tip", mount_pos=(0.0, 0.0, 0.0),
                 mount_yaw: float = 0.0, cell: float = DEFAULT_CELL, *, layout: Layout,
                 wall_height: float = WALL_HEIGHT) -> ArmScene:
-    """Attach the arm at ``xml_path`` to the workspace; validate it is a hinge-joint arm."""
-    arm = _load_arm(xml_path)
-    sites = [s.name for s in arm.find_all("site") if s.name]
-    if tip_site not in sites:
-        valid = ", ".join(sites) if sites else "none"
-        raise ArmModelError(f"arm MJCF {str(xml_path)!r} has no site {tip_site!r}; its sites: {valid}")
-    joints = arm.find_all("joint")
-    if any(j.tag == "freejoint" or j.type == "free" for j in joints):
-        raise ArmModelError(f"arm MJCF {str(xml_path)!r} has a free joint; a fixed-base serial arm is needed")
-    kinds = [(j.type or "hinge") for j in joints if j.tag == "joint"]
-    if not joints or "hinge" not in kinds:
-        raise ArmModelError(f"arm MJCF {str(xml_path)!r} has no hinge joints")
-    if any(k != "hinge" for k in kinds):
-        bad = sorted({k for k in kinds if k != "hinge"})
-        raise ArmModelError(
-            f"arm MJCF {str(xml_path)!r} has {', '.join(bad)} joints; only hinge joints are supported")
-    home = arm_home(xml_path)
-    for key in list(arm.keyframe.key):
-        key.remove()
-    arm.model = "arm"
-    scene = build_workspace(layout, cell, wall_height)
-    frame = scene.attach(arm)
-    frame.pos = tuple(float(v) for v in mount_pos)
-    frame.quat = (math.cos(mount_yaw / 2), 0.0, 0.0, math.sin(mount_yaw / 2))
-    xml = scene.to_xml_string()
+    """Attach the arm at ``xml_path`` to the workspace (see the module docstring)."""
+    tool = Tool(site=tool) if isinstance(tool, str) else tool
+    path = Path(xml_path)
+    where = repr(str(path))
+    spec, model = _load_arm(path)
+    if any(model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE for j in range(model.njnt)):
+        raise ArmModelError(f"arm MJCF {where} has a free joint; a fixed-base serial arm is needed")
+    tip_body = _tip_body(model, tool, where)
+    chain = _chain(model, tip_body, where)
+    q_all = _home_qpos(model)
+    off = [j for j in range(model.njnt) if j not in chain]
+    joint_name = lambda j: _name(model, mujoco.mjtObj.mjOBJ_JOINT, j)  # noqa: E731
+    for j in chain:
+        if not joint_name(j):
+            raise ArmModelError(f"arm MJCF {where}: every joint on the chain from the base to the tool needs a name")
+    held = tuple((joint_name(j) or f"#{j}", float(q_all[model.jnt_qposadr[j]])) for j in off
+                 if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE or model.jnt_type[j] == mujoco.mjtJoint.mjJNT_SLIDE)
+    tip_name = _tool_site(spec, model, tool, tip_body)
+    unservoed = _actuators(spec, model, chain)
+    _prune(spec, model, set(off))
+    _hold(spec, model, off, q_all, where)
+    arm_name = spec.modelname or path.stem
+    scene_spec = build_workspace(layout, cell, wall_height)
+    _copy_options(scene_spec, spec)
+    frame = scene_spec.worldbody.add_frame(pos=[float(v) for v in mount_pos],
+                                           quat=[math.cos(mount_yaw / 2), 0.0, 0.0, math.sin(mount_yaw / 2)])
     try:
-        model = mujoco.MjModel.from_xml_string(xml, assets=scene.get_assets())
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            scene_spec.attach(spec, prefix=PREFIX, frame=frame)
+            for j in unservoed:
+                lo, hi = model.jnt_range[j]
+                scene_spec.add_actuator(
+                    name=f"{PREFIX}servo_{joint_name(j)}", target=PREFIX + joint_name(j),
+                    trntype=mujoco.mjtTrn.mjTRN_JOINT, gainprm=[SERVO_KP] + [0.0] * 9,
+                    biastype=mujoco.mjtBias.mjBIAS_AFFINE, biasprm=[0.0, -SERVO_KP, -0.1 * SERVO_KP] + [0.0] * 7,
+                    ctrllimited=bool(model.jnt_limited[j]), ctrlrange=[lo, hi])
+            scene = scene_spec.compile()
+            xml = scene_spec.to_xml()
     except Exception as err:  # noqa: BLE001
-        first = str(err).strip().splitlines()[0]
-        raise ArmModelError(f"arm MJCF {str(xml_path)!r} does not compile in the scene: {first}") from None
-    if model.nq != len(home):
-        raise ArmModelError(f"arm MJCF {str(xml_path)!r}: home has {len(home)} values for {model.nq} joints")
-    table_body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "table")
-    env = model.geom_bodyid == table_body
-    arm_geoms = np.array([
-        (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, g) or "").startswith(PREFIX)
-        or (model.geom_bodyid[g] != table_body and model.geom_bodyid[g] != 0)
-        for g in range(model.ngeom)
-    ], dtype=bool)
-    lower = np.full(model.nq, -np.inf)
-    upper = np.full(model.nq, np.inf)
-    for j in range(model.njnt):
-        adr = model.jnt_qposadr[j]
-        if model.jnt_limited[j]:
-            lower[adr], upper[adr] = model.jnt_range[j]
-    data = mujoco.MjData(model)
+        raise ArmModelError(f"arm MJCF {where} does not compile in the scene: {_first_line(err)}") from None
+    home = q_all[model.jnt_qposadr[chain]]
+    if scene.nq != len(chain):
+        raise ArmModelError(f"arm MJCF {where}: the scene has {scene.nq} positions for {len(chain)} chain joints")
+    table_body = mujoco.mj_name2id(scene, mujoco.mjtObj.mjOBJ_BODY, "table")
+    env = scene.geom_bodyid == table_body
+    arm_geoms = (scene.geom_bodyid != table_body) & (scene.body_weldid[scene.geom_bodyid] != 0)
+    lower = np.full(scene.nq, -np.inf)
+    upper = np.full(scene.nq, np.inf)
+    for j in range(scene.njnt):
+        adr = scene.jnt_qposadr[j]
+        if scene.jnt_limited[j]:
+            lower[adr], upper[adr] = scene.jnt_range[j]
+    data = mujoco.MjData(scene)
     data.qpos[:] = home
-    mujoco.mj_kinematics(model, data)
+    mujoco.mj_kinematics(scene, data)
     planar = bool(np.all(np.abs(np.abs(data.xaxis[:, 2]) - 1.0) < 1e-6))
-    return ArmScene(model=model, xml=xml, tip=PREFIX + tip_site, home=home, lower=lower,
+    return ArmScene(model=scene, xml=xml, tip=PREFIX + tip_name, home=home, lower=lower,
                     upper=upper, env_geoms=env, arm_geoms=arm_geoms, cell=cell, layout=layout,
-                    planar=planar)
+                    planar=planar, name=arm_name, chain=tuple(joint_name(j) for j in chain), held=held,
+                    tool=tool)
 
 
 class ContactChecker:
@@ -144,6 +354,7 @@ class ContactChecker:
         self.model = scene.model
         self.data = mujoco.MjData(scene.model)
         self._env = scene.env_geoms
+        self._moving = scene.arm_geoms
         self._tip = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, scene.tip)
 
     def touches(self, q: np.ndarray) -> bool:
@@ -156,8 +367,7 @@ class ContactChecker:
             return False
         g1 = d.contact.geom1[:n]
         g2 = d.contact.geom2[:n]
-        e1, e2 = self._env[g1], self._env[g2]
-        return bool(np.any(e1 != e2))
+        return bool(np.any((self._env[g1] & self._moving[g2]) | (self._env[g2] & self._moving[g1])))
 
     def tip(self, q: np.ndarray) -> np.ndarray:
         """The tip position after the last ``touches`` call at q (or computed now)."""

@@ -1,5 +1,5 @@
 """The tabletop workspace: the rooms layout laid on a table as low walls, built with
-``dm_control.mjcf``.
+MuJoCo's ``MjSpec``.
 
 Conventions (metres, world frame): the tabletop is the plane z = 0, the table's centre is
 the world origin, and cell (x, y) of the layout is the square of side ``cell`` centred at
@@ -63,25 +63,28 @@ def wall_boxes(layout: Layout, cell: float = DEFAULT_CELL,
 
 def build_workspace(layout: Layout, cell: float = DEFAULT_CELL,
                     wall_height: float = WALL_HEIGHT):
-    """The table scene as a ``dm_control.mjcf`` root element (arms are attached to it)."""
-    from dm_control import mjcf
+    """The table scene as a ``mujoco.MjSpec`` (arms are attached to it)."""
+    import mujoco
 
     if not cell > 0:
         raise ValueError(f"cell size must be positive, got {cell}")
-    root = mjcf.RootElement(model="workspace")
-    root.compiler.angle = "radian"
-    root.option.timestep = 0.002
-    root.option.integrator = "implicitfast"
-    root.visual.headlight.ambient = (0.4, 0.4, 0.4)
-    root.asset.add("material", name="table_mat", rgba=(0.82, 0.72, 0.58, 1))
-    root.asset.add("material", name="wall_mat", rgba=(0.35, 0.3, 0.28, 1))
-    root.worldbody.add("light", name="top_light", pos=(0, 0, 2.0), dir=(0, 0, -1))
+    spec = mujoco.MjSpec()
+    spec.modelname = "workspace"
+    spec.compiler.degree = False
+    spec.option.timestep = 0.002
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    spec.visual.headlight.ambient = [0.4, 0.4, 0.4]
+    spec.add_material(name="table_mat", rgba=[0.82, 0.72, 0.58, 1])
+    spec.add_material(name="wall_mat", rgba=[0.35, 0.3, 0.28, 1])
+    world = spec.worldbody
+    world.add_light(name="top_light", pos=[0, 0, 2.0], dir=[0, 0, -1])
     half = layout.width * cell / 2
-    table = root.worldbody.add("body", name="table")
-    table.add("geom", name="table_top", type="box", size=(half, half, TABLE_THICKNESS / 2),
-              pos=(0, 0, -TABLE_THICKNESS / 2), material="table_mat", contype=0, conaffinity=1)
+    table = world.add_body(name="table")
+    box = mujoco.mjtGeom.mjGEOM_BOX
+    table.add_geom(name="table_top", type=box, size=[half, half, TABLE_THICKNESS / 2],
+                   pos=[0, 0, -TABLE_THICKNESS / 2], material="table_mat", contype=0, conaffinity=1)
     for i, (centre, size) in enumerate(wall_boxes(layout, cell, wall_height)):
-        table.add("geom", name=f"wall_{i}", type="box", size=tuple(size), pos=tuple(centre),
-                  material="wall_mat", contype=0, conaffinity=1)
-    root.worldbody.add("camera", name="top", pos=(0, 0, 1.2), quat=(1, 0, 0, 0))
-    return root
+        table.add_geom(name=f"wall_{i}", type=box, size=[float(v) for v in size],
+                       pos=[float(v) for v in centre], material="wall_mat", contype=0, conaffinity=1)
+    world.add_camera(name="top", pos=[0, 0, 1.2], quat=[1, 0, 0, 0])
+    return spec

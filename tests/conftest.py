@@ -5,7 +5,7 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 
 import pytest  # noqa: E402
 
-SCARA_XML = """<mujoco model="my_scara"><worldbody>
+SCARA_XML = """<mujoco model="my_scara"><compiler angle="radian"/><worldbody>
   <body name="upper" pos="0.05 0.02 0.15">
     <joint name="shoulder" type="hinge" axis="0 0 1" range="-3 3"/>
     <geom name="upper_geom" type="capsule" size="0.01" fromto="0 0 0 0.24 0 0"/>

@@ -129,7 +129,7 @@ def test_cache_hits_misses_and_rebuilds(tmp_path, monkeypatch):
 
 
 BYO_ARM = """
-<mujoco model="my_scara">
+<mujoco model="my_scara"><compiler angle="radian"/>
   <worldbody>
     <body name="column" pos="0.05 0.02 0.2">
       <geom name="column_geom" type="cylinder" size="0.02 0.01" contype="1" conaffinity="0"/>
@@ -175,8 +175,8 @@ def test_a_bring_your_own_arm_compiles_into_a_working_robot(tmp_path):
 def test_bad_arms_raise_one_line_errors(tmp_path, mutate, message):
     xml = tmp_path / "arm.xml"
     xml.write_text(mutate(BYO_ARM))
-    with pytest.raises(ArmTransferError, match=message) as err:
-        arm_robot(None, "cartesian", xml_path=xml, tip_site="pen_tip", cache=False)
+    with pytest.raises(ArmTransferError, match=message) as err:  # mounted where the user put it
+        arm_robot(None, "cartesian", xml_path=xml, tip_site="pen_tip", base_pos=(-0.1, 0.0, 0.0), cache=False)
     assert "\n" not in str(err.value)
 
 

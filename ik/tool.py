@@ -1,0 +1,63 @@
+"""The tool point: where on an arm the tip that labels each configuration with a cell is.
+
+An arm file says nothing of the tool a user means: MuJoCo Menagerie arms have a flange site
+(``attachment_site``) or no site at all. A :class:`Tool` names a site or a body of the file
+and an offset in that site's or body's own frame, in metres:
+
+- ``Tool(site="tip")``: the built-in arms' convention, the site itself;
+- ``Tool(site="attachment_site", offset=(0, 0, 0.12))``: 12 cm past a UR5e's flange;
+- ``Tool(body="hand", offset=(0, 0, 0.1034))``: between a Panda's fingertips.
+
+The tool's axis, which spatial arms keep pointing down, is the offset's direction when there
+is an offset, else the site's z axis (a body without offset: the body's z axis).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from armtransfer.errors import ArmModelError
+
+
+@dataclass(frozen=True)
+class Tool:
+    site: str | None = "tip"
+    body: str | None = None
+    offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        if (self.site is None) == (self.body is None):
+            raise ArmModelError("the tool point needs exactly one of a tip site or a tip body")
+        if len(self.offset) != 3 or not all(math.isfinite(v) for v in self.offset):
+            raise ArmModelError(f"a tip offset is three finite numbers (metres), got {self.offset!r}")
+        object.__setattr__(self, "offset", tuple(float(v) for v in self.offset))
+
+    @property
+    def has_offset(self) -> bool:
+        return any(v != 0.0 for v in self.offset)
+
+    def key(self) -> dict:
+        """What the compiled arrays depend on (for the cache key)."""
+        return {"site": self.site, "body": self.body, "offset": list(self.offset)}
+
+    def describe(self) -> str:
+        where = f"site {self.site}" if self.site is not None else f"body {self.body}"
+        if self.has_offset:
+            where += " + (" + ", ".join(f"{v:g}" for v in self.offset) + ") m"
+        return where
+
+
+def parse_offset(text: str) -> tuple[float, float, float]:
+    """'0,0,0.12' -> (0.0, 0.0, 0.12); one line naming the problem otherwise."""
+    parts = [p.strip() for p in str(text).split(",")]
+    try:
+        values = tuple(float(p) for p in parts)
+    except ValueError:
+        values = ()
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        raise ArmModelError(f"--tip-offset must be three finite numbers X,Y,Z in metres, got {text!r}")
+    return values  # type: ignore[return-value]
+
+
+__all__ = ["Tool", "parse_offset"]
