@@ -68,15 +68,16 @@ def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = 
     home_tip = ik.configuration
     home_tip.update(scene.home)
     p = home_tip.get_transform_frame_to_world(scene.tip, "site").translation()
-    seed = _nearest_free_cell(p[:2], cell, layout)
 
     q_of: dict[int, np.ndarray] = {}
     attempts = np.zeros(layout.n_cells, dtype=np.int8)
 
-    def try_cell(c: int, q0: np.ndarray) -> bool:
+    def try_cell(c: int, q0: np.ndarray, rng: np.random.Generator | None = None) -> bool:
+        """IK for cell c from q0 (and, given ``rng``, from random configurations too)."""
         attempts[c] += 1
         x, y = layout.xy(c)
-        res = ik.solve(np.array([x * cell, y * cell]), q0)
+        target = np.array([x * cell, y * cell])
+        res = ik.solve(target, q0) if rng is None else ik.solve_any(target, q0, rng, restarts=SEED_RESTARTS)
         if not ik.ok(res):
             return False
         tip = ik.configuration.get_transform_frame_to_world(scene.tip, "site").translation()
@@ -86,10 +87,9 @@ def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = 
         return True
 
     queue: deque[int] = deque()
-    # Seed from home; if the nearest cell fails, walk outwards over cells by distance.
-    order = _cells_by_distance(p[:2], cell, layout)
-    for c in [seed, *order[:50]]:
-        if c >= 0 and free[c] and attempts[c] == 0 and try_cell(c, scene.home):
+    rng = np.random.default_rng(0)
+    for c in seed_cells(scene, p):
+        if free[c] and attempts[c] == 0 and (try_cell(c, scene.home) or try_cell(c, scene.home, rng)):
             queue.append(c)
             break
     while queue:
@@ -142,6 +142,27 @@ def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = 
     canonical[cells] = np.arange(n)
     return dict(next_state=next_state, wind_state=wind, label=cells.astype(np.int32),
                 canonical=canonical, qpos=qpos, tip=tips)
+
+
+SEED_RESTARTS = 8
+"""Random configurations (inside the joint limits) IK tries for a first cell, after home."""
+
+
+def seed_cells(scene: ArmScene, home_tip: np.ndarray, n: int = 6) -> list[int]:
+    """Cells to try first: those nearest the tip at home, then those nearest the point halfway
+    from the arm's base to the table's centre (a straight or folded home may put the tip
+    far off the table, or at a singular pose, where IK from home cannot start)."""
+    layout, cell = scene.layout, scene.cell
+    data = mujoco.MjData(scene.model)
+    data.qpos[:] = scene.home
+    mujoco.mj_kinematics(scene.model, data)
+    base = data.xanchor[int(np.argmin(scene.model.jnt_qposadr))][:2]
+    out: list[int] = []
+    for point in (home_tip[:2], base / 2):
+        for c in _cells_by_distance(point, cell, layout)[:n]:
+            if int(c) not in out:
+                out.append(int(c))
+    return out
 
 
 def _segment_clear(contact: ContactChecker, qa, qb, pa, pb, n_points: int, cell, layout) -> bool:
@@ -240,10 +261,30 @@ def _lattice_origin(scene: ArmScene, fk: PlanarFK) -> np.ndarray:
         res = ik.solve(np.array([x * cell, y * cell]), home)
         if ik.ok(res):
             return res.q
+    rng = np.random.default_rng(0)  # a straight (singular) home: start IK elsewhere too
+    for c in seed_cells(scene, np.append(fk.tip(home), fk.tip_z)):
+        x, y = layout.xy(int(c))
+        res = ik.solve_any(np.array([x * cell, y * cell]), home, rng, restarts=SEED_RESTARTS)
+        if ik.ok(res):
+            return res.q
     raise UnreachableTableError("the arm's tip cannot reach the table near its home configuration")
 
 
-def compile_joint(scene: ArmScene, step: float, progress: bool = False) -> dict:
+MAX_LATTICE = 4_000_000
+"""The most joint-lattice points the ``joint`` model lays out (memory grows with them)."""
+STEP_LADDER = (0.05, 0.08, 0.12, 0.18, 0.25, 0.35, 0.5)
+"""Lattice steps (rad) tried, finest first, when the arm's step is not given."""
+
+
+def _lattice_dims(lo: np.ndarray, hi: np.ndarray, home: np.ndarray, step: float):
+    n_lo = np.ceil((lo - home) / step - 1e-9).astype(int)
+    n_hi = np.floor((hi - home) / step + 1e-9).astype(int)
+    return n_lo, tuple(int(v) for v in n_hi - n_lo + 1)
+
+
+def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -> dict:
+    """The ``joint`` model's arrays; ``step`` None: the finest of ``STEP_LADDER`` whose lattice
+    has at most ``MAX_LATTICE`` points (the step used is returned as ``joint_step``)."""
     layout, cell = scene.layout, scene.cell
     fk = PlanarFK(scene)
     contact = ContactChecker(scene)
@@ -257,10 +298,15 @@ def compile_joint(scene: ArmScene, step: float, progress: bool = False) -> dict:
     dof = len(home)
     lo = np.where(np.isfinite(scene.lower), scene.lower, home - np.pi)
     hi = np.where(np.isfinite(scene.upper), scene.upper, home + np.pi)
-    n_lo = np.ceil((lo - home) / step - 1e-9).astype(int)
-    n_hi = np.floor((hi - home) / step + 1e-9).astype(int)
-    dims = tuple(int(v) for v in n_hi - n_lo + 1)
-    total = int(np.prod(dims))
+    if step is None:
+        sizes = {s: int(np.prod(_lattice_dims(lo, hi, home, s)[1], dtype=float)) for s in STEP_LADDER}
+        step = next((s for s in STEP_LADDER if sizes[s] <= MAX_LATTICE), STEP_LADDER[-1])
+    n_lo, dims = _lattice_dims(lo, hi, home, step)
+    total = int(np.prod(dims, dtype=float))
+    if total > MAX_LATTICE:
+        raise ArmModelError(
+            f"the joint lattice of this {dof}-joint arm at a step of {step:g} rad has {total:.3g} points "
+            f"(at most {MAX_LATTICE:,}); use a coarser joint step or the cartesian action model")
     grids = np.indices(dims).reshape(dof, -1).T  # lattice indices [total, dof]
     Q = home + (grids + n_lo) * step
     cells = cells_of_xy(fk.tip(Q), cell, layout)
@@ -361,4 +407,4 @@ def compile_joint(scene: ArmScene, step: float, progress: bool = False) -> dict:
     tips = np.column_stack([tip_xy, np.full(n, fk.tip_z)])
     return dict(next_state=next_state.astype(np.int32), wind_state=wind.astype(np.int32),
                 label=label.astype(np.int32), canonical=canonical, qpos=qpos, tip=tips,
-                lattice=(grids[states] + n_lo).astype(np.int32))
+                lattice=(grids[states] + n_lo).astype(np.int32), joint_step=np.array(step))

@@ -21,13 +21,13 @@ import numpy as np
 from armtransfer.ik import cache as _cache
 from armtransfer.ik.actions import ACTION_MODELS, action_model
 from armtransfer.ik.description import ArmDescription
+from armtransfer.ik.tool import Tool
 from armtransfer.errors import ArmModelError, UnknownArmError
 from armtransfer.models import ARMS
 from armtransfer.tasks.layout import ROOMS, Layout
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.ik.workspace import DEFAULT_CELL, WALL_HEIGHT
 
-CUSTOM_JOINT_STEP = 0.05
 SIDECAR_FORMAT = "armtransfer-generated-arm/1"
 """The JSON ``armtransfer arms generate`` writes beside an arm: its mount and tool."""
 
@@ -70,60 +70,112 @@ def _layout_data(layout: Layout) -> dict:
     return {"lo": layout.lo, "hi": layout.hi, "walls": layout.walls, "doors": layout.doors}
 
 
+def tasks_solvable(robot: DiscreteRobot, tasks=None) -> int:
+    """How many of ``tasks`` (Table I by default) the robot can solve: both cells reached and
+    the goal reachable from the start."""
+    from armtransfer.errors import InvalidCellError
+    from armtransfer.tasks.catalog import TABLE_I
+
+    solved = 0
+    for task in (tasks if tasks is not None else TABLE_I.values()):
+        try:
+            s, g = task.cells(robot.layout)
+            start = robot.start_state(s)
+            robot.start_state(g, what="goal")
+        except InvalidCellError:
+            continue
+        solved += robot.shortest_path(start, g) is not None
+    return solved
+
+
+def make_tool(tip_site: str | None = None, tip_body: str | None = None, tip_offset=None) -> Tool:
+    """The tool point of a bring-your-own arm: ``tip_site`` or ``tip_body`` (not both; the site
+    ``tip`` when neither is given), with an optional offset in its frame (metres)."""
+    if tip_site is not None and tip_body is not None:
+        raise ArmModelError("give the tool point as a tip site or a tip body, not both")
+    offset = tuple(tip_offset) if tip_offset is not None else (0.0, 0.0, 0.0)
+    if tip_body is not None:
+        return Tool(site=None, body=tip_body, offset=offset)
+    return Tool(site=tip_site or "tip", offset=offset)
+
+
+def file_arm_name(path: Path) -> str:
+    """A bring-your-own arm's name: its MJCF ``model`` attribute, else the file's stem."""
+    import xml.etree.ElementTree as ET
+
+    try:
+        for _, element in ET.iterparse(str(path), events=("start",)):
+            name = (element.get("model") or "").strip()
+            return name or path.stem
+    except (ET.ParseError, OSError):
+        pass
+    return path.stem
+
+
 def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
               xml_path: str | Path | None = None, tip_site: str | None = None,
-              base_pos: tuple[float, float, float] | None = None, base_yaw: float = 0.0,
+              tip_body: str | None = None, tip_offset=None, arm_name: str | None = None,
+              base_pos: tuple[float, float, float] | None = None, base_yaw: float | None = None,
               joint_step: float | None = None, tip_down: bool | None = None, layout: Layout = ROOMS,
               cache: bool = True, progress: bool = False) -> DiscreteRobot:
     """Compile (or load from the cache) the discrete robot of an arm and action model.
 
-    Built-in arms are named by ``arm``; a bring-your-own arm is given by ``xml_path`` and
-    ``tip_site`` (and optionally its base pose ``base_pos``/``base_yaw`` in the table frame:
-    tabletop z = 0, cell (x, y) centred at (x * cell_size, y * cell_size)); ``tip_down``
-    keeps a bring-your-own arm's tool pointing down in the ``cartesian`` models.
+    Built-in arms are named by ``arm``. A bring-your-own arm is the MJCF file ``xml_path``
+    (MuJoCo Menagerie files work as they are), its tool point ``tip_site`` or ``tip_body``
+    with ``tip_offset`` (metres, in that site's or body's frame), and its name ``arm_name``
+    (default: the file's ``model`` attribute). Its base pose ``base_pos``/``base_yaw`` is in
+    the table frame (tabletop z = 0, cell (x, y) centred at (x * cell_size, y * cell_size));
+    without ``base_pos`` it is chosen automatically (see :func:`automatic_mount`). A spatial
+    bring-your-own arm keeps its tool pointing down unless ``tip_down=False``.
     """
     model = action_model(actions)
     if not (np.isfinite(cell_size) and cell_size > 0):
         raise ArmModelError(f"cell size must be a positive number of metres, got {cell_size}")
+    if base_yaw is not None and not np.isfinite(base_yaw):
+        raise ArmModelError(f"the base yaw must be a finite number of radians, got {base_yaw!r}")
     if xml_path is not None:
-        generated = read_sidecar(xml_path) if base_pos is None else None
-        if generated is not None:  # mounted as it was generated, unless told otherwise
-            base_pos, base_yaw = tuple(generated["mount_pos"]), float(generated["mount_yaw"])
-            tip_down = generated["tip_down"] if tip_down is None else tip_down
-            joint_step = joint_step or generated["joint_step"]
         path = Path(xml_path)
         try:
             xml_bytes = path.read_bytes()
         except OSError as err:
             raise ArmModelError(f"cannot read arm MJCF {str(path)!r}: {err.strerror or err}") from None
-        name = arm or path.stem
-        tip = tip_site or "tip"
-        mount = tuple(float(v) for v in (base_pos or (0.0, 0.0, 0.0)))
-        yaw, kind, tip_down = float(base_yaw), "custom", bool(tip_down)
-        step = joint_step or CUSTOM_JOINT_STEP
+        tool = make_tool(tip_site, tip_body, tip_offset)
+        name = arm_name or arm or file_arm_name(path)
+        kind, source = "custom", "given"
+        generated = read_sidecar(path) if base_pos is None else None
+        if generated is not None:  # mounted as it was generated, unless told otherwise
+            base_pos, base_yaw = tuple(generated["mount_pos"]), float(generated["mount_yaw"])
+            tip_down = generated["tip_down"] if tip_down is None else tip_down
+            joint_step = joint_step or generated["joint_step"]
+            source = "generated"
+        if base_pos is None:
+            pose = automatic_mount(path, tool, cell_size=cell_size, layout=layout, yaw=base_yaw,
+                                   cache=cache, progress=progress)
+            base_pos, base_yaw, source = pose.pos, pose.yaw, "automatic"
+        mount = tuple(float(v) for v in base_pos)
+        yaw = float(base_yaw or 0.0)
+        step = joint_step  # None: the compile picks the finest step its lattice allows
     else:
         if arm not in ARMS:
             raise UnknownArmError(f"unknown arm {arm!r}; valid arms: {', '.join(ARMS)}")
         check_actions(arm, actions)
         info = ARMS[arm]
-        path, name, tip = info.xml_path, arm, info.tip_site
+        path, name, tool = info.xml_path, arm, Tool(site=info.tip_site)
         xml_bytes = path.read_bytes()
-        mount = info.mount_pos
-        if info.kind == "planar":  # hang over the same cell whatever the cell size
-            mount = (mount[0] * cell_size / DEFAULT_CELL, mount[1] * cell_size / DEFAULT_CELL, mount[2])
+        mount, source = _builtin_mount(info, cell_size), "built-in"
         if base_pos is not None:
-            mount = tuple(float(v) for v in base_pos)
-        yaw = info.mount_yaw if base_pos is None else float(base_yaw)
+            mount, source = tuple(float(v) for v in base_pos), "given"
+        yaw = info.mount_yaw if base_pos is None else float(base_yaw or 0.0)
         kind, tip_down = info.kind, info.tip_down
         step = joint_step or info.joint_step
-    robot_name = f"{name}:{model.name}"
     parts = {
-        "version": 1, "arm_xml": _sha(xml_bytes), "tip": tip, "mount": mount, "yaw": yaw,
-        "actions": model.name, "cells": model.cells, "tip_down": tip_down,
+        "version": 2, "arm_xml": _sha(xml_bytes), "assets": _assets_sha(path), "tool": tool.key(),
+        "mount": mount, "yaw": yaw, "actions": model.name, "cells": model.cells, "tip_down": tip_down,
         "joint_step": step if model.kind == "joint" else None, "cell": cell_size,
         "wall_height": WALL_HEIGHT, "layout": _layout_data(layout),
     }
     key = _cache.cache_key(parts)
+    robot_name = f"{name}:{model.name}"
     status = "off"
     start = time.perf_counter()
     arrays = None
@@ -133,19 +185,23 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
     if arrays is None:
         if progress:
             print(f"compiling {robot_name} ...", file=sys.stderr, flush=True)
-        arrays = _compile(path, tip, mount, yaw, model, tip_down, step, cell_size, layout, progress)
+        scene = _scene(path, tool, mount, yaw, cell_size, layout)
+        arrays = _compile(scene, model, tip_down, step, progress)
         if cache:
             _cache.save(robot_name, key, arrays)
     seconds = time.perf_counter() - start
     dof = int(arrays["qpos"].shape[1])
+    if "joint_step" in arrays:
+        step = float(arrays["joint_step"])
     label = arrays["label"]
     reach = float(len(np.unique(label)) / layout.free.sum())
+    chain, held = _chain_of(arrays)
     description = ArmDescription(
         name=name, actions=model.name, dof=dof, kind=kind, qpos=arrays["qpos"], tip=arrays["tip"],
         reach=reach, cache=status, key=key, seconds=seconds, cell_size=cell_size,
-        mount=mount, yaw=yaw, xml_path=str(path), tip_site=tip,
+        mount=mount, yaw=yaw, xml_path=str(path), tool=tool,
         joint_step=step if model.kind == "joint" else None, layout=layout,
-        lattice=arrays.get("lattice"),
+        lattice=arrays.get("lattice"), mount_source=source, chain=chain, held=held,
     )
     return DiscreteRobot(
         name=robot_name,
@@ -158,6 +214,92 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
         layout=layout,
         arm=description,
     )
+
+
+def _builtin_mount(info, cell_size: float) -> tuple[float, float, float]:
+    mount = info.mount_pos
+    if info.kind == "planar":  # hang over the same cell whatever the cell size
+        mount = (mount[0] * cell_size / DEFAULT_CELL, mount[1] * cell_size / DEFAULT_CELL, mount[2])
+    return mount
+
+
+def _chain_of(arrays: dict) -> tuple[tuple[str, ...], tuple[tuple[str, float], ...]]:
+    """The chain and held joints, stored with the arrays (as text) so a cache hit has them."""
+    chain = tuple(str(v) for v in arrays.get("chain", ()))
+    held = tuple((h.split("=")[0], float(h.split("=")[1])) for h in (str(v) for v in arrays.get("held", ())))
+    return chain, held
+
+
+def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, layout: Layout = ROOMS,
+                    yaw: float | None = None, cache: bool = True, progress: bool = False):
+    """A base pose for an arm that came without one (``ik.mount.Pose``).
+
+    The candidates of ``ik.mount.candidates`` are scored by a quick inverse-kinematics reach
+    estimate; the best three are compiled in full (the 1-cell cartesian model, or the joint
+    lattice for an arm with vertical joint axes is not needed: reach is a property of the
+    tool's workspace) and the one reaching the most free cells with the most Table I tasks
+    solvable wins. The choice is cached under the arm file's content, tool, cell size and
+    layout, so it is made once.
+    """
+    import json
+
+    from armtransfer.ik import mount as _mount
+    from armtransfer.tasks.catalog import TABLE_I
+
+    parts = {"version": 1, "what": "mount", "arm_xml": _sha(path.read_bytes()), "assets": _assets_sha(path),
+             "tool": tool.key(), "cell": cell_size, "yaw": yaw, "layout": _layout_data(layout),
+             "stride": _mount.STRIDE, "gaps": _mount.GAPS, "grid": _mount.PLANAR_GRID}
+    key = _cache.cache_key(parts)
+    entry = _cache.cache_dir() / f"mount-{key[:16]}.json"
+    if cache:
+        _check_cache_dir()
+        try:
+            data = json.loads(entry.read_text())
+            if data.get("key") == key:
+                return _mount.Pose(tuple(data["pos"]), float(data["yaw"]))
+        except (OSError, ValueError, KeyError, TypeError):
+            pass
+    origin = _scene(path, tool, (0.0, 0.0, 0.0), 0.0, cell_size, layout)
+    must = sorted({c for t in TABLE_I.values() for c in t.cells(layout)})
+    poses = _mount.candidates(origin, layout.width * cell_size / 2, yaw)
+    scored = []
+    for i, pose in enumerate(poses):
+        share, hit = _mount.estimate_reach(path, tool, pose, layout, cell_size, must=must,
+                                           rng=np.random.default_rng(i))
+        scored.append((hit, share, -i, pose))
+    scored.sort(key=lambda t: (t[0], t[1], t[2]), reverse=True)
+    if not scored or scored[0][1] == 0.0:
+        from armtransfer.errors import UnreachableTableError
+
+        raise UnreachableTableError(
+            f"the arm's tool ({tool.describe()}) cannot reach the table from any base pose tried; give "
+            "--base-pos X,Y,Z and --base-yaw")
+    best = None
+    for hit, share, _, pose in scored[:3]:
+        if progress:
+            print(f"  mount candidate: {pose.describe()} (estimated reach {share:.0%})", file=sys.stderr, flush=True)
+        try:
+            robot = arm_robot(None, "cartesian", cell_size=cell_size, xml_path=path, tip_site=tool.site,
+                              tip_body=tool.body, tip_offset=tool.offset, base_pos=pose.pos,
+                              base_yaw=pose.yaw, layout=layout, cache=cache)
+        except ArmModelError:
+            continue
+        rank = (tasks_solvable(robot), robot.arm.reach)
+        if best is None or rank > best[0]:
+            best = (rank, pose)
+    if best is None:
+        from armtransfer.errors import UnreachableTableError
+
+        raise UnreachableTableError(
+            f"the arm's tool ({tool.describe()}) cannot reach the table from any base pose tried; give "
+            "--base-pos X,Y,Z and --base-yaw")
+    pose = best[1]
+    if cache:
+        from armtransfer.io import write_json_atomic
+
+        write_json_atomic(entry, {"key": key, "pos": list(pose.pos), "yaw": pose.yaw,
+                                  "solvable": best[0][0], "reach": best[0][1]})
+    return pose
 
 
 def _check_cache_dir() -> None:
@@ -193,32 +335,59 @@ def _sha(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
-def arm_scene(arm: str | None = None, *, cell_size: float = DEFAULT_CELL, xml_path=None,
-              tip_site: str | None = None, base_pos=None, base_yaw: float = 0.0,
-              layout: Layout = ROOMS):
-    """The MuJoCo scene (``ik.scene.ArmScene``) a robot of this arm is compiled in."""
-    from armtransfer.ik.scene import build_scene
+def _assets_sha(path: Path) -> str | None:
+    """A hash of the files in the arm file's ``meshdir`` and ``texturedir`` (its meshes shape
+    its collisions), or None when it names neither."""
+    import hashlib
+    import re
 
+    head = path.read_text(errors="replace")[:20000]
+    dirs = sorted(set(re.findall(r'(?:meshdir|texturedir|assetdir)\s*=\s*"([^"]*)"', head)))
+    if not dirs:
+        return None
+    h = hashlib.sha256()
+    for d in dirs:
+        root = (path.parent / d).resolve()
+        if root.is_dir():
+            for f in sorted(p for p in root.rglob("*") if p.is_file()):
+                h.update(str(f.relative_to(root)).encode())
+                h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+def arm_scene(arm: str | None = None, *, cell_size: float = DEFAULT_CELL, xml_path=None,
+              tip_site: str | None = None, tip_body: str | None = None, tip_offset=None,
+              base_pos=None, base_yaw: float | None = None, layout: Layout = ROOMS):
+    """The MuJoCo scene (``ik.scene.ArmScene``) a robot of this arm is compiled in (a
+    bring-your-own arm without ``base_pos`` at the origin)."""
     if xml_path is not None:
-        return build_scene(Path(xml_path), tip_site or "tip", base_pos or (0.0, 0.0, 0.0),
-                           base_yaw, cell_size, layout=layout)
+        return _scene(Path(xml_path), make_tool(tip_site, tip_body, tip_offset), base_pos or (0.0, 0.0, 0.0),
+                      base_yaw or 0.0, cell_size, layout)
     if arm not in ARMS:
         raise UnknownArmError(f"unknown arm {arm!r}; valid arms: {', '.join(ARMS)}")
     info = ARMS[arm]
-    mount = info.mount_pos
-    if info.kind == "planar":
-        mount = (mount[0] * cell_size / DEFAULT_CELL, mount[1] * cell_size / DEFAULT_CELL, mount[2])
-    return build_scene(info.xml_path, info.tip_site, mount, info.mount_yaw, cell_size, layout=layout)
+    return _scene(info.xml_path, Tool(site=info.tip_site), _builtin_mount(info, cell_size), info.mount_yaw,
+                  cell_size, layout)
 
 
-def _compile(path, tip, mount, yaw, model, tip_down, step, cell, layout, progress) -> dict:
-    from armtransfer.ik.compile import compile_cartesian, compile_joint
+def _scene(path, tool: Tool, mount, yaw, cell, layout):
     from armtransfer.ik.scene import build_scene
 
-    scene = build_scene(Path(path), tip, mount, yaw, cell, layout=layout)
+    return build_scene(Path(path), tool, mount, yaw, cell, layout=layout)
+
+
+def _compile(scene, model, tip_down, step, progress) -> dict:
+    from armtransfer.ik.compile import compile_cartesian, compile_joint
+
     if model.kind == "joint":
-        return compile_joint(scene, step, progress)
-    return compile_cartesian(scene, tip_down, model.cells, progress)
+        arrays = compile_joint(scene, step, progress)
+    else:
+        arrays = compile_cartesian(scene, (not scene.planar) if tip_down is None else tip_down, model.cells,
+                                   progress)
+    arrays["chain"] = np.array(list(scene.chain), dtype=str).reshape(-1)
+    arrays["held"] = np.array([f"{n}={v!r}" for n, v in scene.held], dtype=str).reshape(-1)
+    return arrays
 
 
-__all__ = ["arm_robot", "arm_scene", "parse_robot_spec", "robot", "robot_specs"]
+__all__ = ["arm_robot", "arm_scene", "automatic_mount", "make_tool", "parse_robot_spec", "robot", "robot_specs",
+           "tasks_solvable"]

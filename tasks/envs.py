@@ -126,14 +126,16 @@ def make_rooms_env(
     return RobotRoomsEnv(grid_robot(robot), the_task, **kwargs)
 
 
-_ARM_OPTIONS = ("cell_size", "xml_path", "tip_site", "base_pos", "base_yaw", "joint_step", "cache")
+_ARM_OPTIONS = ("cell_size", "xml_path", "tip_site", "tip_body", "tip_offset", "arm_name", "base_pos", "base_yaw",
+                "joint_step", "cache")
 
 
 def make_arm_rooms_env(arm: str | None = None, actions: str = "joint", task: int | None = 1,
                        start: tuple[int, int] | None = None,
                        goal: tuple[int, int] | None = None, **kwargs: Any) -> RobotRoomsEnv:
     """Entry point of ``armtransfer/ArmRooms-v0``: an arm robot (compiled or loaded from the
-    cache) on a Table I or custom task. Bring-your-own arms: ``xml_path=`` and ``tip_site=``."""
+    cache) on a Table I or custom task. Bring-your-own arms: ``xml_path=`` with ``tip_site=`` or
+    ``tip_body=``, ``tip_offset=``, ``arm_name=``, ``base_pos=``/``base_yaw=`` (automatic without)."""
     from armtransfer.tasks.arms import arm_robot, parse_robot_spec
 
     robot_kwargs = {k: kwargs.pop(k) for k in _ARM_OPTIONS if k in kwargs}

@@ -49,7 +49,7 @@ def test_byo_arm_errors_exit_2(tmp_path, capsys):
       <joint name="j" type="slide" axis="1 0 0"/><geom name="g" size="0.01"/>
       <site name="tip"/></body></worldbody></mujoco>""")
     _one_line_error(capsys, ["arms", "list", "--arm-xml", str(xml), "--tip-site", "tip"],
-                    "no hinge joints")
+                    "joint j on the chain from the base to the tool is a slide joint; only hinge joints")
     _one_line_error(capsys, ["arms", "list", "--arm-xml", str(xml), "--tip-site", "pen"],
                     "no site 'pen'; its sites: tip")
 
@@ -63,6 +63,8 @@ def test_arms_list_includes_a_bring_your_own_arm(scara_xml, capsys):
     argv = ["arms", "list", "--arm", "planar2", "--actions", "joint", "--arm-xml", str(xml),
             "--tip-site", "pen_tip", "--base-pos=-0.1,0,0"]
     assert cli.main(argv) == 0
-    rows = {line.split()[0]: line.split() for line in capsys.readouterr().out.splitlines()[1:]}
+    table, _, notes = capsys.readouterr().out.partition("\n\n")
+    rows = {line.split()[0]: line.split() for line in table.splitlines()[1:]}
     assert set(rows) == {"planar2:joint", "my_scara:joint"}
+    assert "given mount --base-pos=-0.1,0,0" in notes and "joints shoulder-elbow" in notes
     assert rows["my_scara:joint"][1] == "2"

@@ -20,15 +20,24 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--dof", type=common.positive_int, default=None,
                         help="arms generate: joints (planar 2-7, spatial6 6, spatial7 7)")
     parser.add_argument("--arm-xml", metavar="PATH",
-                        help="also list a bring-your-own MJCF serial arm with hinge joints")
-    parser.add_argument("--tip-site", metavar="NAME", default="tip",
-                        help="the tool-tip site of --arm-xml (default: tip)")
+                        help="a bring-your-own MJCF arm (a MuJoCo Menagerie file works as it is); "
+                             "'custom[:ACTIONS]' is its robot")
+    parser.add_argument("--tip-site", metavar="NAME", default=None,
+                        help="the tool point of --arm-xml is this site (default: a site named tip)")
+    parser.add_argument("--tip-body", metavar="NAME", default=None,
+                        help="the tool point of --arm-xml is this body's origin (instead of --tip-site)")
+    parser.add_argument("--tip-offset", metavar="X,Y,Z", default=None,
+                        help="the tool point is this far (m) from the tip site or body, in its own frame; "
+                             "the tool's axis, kept pointing down, runs along it (e.g. 0,0,0.12)")
+    parser.add_argument("--arm-name", metavar="NAME", default=None,
+                        help="the name of --arm-xml in tables, plots, JSON and the cache (default: its "
+                             "MJCF model attribute)")
     parser.add_argument("--base-pos", metavar="X,Y,Z", default=None,
-                        help="base position of --arm-xml in the table frame, metres "
-                             "(tabletop z=0, table centre at the origin; default 0,0,0); write "
-                             "negative values as --base-pos=-0.1,0,0")
-    parser.add_argument("--base-yaw", metavar="RAD", type=float, default=0.0,
-                        help="rotation of --arm-xml's base about z (rad)")
+                        help="base position of --arm-xml in the table frame, metres (tabletop z=0, "
+                             "table centre at the origin); default: chosen automatically, the pose that "
+                             "reaches the most cells; write negative values as --base-pos=-0.1,0,0")
+    parser.add_argument("--base-yaw", metavar="RAD", type=float, default=None,
+                        help="rotation of --arm-xml's base about z (rad); default: facing the table")
     parser.add_argument("--arm", default=None, metavar="NAMES",
                         help="only these built-in arms, comma-separated (e.g. planar2,ur5e_like)")
     parser.add_argument("--actions", default=None,
@@ -79,32 +88,36 @@ def run(args: argparse.Namespace) -> int:
         # Validate the file before the long built-in listing, so bad input fails fast.
         from armtransfer.tasks.arms import arm_scene
 
-        arm_scene(xml_path=args.arm_xml, tip_site=args.tip_site, base_pos=common.parse_base_pos(args.base_pos),
-                  base_yaw=args.base_yaw, cell_size=args.cell_size)
+        options = common.arm_file_options(args)
+        arm_scene(xml_path=args.arm_xml, cell_size=args.cell_size,
+                  **{k: v for k, v in options.items() if k != "arm_name"})
         for a in custom:
-            jobs.append(dict(arm=None, actions=a, xml_path=args.arm_xml, tip_site=args.tip_site,
-                             base_pos=common.parse_base_pos(args.base_pos), base_yaw=args.base_yaw))
+            jobs.append(dict(arm=None, actions=a, xml_path=args.arm_xml, **options))
+    from armtransfer.tasks.arms import tasks_solvable
+
+    robots = [arm_robot(job.pop("arm"), job.pop("actions"), cell_size=args.cell_size, cache=not args.no_cache,
+                        progress=common.interactive(), **job) for job in jobs]
     header = f"{'robot':<24} {'dof':>3} {'actions':>7} {'states':>7} {'reach':>6} {'tableI':>6} {'cache':>6}"
     print(header)
-    for job in jobs:
-        r = arm_robot(job.pop("arm"), job.pop("actions"), cell_size=args.cell_size,
-                      cache=not args.no_cache, **job)
-        solved = sum(_solvable(r, t) for t in TABLE_I.values())
+    for r in robots:
+        solved = tasks_solvable(r)
         print(f"{r.name:<24} {r.arm.dof:>3} {r.n_actions:>7} {r.n_states:>7} "
               f"{r.arm.reach:>6.1%} {solved:>4}/{len(TABLE_I)} {r.arm.cache:>6}")
+    custom = [r for r in robots if r.arm.kind == "custom"]
+    if custom:
+        print()
+    for r in custom:
+        print(f"{r.name}: {mount_line(r.arm)}")
     return 0
 
 
-def _solvable(robot, task) -> bool:
-    from armtransfer.errors import InvalidCellError
-
-    try:
-        s, g = task.cells()
-        start = robot.start_state(s)
-        robot.start_state(g, what="goal")
-    except InvalidCellError:
-        return False
-    return robot.shortest_path(start, g) is not None
+def mount_line(arm) -> str:
+    """One line on a bring-your-own arm: its tool, chain, held joints and mount."""
+    held = ", ".join(f"{n} at {v:g}" for n, v in arm.held)
+    x, y, z = arm.mount
+    return (f"tool {arm.tool.describe()}; {arm.dof} joints {'-'.join(arm.chain)}"
+            + (f" (held: {held})" if held else "")
+            + f"; {arm.mount_source} mount --base-pos={x:.4g},{y:.4g},{z:.4g} --base-yaw={arm.yaw:.4g}")
 
 
 def generate(args: argparse.Namespace) -> int:

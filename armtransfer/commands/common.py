@@ -197,13 +197,26 @@ def check_arm_flags(args: argparse.Namespace) -> None:
     options only with --arm-xml (they would be silently ignored otherwise)."""
     if not (math.isfinite(args.cell_size) and args.cell_size > 0):
         raise ArmModelError(f"--cell-size must be a positive number of metres, got {args.cell_size!r}")
+    flags = (("--base-pos", "base_pos"), ("--base-yaw", "base_yaw"), ("--tip-site", "tip_site"),
+             ("--tip-body", "tip_body"), ("--tip-offset", "tip_offset"), ("--arm-name", "arm_name"))
     if not getattr(args, "arm_xml", None):
-        given = [flag for flag, value, default in (("--base-pos", args.base_pos, None),
-                                                   ("--base-yaw", args.base_yaw, 0.0),
-                                                   ("--tip-site", args.tip_site, "tip")) if value != default]
+        given = [flag for flag, attr in flags if getattr(args, attr, None) is not None]
         if given:
             raise ArmModelError(f"{given[0]} goes with --arm-xml PATH (a bring-your-own arm)")
     else:
-        parse_base_pos(args.base_pos)
-    if not math.isfinite(args.base_yaw):
+        arm_file_options(args)
+    if args.base_yaw is not None and not math.isfinite(args.base_yaw):
         raise ArmModelError(f"--base-yaw must be a finite number of radians, got {args.base_yaw!r}")
+
+
+def arm_file_options(args: argparse.Namespace) -> dict:
+    """The bring-your-own arm's options as ``arm_robot`` keywords, checked."""
+    from armtransfer.ik.tool import parse_offset
+
+    if args.tip_site is not None and args.tip_body is not None:
+        raise ArmModelError("give --tip-site or --tip-body, not both")
+    if args.arm_name is not None and not args.arm_name.strip():
+        raise ArmModelError("--arm-name must not be empty")
+    return dict(tip_site=args.tip_site, tip_body=args.tip_body,
+                tip_offset=parse_offset(args.tip_offset) if args.tip_offset is not None else None,
+                arm_name=args.arm_name, base_pos=parse_base_pos(args.base_pos), base_yaw=args.base_yaw)

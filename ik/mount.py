@@ -1,0 +1,150 @@
+"""Where to mount an arm that came without a base pose: candidates and a quick reach estimate.
+
+An arm file says nothing of where it stands relative to the table. ``candidates`` lists
+base poses worth trying:
+
+- an arm whose joint axes are all vertical (a SCARA-like arm, its tip riding at one height)
+  is hung at the height that puts its tip just above the tabletop, over points of a grid
+  across and around the table;
+- any other arm stands on the table's plane beside it, on the four sides and at the four
+  corners, at a few distances, turned so that its home tip points at the table's centre.
+
+``estimate_reach`` scores one pose: inverse kinematics (the compile's own ``TipIK``, tool
+pointing down for spatial arms) over a sparse lattice of free cells, warm-started from
+neighbour to neighbour as the compile does, and contact-checked; the score is the share of
+those cells reached. The caller (``armtransfer.tasks.arms``) compiles the best few poses in
+full and keeps the one that reaches the most free cells with the tasks solvable.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import mujoco
+import numpy as np
+
+from armtransfer.ik.compile import SEED_RESTARTS, seed_cells
+from armtransfer.ik.labels import cells_of_xy
+from armtransfer.ik.scene import ArmScene, ContactChecker, build_scene
+from armtransfer.ik.solve import TIP_HEIGHT, TipIK
+from armtransfer.ik.tool import Tool
+
+if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never imported
+    from armtransfer.tasks.layout import Layout
+
+STRIDE = 4
+"""Cells between the lattice points the estimate tries (every 4th cell each way)."""
+PLANAR_GRID = (-0.2, -0.1, 0.0, 0.1, 0.2)
+"""Base positions (m, each axis) tried for an arm with vertical joint axes."""
+GAPS = (0.05, 0.15, 0.3)
+"""Distances (m) from the table's edge tried for a spatial arm standing beside it."""
+
+
+@dataclass(frozen=True)
+class Pose:
+    pos: tuple[float, float, float]
+    yaw: float
+
+    def describe(self) -> str:
+        return f"base at ({self.pos[0]:.3f}, {self.pos[1]:.3f}, {self.pos[2]:.3f}) m, yaw {self.yaw:.3f} rad"
+
+
+def _tip_at(scene: ArmScene, q: np.ndarray) -> np.ndarray:
+    data = mujoco.MjData(scene.model)
+    data.qpos[:] = q
+    mujoco.mj_kinematics(scene.model, data)
+    return data.site_xpos[mujoco.mj_name2id(scene.model, mujoco.mjtObj.mjOBJ_SITE, scene.tip)].copy()
+
+
+def _reach_bound(scene: ArmScene) -> tuple[np.ndarray, float]:
+    """The first joint's anchor and the sum of the distances from joint to joint to the tip
+    at home: no tip position lies farther from the anchor than that."""
+    data = mujoco.MjData(scene.model)
+    data.qpos[:] = scene.home
+    mujoco.mj_kinematics(scene.model, data)
+    points = np.vstack([data.xanchor[np.argsort(scene.model.jnt_qposadr)], _tip_at(scene, scene.home)])
+    return points[0], float(np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1)))
+
+
+def candidates(scene: ArmScene, table_half: float, yaw: float | None = None) -> list[Pose]:
+    """Base poses to try for the arm of ``scene`` (built at the origin, yaw 0)."""
+    anchor, reach = _reach_bound(scene)
+    tip = _tip_at(scene, scene.home)
+    if scene.planar:
+        z = TIP_HEIGHT / 2 - float(tip[2])
+        turn = 0.0 if yaw is None else yaw
+        return [Pose((x, y, z), turn) for x in PLANAR_GRID for y in PLANAR_GRID]
+    home_dir = math.atan2(tip[1] - anchor[1], tip[0] - anchor[0]) if np.linalg.norm((tip - anchor)[:2]) > 1e-6 else 0.0
+    out = []
+    for gap in GAPS:
+        d = table_half + gap
+        for k in range(8):
+            theta = -math.pi / 2 + k * math.pi / 4  # start in front of the table (-y side)
+            corner = k % 2 == 1
+            r = d * (math.sqrt(2) if corner else 1.0)
+            if r - table_half > reach:  # cannot reach even the nearest edge
+                continue
+            x, y = r * math.cos(theta), r * math.sin(theta)
+            facing = math.atan2(-y, -x) - home_dir if yaw is None else yaw
+            facing = (facing + math.pi) % (2 * math.pi) - math.pi
+            out.append(Pose((round(x, 4), round(y, 4), 0.0), round(facing, 4)))
+    return out
+
+
+def _lattice(layout: Layout, extra: list[int]) -> list[int]:
+    ids = [layout.cell(x, y) for x in range(layout.lo, layout.hi + 1, STRIDE)
+           for y in range(layout.lo, layout.hi + 1, STRIDE) if layout.free[layout.cell(x, y)]]
+    return sorted(set(ids) | {int(c) for c in extra if layout.free[int(c)]})
+
+
+def estimate_reach(xml_path, tool: Tool, pose: Pose, layout: Layout, cell: float, *,
+                   must: list[int] = (), rng: np.random.Generator | None = None) -> tuple[float, int]:
+    """(share of the sparse lattice's free cells reached, how many of ``must`` were reached)."""
+    scene = build_scene(xml_path, tool, pose.pos, pose.yaw, cell, layout=layout)
+    ik = TipIK(scene, tip_down=not scene.planar)
+    contact = ContactChecker(scene)
+    rng = rng if rng is not None else np.random.default_rng(0)
+    cells = _lattice(layout, list(must))
+    xy = layout.xy_of(np.array(cells)) * cell
+    found: dict[int, np.ndarray] = {}
+
+    def attempt(i: int, q0: np.ndarray, restarts: int = 0) -> bool:
+        res = ik.solve_any(xy[i], q0, rng, restarts=restarts) if restarts else ik.solve(xy[i], q0)
+        if not ik.ok(res) or contact.touches(res.q):
+            return False
+        if int(cells_of_xy(contact.tip(res.q), cell, layout)) != cells[i]:
+            return False
+        found[i] = res.q
+        return True
+
+    queue: deque[int] = deque()
+    index = {c: i for i, c in enumerate(cells)}
+    for c in seed_cells(scene, _tip_at(scene, scene.home)):  # from home or random configurations
+        i = index.get(c)
+        if i is None:
+            i = int(np.argmin(np.linalg.norm(xy - np.array(layout.xy(c)) * cell, axis=1)))
+        if i not in found and attempt(i, scene.home, restarts=SEED_RESTARTS):
+            queue.append(i)
+            break
+    spacing = STRIDE * cell * 1.5
+    tries = np.zeros(len(cells), dtype=int)
+    while queue:
+        i = queue.popleft()
+        near = np.flatnonzero(np.linalg.norm(xy - xy[i], axis=1) <= spacing)
+        for n in near:
+            n = int(n)
+            if n in found or tries[n] >= 2:
+                continue
+            tries[n] += 1
+            if attempt(n, found[i]):
+                queue.append(n)
+    share = len(found) / max(1, len(cells))
+    must_set = {int(c) for c in must}
+    reached_must = sum(1 for i in found if cells[i] in must_set)
+    return share, reached_must
+
+
+__all__ = ["Pose", "candidates", "estimate_reach"]
