@@ -61,7 +61,7 @@ def arm_options(args: argparse.Namespace) -> dict:
     """The bring-your-own arm's options (for ``custom[:ACTIONS]``) and the cell size."""
     options = dict(cell_size=args.cell_size)
     if getattr(args, "arm_xml", None):
-        options.update(tip_site=args.tip_site, base_pos=common.parse_base_pos(args.base_pos), base_yaw=args.base_yaw)
+        options.update(common.arm_file_options(args))
     return options
 
 
@@ -88,7 +88,7 @@ def run(args: argparse.Namespace) -> int:
         source = resolve(args.source, xml_path=args.arm_xml, progress=common.interactive(), **options)
         target = resolve(args.target, xml_path=args.arm_xml, progress=common.interactive(), **options)
     with staged_directory(out) as tmp:
-        result = _run_into(args, tmp, source, target)
+        result = _run_into(args, tmp, source, target, out)
         if args.json:
             write_json_atomic(args.json, result["json"])
         if args.render and result["video"]:
@@ -102,7 +102,9 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target: DiscreteRobot) -> dict:
+def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target: DiscreteRobot,
+              final: Path) -> dict:
+    """Everything into ``tmp``, which becomes ``final`` when complete (paths in results.json name ``final``)."""
     kwargs = {**common.transfer_kwargs(args), **_fast_overrides(args)}
     if args.source_planner == "learn" and not args.trajectory:
         kwargs["trajectory"] = ["learned"]
@@ -112,6 +114,12 @@ def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target
     with common.progress_bar(total, "learning") as bar:
         result = api.transfer(source, target, progress=bar.update, **kwargs)
     out_json = result.to_json()
+    out_json["arms"] = {label: arm_json(r) for label, r in (("source", source), ("target", target))
+                        if r.arm is not None}
+    for label, arm in out_json["arms"].items():
+        if arm["mount_source"] == "automatic":
+            print(f"{label} {arm['name']}: automatic mount --base-pos={','.join(f'{v:.4g}' for v in arm['mount'])} "
+                  f"--base-yaw={arm['yaw']:.4g} (reaches {100 * arm['reach']:.1f}% of the free cells)")
     print_results(out_json)
     write_json_atomic(tmp / "results.json", out_json)
     write_text_atomic(tmp / "table.md", _table_md(out_json))
@@ -128,13 +136,22 @@ def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target
         video = "rollout.mp4"
         stats = _video({"paths": paths, "source": source, "target": target}, args, tmp / video)
         # results.json stays the same for the same seed: wall-clock timings go to timings.json
-        out_json["rollout"] = {k: v for k, v in stats.items() if k not in TIMINGS} | {"video": video}
+        out_json["rollout"] = {k: v for k, v in stats.items() if k not in TIMINGS} | {"video": str(final / video)}
         write_json_atomic(tmp / "timings.json", {"rollout": {k: stats[k] for k in TIMINGS if k in stats}})
         write_json_atomic(tmp / "results.json", out_json)
         for label, rp in zip(("source", "target"), stats["replays"]):
             print(f"replay {label}: largest tip deviation {rp['max_deviation_cells']:.2f} cell, "
                   f"reached the goal cell: {'yes' if rp['reached_goal'] else 'no'}")
     return {"json": out_json, "video": video, "paths": paths, "source": source, "target": target}
+
+
+def arm_json(robot: DiscreteRobot) -> dict:
+    """What results.json says of an arm robot: its name, joints, tool, mount and reach."""
+    arm = robot.arm
+    return {"name": arm.name, "robot": robot.name, "dof": arm.dof, "chain": list(arm.chain),
+            "held": {n: v for n, v in arm.held}, "tool": arm.tool.key(), "mount": list(arm.mount),
+            "yaw": arm.yaw, "mount_source": arm.mount_source, "reach": round(arm.reach, 6),
+            "xml": arm.xml_path if arm.kind == "custom" else None}
 
 
 def _paths(out_json: dict, source: DiscreteRobot, target: DiscreteRobot) -> dict:

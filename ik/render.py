@@ -5,7 +5,8 @@ Rendering is MuJoCo's offscreen OpenGL; ``MUJOCO_GL`` must name the backend befo
 works without a display and without a GPU through Mesa's EGL (llvmpipe).
 
 Each panel is one ``Replay`` (``armtransfer.ik.replay``) rendered with its own model and
-``mujoco.Renderer`` from a fixed free camera that shows the whole table and its walls.
+``mujoco.Renderer`` from a fixed free camera that fits the whole scene: the table, its walls
+and the arm wherever it is mounted; the tool tip's path is drawn on the table as dots.
 Markers are drawn as MuJoCo user geoms added to the renderer's scene (they are not part
 of the model, so they never collide): the transferred trajectory's cells as orange
 tiles, the goal cell as a green disc. Panels are concatenated left to right; a shorter
@@ -51,6 +52,9 @@ FORMATS = {".mp4": "mp4", ".gif": "gif"}
 TRAJECTORY_RGBA = (1.0, 0.55, 0.1, 1.0)
 GOAL_RGBA = (0.1, 0.75, 0.2, 1.0)
 START_RGBA = (0.15, 0.35, 0.9, 1.0)
+TIP_PATH_RGBA = (0.85, 0.1, 0.6, 1.0)
+TIP_PATH_POINTS = 300
+"""At most this many dots mark the tool tip's path."""
 MAX_SIZE = 4096
 
 
@@ -69,6 +73,8 @@ class RolloutPanel:
     """The goal cell (green disc); defaults to the replay's goal."""
     show_start: bool = True
     """A blue tile under the first planned cell."""
+    show_tip_path: bool = True
+    """Small dots on the table where the tool tip went during the replay."""
 
 
 @dataclass
@@ -120,40 +126,74 @@ ELEVATION = -70.0
 that the arms' links stand out from the table."""
 
 
-def table_camera(replay_or_scene, width: int = 320, height: int = 240, *,
-                 elevation: float = ELEVATION) -> mujoco.MjvCamera:
-    """A fixed free camera over the table's centre, from the front (-y side), ``elevation``
-    degrees down. Used with an orthographic projection (``view_extent``) so the table keeps
-    its scale however high an arm's links rise towards the camera."""
+def _camera_axes(elevation: float, azimuth: float = 90.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(forward, right, up) unit vectors of a free camera at ``azimuth``/``elevation`` degrees."""
+    el, az = math.radians(elevation), math.radians(azimuth)
+    forward = np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
+    right = np.cross(forward, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    return forward, right, np.cross(right, forward)
+
+
+def scene_points(replay_or_scene, samples: int = 40) -> np.ndarray:
+    """Points the view must show: the table's corners at its walls' height, and every arm
+    body at up to ``samples`` configurations of the replay (at home for a bare scene)."""
     scene = getattr(replay_or_scene, "scene", replay_or_scene)
     half = scene.layout.width * scene.cell / 2
+    corners = np.array([[sx * half, sy * half, z] for sx in (-1, 1) for sy in (-1, 1) for z in (0.0, WALL_HEIGHT)])
+    qs = getattr(replay_or_scene, "qpos", None)
+    qs = np.asarray(scene.home)[None] if qs is None else qs[np.unique(np.linspace(0, len(qs) - 1, samples).astype(int))]
+    data = mujoco.MjData(scene.model)
+    table = mujoco.mj_name2id(scene.model, mujoco.mjtObj.mjOBJ_BODY, "table")
+    arm = [b for b in range(1, scene.model.nbody) if b != table]
+    points = [corners]
+    for q in qs:
+        data.qpos[:] = q
+        mujoco.mj_kinematics(scene.model, data)
+        points.append(data.xpos[arm])
+        points.append(data.site_xpos)
+    return np.vstack(points)
+
+
+def table_camera(replay_or_scene, width: int = 320, height: int = 240, *,
+                 elevation: float = ELEVATION) -> mujoco.MjvCamera:
+    """A fixed free camera from the front (-y side), ``elevation`` degrees down, looking at the
+    middle of everything the replay shows: the table and the arm wherever it is mounted (see
+    ``view_extent`` for the orthographic scale that fits it)."""
+    points = scene_points(replay_or_scene)
+    forward, right, up = _camera_axes(elevation)
+    u, v = points @ right, points @ up
+    centre = right * (u.min() + u.max()) / 2 + up * (v.min() + v.max()) / 2
+    depth = points @ forward
+    centre = centre + forward * float(depth.mean())
     cam = mujoco.MjvCamera()
     cam.type = mujoco.mjtCamera.mjCAMERA_FREE
-    cam.lookat[:] = (0.0, 0.0, 0.0)
-    cam.distance = 4 * half + 1.0  # beyond the tallest arm; orthographic, so no zoom effect
+    cam.lookat[:] = centre
+    cam.distance = float(np.ptp(depth)) + 2.0  # in front of everything; orthographic, so no zoom
     cam.azimuth = 90.0
     cam.elevation = elevation
     return cam
 
 
-def view_extent(scene, width: int, height: int, elevation: float = ELEVATION) -> float:
-    """Vertical extent (m) of the orthographic view that shows the whole table and its walls
-    with a small margin at aspect ``width / height``."""
-    half = scene.layout.width * scene.cell / 2
-    el = math.radians(abs(elevation))
-    vertical = 2 * half * math.sin(el) + 2 * WALL_HEIGHT * math.cos(el)
-    horizontal_as_vertical = 2 * half * height / width
+def view_extent(replay_or_scene, width: int, height: int, elevation: float = ELEVATION) -> float:
+    """Vertical extent (m) of the orthographic view that shows the table, its walls and the
+    arm's bodies with a small margin at aspect ``width / height``."""
+    points = scene_points(replay_or_scene)
+    _, right, up = _camera_axes(elevation)
+    vertical = float(np.ptp(points @ up))
+    horizontal_as_vertical = float(np.ptp(points @ right)) * height / width
     return 1.12 * max(vertical, horizontal_as_vertical)
 
 
-def offscreen_model(scene, width: int, height: int, samples: int = 4) -> mujoco.MjModel:
+def offscreen_model(replay_or_scene, width: int, height: int, samples: int = 4) -> mujoco.MjModel:
     """A copy of the scene's model set up for an orthographic offscreen view of the table."""
+    scene = getattr(replay_or_scene, "scene", replay_or_scene)
     model = copy.copy(scene.model)
     model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), width)
     model.vis.global_.offheight = max(int(model.vis.global_.offheight), height)
     model.vis.quality.offsamples = int(samples)
     model.vis.global_.orthographic = 1
-    model.vis.global_.fovy = view_extent(scene, width, height)
+    model.vis.global_.fovy = view_extent(replay_or_scene, width, height)
     return model
 
 
@@ -189,7 +229,7 @@ class PanelRenderer:
                  camera: mujoco.MjvCamera | None = None) -> None:
         self.panel = panel
         rp = panel.replay
-        self.model = offscreen_model(rp.scene, width, height, samples)
+        self.model = offscreen_model(rp, width, height, samples)
         self.data = mujoco.MjData(self.model)
         self.camera = camera or table_camera(rp, width, height)
         self.shadows = shadows
@@ -233,6 +273,12 @@ def _markers(panel: RolloutPanel) -> list[tuple[int, np.ndarray, np.ndarray, np.
     goal = rp.goal_cell if panel.goal_cell is None else panel.goal_cell
     out.append((int(mujoco.mjtGeom.mjGEOM_CYLINDER), np.array([1.2 * cell, thin, 0.0]),
                 centre(goal, thin), np.array(GOAL_RGBA)))
+    if panel.show_tip_path:  # where the tool tip went, drawn on the table
+        sphere = int(mujoco.mjtGeom.mjGEOM_SPHERE)
+        step = max(1, len(rp.tip) // TIP_PATH_POINTS)
+        for p in rp.tip[::step]:
+            out.append((sphere, np.array([0.15 * cell, 0.0, 0.0]), np.array([p[0], p[1], 3 * thin]),
+                        np.array(TIP_PATH_RGBA)))
     return out
 
 
