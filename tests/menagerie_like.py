@@ -308,6 +308,11 @@ PANDA_HOME = (0.0, 0.0, 0.0, -1.57079, 0.0, 1.57079, -0.7853)
 FINGER_LENGTH = 0.045
 HAND_TO_FINGERS = 0.0584
 PANDA_TCP = HAND_TO_FINGERS + FINGER_LENGTH  # 0.1034: the fingertips, from the hand frame
+FINGERTIP = 0.02
+"""The last 2 cm of each finger is a narrow tip (6 mm wide, 3 mm thick): the closed gripper
+fits through a 1-cell door between 2 cm walls, as a stylus does, with the wide part above
+the walls when the fingertips are at the tip height."""
+FINGER_UPPER = FINGER_LENGTH - FINGERTIP
 
 
 def panda_style(directory, hand: bool = True) -> Path:
@@ -358,7 +363,8 @@ def panda_style(directory, hand: bool = True) -> Path:
     pad = indent + "  " * n
     if hand:
         meshes.add("hand_c", *box_mesh((0, -0.1, 0.033), (0, 0.1, 0.033), 0.03), named=True)
-        meshes.add("finger_0", *box_mesh((0, 0.0065, 0), (0, 0.0065, FINGER_LENGTH), 0.008), fmt="obj")
+        meshes.add("finger_0", *box_mesh((0, 0.0065, 0), (0, 0.0065, FINGER_UPPER), 0.005), fmt="obj")
+        meshes.add("finger_1", *box_mesh((0, 0.002, FINGER_UPPER), (0, 0.002, FINGER_LENGTH), 0.0015), fmt="obj")
         body_xml += [
             f'{pad}  <body name="hand" pos="0 0 {_f(PANDA_FLANGE)}" quat="{_v(_quat_rz(-math.pi / 4))}">',
             f'{pad}    <inertial mass="0.73" pos="-0.01 0 0.03" diaginertia="0.001 0.0025 0.0017"/>',
@@ -372,8 +378,11 @@ def panda_style(directory, hand: bool = True) -> Path:
                 f'{pad}      <inertial mass="0.015" pos="0 0.0065 0.0225" diaginertia="2.375e-6 2.375e-6 7.5e-7"/>',
                 f'{pad}      <joint name="finger_joint{joint}" class="panda/finger"/>',
                 f'{pad}      <geom mesh="finger_0" material="black" class="panda/visual"/>',
-                f'{pad}      <geom class="panda/fingertip_pad" size="0.008 0.005 {_f(FINGER_LENGTH / 2)}" '
-                f'pos="0 0.0065 {_f(FINGER_LENGTH / 2)}"/>',
+                f'{pad}      <geom mesh="finger_1" material="black" class="panda/visual"/>',
+                f'{pad}      <geom class="panda/collision" type="box" size="0.008 0.005 {_f(FINGER_UPPER / 2)}" '
+                f'pos="0 0.0065 {_f(FINGER_UPPER / 2)}"/>',
+                f'{pad}      <geom class="panda/fingertip_pad" size="0.003 0.0015 {_f(FINGERTIP / 2)}" '
+                f'pos="0 0.002 {_f(FINGER_LENGTH - FINGERTIP / 2)}"/>',
                 f"{pad}    </body>",
             ]
         body_xml.append(f"{pad}  </body>")
@@ -470,6 +479,8 @@ SO100_SCALE = 1.8
 real one's tool cannot point down over more than a third of a 0.51 m table from beside it."""
 SO100_JAW = 0.1 * SO100_SCALE
 """Length of the fixed jaw from the wrist-roll frame (``Fixed_Jaw``) to its tip, along z."""
+SO100_JAW_TIP = 0.02
+"""The jaws' last 2 cm are narrow (3 mm by 6 mm each): closed, they fit through a 1-cell door."""
 
 
 def so100_style(directory) -> Path:
@@ -504,13 +515,19 @@ def so100_style(directory) -> Path:
         mesh = meshes.add(body, *box_mesh((0, 0, 0), end, r))
         out = [f"{pad}{cylinder_inertial(mass, r, (0, 0, 0), end)}" if body != "Base" else "",
                f'{pad}<geom class="so_arm100/visual" mesh="{mesh}"/>']
-        if body == "Fixed_Jaw":  # the fixed jaw is a finger beside the roll axis
-            out.append(f'{pad}<geom class="so_arm100/finger_collision" size="0.004 0.01 {_f(SO100_JAW * 0.4)}" '
-                       f'pos="-0.008 0 {_f(SO100_JAW * 0.6)}"/>')
+        if body == "Fixed_Jaw":  # the fixed jaw is a finger beside the roll axis, narrow at its tip
+            upper = SO100_JAW - SO100_JAW_TIP
+            out.append(f'{pad}<geom class="so_arm100/finger_collision" size="0.004 0.01 {_f(upper * 0.3)}" '
+                       f'pos="-0.008 0 {_f(upper * 0.7)}"/>')
+            out.append(f'{pad}<geom class="so_arm100/finger_collision" size="0.0015 0.003 {_f(SO100_JAW_TIP / 2)}" '
+                       f'pos="-0.002 0 {_f(SO100_JAW - SO100_JAW_TIP / 2)}"/>')
             out.append(f'{pad}<geom class="so_arm100/collision" size="{_f(r)}" fromto="0 0 0 0 0 {_f(0.2 * SO100_JAW)}"/>')
-        elif body == "Moving_Jaw":
-            out.append(f'{pad}<geom class="so_arm100/finger_collision" size="0.004 0.01 {_f(0.35 * SO100_JAW)}" '
-                       f'pos="0 0 {_f(0.35 * SO100_JAW)}"/>')
+        elif body == "Moving_Jaw":  # hinged 8 mm beside the roll axis, its tip meeting the fixed one's
+            upper = 0.7 * SO100_JAW - SO100_JAW_TIP
+            out.append(f'{pad}<geom class="so_arm100/finger_collision" size="0.004 0.01 {_f(upper / 2)}" '
+                       f'pos="0 0 {_f(upper / 2)}"/>')
+            out.append(f'{pad}<geom class="so_arm100/finger_collision" size="0.0015 0.003 {_f(SO100_JAW_TIP / 2)}" '
+                       f'pos="-0.006 0 {_f(0.7 * SO100_JAW - SO100_JAW_TIP / 2)}"/>')
         else:
             out.append(f'{pad}<geom class="so_arm100/collision" size="{_f(r)}" fromto="0 0 0 {_v(end)}"/>')
         return [line for line in out if line]
