@@ -301,7 +301,7 @@ def ur5e_style(directory) -> Path:
 
 PANDA_MASSES = (4.970684, 0.646926, 3.228604, 3.587895, 1.225946, 1.666555, 0.735522)
 """The Panda's published link masses (kg), links 1-7."""
-PANDA_RADII = (0.06, 0.06, 0.055, 0.055, 0.05, 0.045, 0.04)
+PANDA_RADII = (0.06, 0.06, 0.055, 0.055, 0.042, 0.04, 0.035)
 PANDA_GAINS = (4500, 4500, 3500, 3500, 2000, 2000, 2000)
 PANDA_HOME = (0.0, 0.0, 0.0, -1.57079, 0.0, 1.57079, -0.7853)
 """The Panda's ready pose: elbow up, hand pointing down."""
@@ -706,6 +706,24 @@ def planar5_straight(directory) -> Path:
 </mujoco>
 """
     return _write(folder, "planar5", text)
+
+
+SUGGESTED = {
+    "ur5e": dict(tip_site="attachment_site", tip_offset=(0.0, 0.0, 0.12), base_pos=(0.0, -0.42, 0.0),
+                 base_yaw=math.pi / 2),
+    "panda": dict(tip_body="hand", tip_offset=(0.0, 0.0, PANDA_TCP), base_pos=(0.0, -0.40, 0.0),
+                  base_yaw=math.pi / 2),
+    "panda_nohand": dict(tip_site="attachment_site", tip_offset=(0.0, 0.0, 0.1), base_pos=(0.0, -0.40, 0.0),
+                         base_yaw=math.pi / 2),
+    "so100": dict(tip_body="Fixed_Jaw", tip_offset=(0.0, 0.0, SO100_JAW), base_pos=(-0.28, 0.0, 0.0),
+                  base_yaw=-math.pi / 2),
+    "planar5": dict(tip_body="stylus", tip_offset=(0.0, 0.0, 0.0), base_pos=(-0.03, 0.03, 0.0), base_yaw=0.0),
+}
+"""A tip and a mount that work for each arm (cartesian, tool pointing down; planar5 also
+joint). Measured with the project's compiler on copies of these files with the classes'
+``/`` replaced and a site at the tip (the fingers held closed): ur5e reaches 100% of the
+free cells, Table I 4/4; panda 96%, 4/4 (panda_nohand the same); so100 76%, 3/4; planar5
+cartesian 77%, 3/4, and joint with a 0.35 rad step 92%, 4/4 (494,461 states, 51 s)."""
 
 
 ALL = {"ur5e": ur5e_style, "panda": panda_style, "panda_nohand": lambda d: panda_style(d, hand=False),
