@@ -301,7 +301,7 @@ def ur5e_style(directory) -> Path:
 
 PANDA_MASSES = (4.970684, 0.646926, 3.228604, 3.587895, 1.225946, 1.666555, 0.735522)
 """The Panda's published link masses (kg), links 1-7."""
-PANDA_RADII = (0.06, 0.06, 0.055, 0.055, 0.042, 0.04, 0.035)
+PANDA_RADII = (0.06, 0.06, 0.055, 0.055, 0.04, 0.04, 0.032)
 PANDA_GAINS = (4500, 4500, 3500, 3500, 2000, 2000, 2000)
 PANDA_HOME = (0.0, 0.0, 0.0, -1.57079, 0.0, 1.57079, -0.7853)
 """The Panda's ready pose: elbow up, hand pointing down."""
@@ -357,7 +357,8 @@ def panda_style(directory, hand: bool = True) -> Path:
             body_xml.append(f'{pad}  <geom class="panda/collision" size="{_f(r * 0.8)}" '
                             f'fromto="0 0 {_f(top + 0.06 + r * 0.8)} 0 0 {_f(-r)}"/>')
         elif np.linalg.norm(child) > 1e-9:
-            end = _shorten((0, 0, 0), child, PANDA_RADII[i + 1] + r * 0.7 if i + 1 < n else 0.0)
+            # clear of the next two joints' housings, which meet at the Panda's wrist
+            end = _shorten((0, 0, 0), child, max(PANDA_RADII[i + 1:i + 3]) + r * 0.7 + 0.005 if i + 1 < n else 0.0)
             body_xml.append(f'{pad}  <geom class="panda/collision" size="{_f(r * 0.7)}" '
                             f'fromto="0 0 0 {_v(end)}"/>')
     pad = indent + "  " * n
@@ -479,6 +480,9 @@ SO100_SCALE = 1.8
 real one's tool cannot point down over more than a third of a 0.51 m table from beside it."""
 SO100_JAW = 0.1 * SO100_SCALE
 """Length of the fixed jaw from the wrist-roll frame (``Fixed_Jaw``) to its tip, along z."""
+SO100_STAND = ((1.2, -0.8, 0.75), math.pi / 2)
+"""The arm stands on a body ``stand`` far from the file's origin: 1.2 m, -0.8 m, 0.75 m up,
+turned a quarter turn (a base far from the table, as in a file written for a whole scene)."""
 SO100_JAW_TIP = 0.02
 """The jaws' last 2 cm are narrow (3 mm by 6 mm each): closed, they fit through a 1-cell door."""
 
@@ -493,7 +497,8 @@ def so100_style(directory) -> Path:
     like the joints (``kp``/``dampratio``); STL meshes in ``assets/`` (``meshdir="assets/"``);
     no site and no keyframe. qpos0 is an L pose: upper arm up, forearm level, jaws down.
     The fixed jaw's tip is ``tip_body="Fixed_Jaw", tip_offset=(0, 0, SO100_JAW)`` (0.18 m),
-    on the roll axis. The base is meant to stand beside the table.
+    on the roll axis. The base is meant to stand beside the table, but the file puts it on a
+    body ``stand`` 1.5 m from the origin and 0.75 m up (``SO100_STAND``).
     """
     s = SO100_SCALE
     folder = Path(directory) / "trs_so_arm100"
@@ -556,6 +561,9 @@ def so100_style(directory) -> Path:
            *geoms("Moving_Jaw", "                  "),
            "                </body>", "              </body>", "            </body>",
            "          </body>", "        </body>", "      </body>", "    </body>"]
+    (sx, sy, sz), stand_yaw = SO100_STAND
+    xml = [f'    <body name="stand" pos="{_v((sx, sy, sz))}" quat="{_v(_quat_rz(stand_yaw))}">',
+           *("  " + line for line in xml), "    </body>"]
     joints = ("Rotation", "Pitch", "Elbow", "Wrist_Pitch", "Wrist_Roll", "Jaw")
     actuators = [f'    <position class="so_arm100/{j}" name="{j}" joint="{j}"/>' for j in joints]
     text = f"""<mujoco model="so_arm100">
@@ -715,8 +723,9 @@ SUGGESTED = {
                   base_yaw=math.pi / 2),
     "panda_nohand": dict(tip_site="attachment_site", tip_offset=(0.0, 0.0, 0.1), base_pos=(0.0, -0.40, 0.0),
                          base_yaw=math.pi / 2),
-    "so100": dict(tip_body="Fixed_Jaw", tip_offset=(0.0, 0.0, SO100_JAW), base_pos=(-0.28, 0.0, 0.0),
-                  base_yaw=-math.pi / 2),
+    # the file frame's pose that puts the base at (-0.28, 0, 0) facing +x, past the stand
+    "so100": dict(tip_body="Fixed_Jaw", tip_offset=(0.0, 0.0, SO100_JAW), base_pos=(0.92, -0.8, -0.75),
+                  base_yaw=-math.pi),
     "planar5": dict(tip_body="stylus", tip_offset=(0.0, 0.0, 0.0), base_pos=(-0.03, 0.03, 0.0), base_yaw=0.0),
 }
 """A tip and a mount that work for each arm (cartesian, tool pointing down; planar5 also
