@@ -121,6 +121,17 @@ def test_planar5_straight_joint_model_automatic_mount(files):
     assert _solvable(r, TABLE_I[1])
 
 
+@pytest.mark.parametrize("which, reach, solved", [("ur5e", 0.8, 4), ("so100", 0.6, 3)])
+def test_an_explicit_mount_is_the_file_frame_pose(files, which, reach, solved):
+    # base_pos/base_yaw place the file's own frame: the SO100-style arm stands on a body 1.5 m
+    # from that frame, and its suggested mount brings the base beside the table
+    tip = {k: v for k, v in ml.SUGGESTED[which].items() if k.startswith("tip")}
+    mount, yaw = ml.SUGGESTED[which]["base_pos"], ml.SUGGESTED[which]["base_yaw"]
+    r = _arm_robot(None, "cartesian", xml_path=files[which], base_pos=mount, base_yaw=yaw, **tip)
+    assert r.arm.mount == pytest.approx(mount) and r.arm.yaw == pytest.approx(yaw)
+    assert r.arm.reach >= reach and _solved(r) >= solved
+
+
 def test_arm_name_overrides_the_model_attribute(files, ur5e):
     r = _arm_robot(None, "cartesian", xml_path=files["ur5e"], tip_site="attachment_site", tip_offset=UR5E_TOOL,
                    arm_name="myarm")
