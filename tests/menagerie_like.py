@@ -11,15 +11,21 @@ arms have and the project's own arms do not (issue 11):
   by a fixed tendon driven by one actuator, plus an equality constraint between them;
 - a flange site (``attachment_site``), or no site at all;
 - a ``home`` keyframe that includes the finger joints, or no keyframe;
-- a 5-joint low-cost arm with a jaw, and a planar 5-joint arm whose qpos0 is the straight,
-  singular pose.
+- a 5-joint low-cost arm with a jaw, standing on a body far from the file's origin, and a
+  planar 5-joint arm whose qpos0 is the straight, singular pose.
 
 The geometry is the project's own: UR5e and Panda from their published DH parameters
 (``armtransfer.models.mjcf``), the SO100-style arm with the SO-ARM100's joint layout and
-proportions. Masses are close to the real arms'; inertias are those of solid cylinders
-along the links. Every file compiles with ``mujoco.MjModel.from_xml_path`` alone.
+proportions at 1.8 times its size. Masses are close to the real arms' (the SO100-style
+one's scaled with its volume); inertias are those of solid cylinders along the links. Every
+file compiles with ``mujoco.MjModel.from_xml_path`` alone. Gripper tips are narrow (a closed
+gripper is under 1 cm wide over its last 2 cm) so that, with the tip 4 mm above the table,
+it passes the rooms' 1-cell doors between 2 cm walls as the built-in arms' styluses do.
 
-Nothing here depends on pytest; ``python tests/menagerie_like.py DIR`` writes all of them.
+``SUGGESTED`` gives a tip and a mount per arm that meet the bounds of
+tests/test_byo_arms.py; ``plain_copy`` writes a copy the compiler from before issue 11
+accepts, to measure them. Nothing here depends on pytest; ``python tests/menagerie_like.py
+DIR`` writes all of the arms.
 """
 
 from __future__ import annotations
@@ -280,7 +286,8 @@ def ur5e_style(directory) -> Path:
     <body name="base" quat="0 0 0 1" childclass="ur5e">
       <inertial mass="4.0" pos="0 0 0.02" diaginertia="0.00443 0.00443 0.0072"/>
       <geom mesh="base_0" material="black" class="ur5e/visual"/>
-      <geom class="ur5e/collision" type="cylinder" size="0.075 {_f(UR5E_PEDESTAL / 2)}" pos="0 0 {_f(UR5E_PEDESTAL / 2)}"/>
+      <geom class="ur5e/collision" type="cylinder" size="0.075 {_f(UR5E_PEDESTAL / 2)}"
+        pos="0 0 {_f(UR5E_PEDESTAL / 2)}"/>
 {chr(10).join(body_xml)}
     </body>
   </worldbody>
@@ -526,7 +533,8 @@ def so100_style(directory) -> Path:
                        f'pos="-0.008 0 {_f(upper * 0.7)}"/>')
             out.append(f'{pad}<geom class="so_arm100/finger_collision" size="0.0015 0.003 {_f(SO100_JAW_TIP / 2)}" '
                        f'pos="-0.002 0 {_f(SO100_JAW - SO100_JAW_TIP / 2)}"/>')
-            out.append(f'{pad}<geom class="so_arm100/collision" size="{_f(r)}" fromto="0 0 0 0 0 {_f(0.2 * SO100_JAW)}"/>')
+            out.append(f'{pad}<geom class="so_arm100/collision" size="{_f(r)}" '
+                       f'fromto="0 0 0 0 0 {_f(0.2 * SO100_JAW)}"/>')
         elif body == "Moving_Jaw":  # hinged 8 mm beside the roll axis, its tip meeting the fixed one's
             upper = 0.7 * SO100_JAW - SO100_JAW_TIP
             out.append(f'{pad}<geom class="so_arm100/finger_collision" size="0.004 0.01 {_f(upper / 2)}" '

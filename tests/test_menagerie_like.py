@@ -212,8 +212,9 @@ def test_the_suggested_tip_and_mount_cover_the_table(arms, name, reach, solved, 
 
 
 def test_plain_copy_puts_the_tip_at_the_offset(arms):
-    for name, frame, offset in (("ur5e", "attachment_site", (0, 0, 0.12)), ("panda_nohand", "attachment_site", (0.05, 0, 0.1)),
-                                ("so100", "Fixed_Jaw", (0, 0, ml.SO100_JAW))):
+    cases = (("ur5e", "attachment_site", (0, 0, 0.12)), ("panda_nohand", "attachment_site", (0.05, 0, 0.1)),
+             ("so100", "Fixed_Jaw", (0, 0, ml.SO100_JAW)))
+    for name, frame, offset in cases:
         model = _model(ml.plain_copy(arms[name], frame, offset))
         data = mujoco.MjData(model)
         mujoco.mj_kinematics(model, data)
