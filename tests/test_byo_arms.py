@@ -18,6 +18,7 @@ import pytest
 import armtransfer
 import menagerie_like as ml
 from armtransfer.commands.arms import _solvable
+from armtransfer.tasks.arms import arm_robot
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.layout import ROOMS
 from test_cli import run_cli  # a fresh interpreter; it inherits the session's ARMTRANSFER_CACHE
@@ -33,25 +34,19 @@ def files(tmp_path_factory):
     return {name: make(out) for name, make in ml.ALL.items()}
 
 
-def _arm_robot(*args, **kwargs):
-    from armtransfer.tasks.arms import arm_robot
-
-    return arm_robot(*args, **kwargs)
-
-
 @pytest.fixture(scope="module")
 def ur5e(files):
-    return _arm_robot(None, "cartesian", xml_path=files["ur5e"], tip_site="attachment_site", tip_offset=UR5E_TOOL)
+    return arm_robot(None, "cartesian", xml_path=files["ur5e"], tip_site="attachment_site", tip_offset=UR5E_TOOL)
 
 
 @pytest.fixture(scope="module")
 def panda(files):
-    return _arm_robot(None, "cartesian", xml_path=files["panda"], tip_body="hand", tip_offset=PANDA_TCP)
+    return arm_robot(None, "cartesian", xml_path=files["panda"], tip_body="hand", tip_offset=PANDA_TCP)
 
 
 @pytest.fixture(scope="module")
 def so100(files):
-    return _arm_robot(None, "cartesian", xml_path=files["so100"], tip_body="Fixed_Jaw", tip_offset=SO100_TIP)
+    return arm_robot(None, "cartesian", xml_path=files["so100"], tip_body="Fixed_Jaw", tip_offset=SO100_TIP)
 
 
 def _solved(robot) -> int:
@@ -96,7 +91,7 @@ def test_so100_style_by_fixed_jaw_and_offset(so100):
 
 
 def test_panda_without_hand_by_flange_site(files):
-    r = _arm_robot(None, "cartesian", xml_path=files["panda_nohand"], tip_site="attachment_site",
+    r = arm_robot(None, "cartesian", xml_path=files["panda_nohand"], tip_site="attachment_site",
                    tip_offset=(0.0, 0.0, 0.1))
     assert r.name == "panda:cartesian" and r.arm.dof == 7
     _check_auto_mount(r)
@@ -105,7 +100,7 @@ def test_panda_without_hand_by_flange_site(files):
 
 def test_planar5_straight_cartesian_from_its_singular_qpos0(files):
     # no keyframe: home is qpos0, the straight arm, where IK's Jacobian loses a rank
-    r = _arm_robot(None, "cartesian", xml_path=files["planar5"], tip_body="stylus")
+    r = arm_robot(None, "cartesian", xml_path=files["planar5"], tip_body="stylus")
     assert r.name == "planar5:cartesian" and r.arm.dof == 5
     _check_auto_mount(r)
     assert r.arm.reach >= 0.6
@@ -114,7 +109,7 @@ def test_planar5_straight_cartesian_from_its_singular_qpos0(files):
 
 @pytest.mark.slow
 def test_planar5_straight_joint_model_automatic_mount(files):
-    r = _arm_robot(None, "joint", xml_path=files["planar5"], tip_body="stylus")
+    r = arm_robot(None, "joint", xml_path=files["planar5"], tip_body="stylus")
     assert r.name == "planar5:joint" and r.arm.dof == 5 and r.n_actions == 10
     _check_auto_mount(r)
     assert r.arm.reach >= 0.6
@@ -127,13 +122,13 @@ def test_an_explicit_mount_is_the_file_frame_pose(files, which, reach, solved):
     # from that frame, and its suggested mount brings the base beside the table
     tip = {k: v for k, v in ml.SUGGESTED[which].items() if k.startswith("tip")}
     mount, yaw = ml.SUGGESTED[which]["base_pos"], ml.SUGGESTED[which]["base_yaw"]
-    r = _arm_robot(None, "cartesian", xml_path=files[which], base_pos=mount, base_yaw=yaw, **tip)
+    r = arm_robot(None, "cartesian", xml_path=files[which], base_pos=mount, base_yaw=yaw, **tip)
     assert r.arm.mount == pytest.approx(mount) and r.arm.yaw == pytest.approx(yaw)
     assert r.arm.reach >= reach and _solved(r) >= solved
 
 
 def test_arm_name_overrides_the_model_attribute(files, ur5e):
-    r = _arm_robot(None, "cartesian", xml_path=files["ur5e"], tip_site="attachment_site", tip_offset=UR5E_TOOL,
+    r = arm_robot(None, "cartesian", xml_path=files["ur5e"], tip_site="attachment_site", tip_offset=UR5E_TOOL,
                    arm_name="myarm")
     assert r.name == "myarm:cartesian"
     assert r.n_states == ur5e.n_states and np.array_equal(r.label, ur5e.label)
