@@ -270,7 +270,7 @@ def _lattice_origin(scene: ArmScene, fk: PlanarFK) -> np.ndarray:
     raise UnreachableTableError("the arm's tip cannot reach the table near its home configuration")
 
 
-MAX_LATTICE = 4_000_000
+MAX_LATTICE = 1_000_000
 """The most joint-lattice points the ``joint`` model lays out (memory grows with them)."""
 STEP_LADDER = (0.05, 0.08, 0.12, 0.18, 0.25, 0.35, 0.5)
 """Lattice steps (rad) tried, finest first, when the arm's step is not given."""

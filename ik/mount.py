@@ -7,7 +7,9 @@ base poses worth trying:
   is hung at the height that puts its tip just above the tabletop, over points of a grid
   across and around the table;
 - any other arm stands on the table's plane beside it, on the four sides and at the four
-  corners, at a few distances, turned so that its home tip points at the table's centre.
+  corners, at a few distances, turned so that its home tip points at the table's centre;
+  an arm too small to cover the table from beside it may also stand on the table, inside
+  a room (``on_table``): its fixed base then stands on cells, never on a wall.
 
 ``estimate_reach`` scores one pose: inverse kinematics (the compile's own ``TipIK``, tool
 pointing down for spatial arms) over a sparse lattice of free cells, warm-started from
@@ -69,28 +71,67 @@ def _reach_bound(scene: ArmScene) -> tuple[np.ndarray, float]:
     return points[0], float(np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1)))
 
 
+def _base(scene: ArmScene) -> tuple[np.ndarray, float]:
+    """Where the arm's base is in its file's frame: the (x, y) of its first joint's axis and
+    the height of the bottom of the geometry no joint moves (the stand it comes on), or of
+    that joint's anchor when nothing is fixed. A file may put its base far from its origin."""
+    model = scene.model
+    data = mujoco.MjData(model)
+    data.qpos[:] = scene.home
+    mujoco.mj_kinematics(model, data)
+    anchor = data.xanchor[int(np.argmin(model.jnt_qposadr))]
+    table = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "table")
+    fixed = [g for g in range(model.ngeom)
+             if model.geom_bodyid[g] not in (0, table) and model.body_weldid[model.geom_bodyid[g]] == 0]
+    bottom = float(anchor[2])
+    for g in fixed:
+        centre, half = model.geom_aabb[g, :3], model.geom_aabb[g, 3:]
+        corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half + centre
+        bottom = min(bottom, float(np.min(data.geom_xpos[g][2] + corners @ data.geom_xmat[g].reshape(3, 3)[2])))
+    return anchor[:2].copy(), bottom
+
+
+def _facing(scene: ArmScene) -> float:
+    """The direction (rad, in the file's frame) from the base's axis to the tip at home."""
+    anchor, _ = _base(scene)
+    tip = _tip_at(scene, scene.home)[:2] - anchor
+    return math.atan2(tip[1], tip[0]) if np.linalg.norm(tip) > 1e-6 else 0.0
+
+
+def _place(scene: ArmScene, x: float, y: float, z: float | None, yaw: float | None) -> Pose:
+    """The mount (the file frame's pose) that stands the base's axis at (x, y), its bottom on
+    the tabletop (or at height ``z``), turned so that home points at the table's centre."""
+    anchor, bottom = _base(scene)
+    if yaw is None:
+        yaw = (math.atan2(-y, -x) if (x, y) != (0.0, 0.0) else 0.0) - _facing(scene)
+    yaw = (yaw + math.pi) % (2 * math.pi) - math.pi
+    c, s = math.cos(yaw), math.sin(yaw)
+    ax, ay = c * anchor[0] - s * anchor[1], s * anchor[0] + c * anchor[1]
+    height = -bottom if z is None else z
+    return Pose((round(x - ax, 4), round(y - ay, 4), round(height, 4)), round(yaw, 4))
+
+
+def on_table(scene: ArmScene, yaw: float | None = None) -> list[Pose]:
+    """Base poses on the table itself, over the grid of ``PLANAR_GRID`` (spatial arms)."""
+    return [_place(scene, x, y, None, yaw) for x in PLANAR_GRID for y in PLANAR_GRID]
+
+
 def candidates(scene: ArmScene, table_half: float, yaw: float | None = None) -> list[Pose]:
     """Base poses to try for the arm of ``scene`` (built at the origin, yaw 0)."""
     anchor, reach = _reach_bound(scene)
     tip = _tip_at(scene, scene.home)
-    if scene.planar:
+    if scene.planar:  # hung so that the tip rides just above the tabletop
         z = TIP_HEIGHT / 2 - float(tip[2])
-        turn = 0.0 if yaw is None else yaw
-        return [Pose((x, y, z), turn) for x in PLANAR_GRID for y in PLANAR_GRID]
-    home_dir = math.atan2(tip[1] - anchor[1], tip[0] - anchor[0]) if np.linalg.norm((tip - anchor)[:2]) > 1e-6 else 0.0
+        return [_place(scene, x, y, z, 0.0 if yaw is None else yaw) for x in PLANAR_GRID for y in PLANAR_GRID]
     out = []
     for gap in GAPS:
         d = table_half + gap
         for k in range(8):
             theta = -math.pi / 2 + k * math.pi / 4  # start in front of the table (-y side)
-            corner = k % 2 == 1
-            r = d * (math.sqrt(2) if corner else 1.0)
+            r = d * (math.sqrt(2) if k % 2 == 1 else 1.0)
             if r - table_half > reach:  # cannot reach even the nearest edge
                 continue
-            x, y = r * math.cos(theta), r * math.sin(theta)
-            facing = math.atan2(-y, -x) - home_dir if yaw is None else yaw
-            facing = (facing + math.pi) % (2 * math.pi) - math.pi
-            out.append(Pose((round(x, 4), round(y, 4), 0.0), round(facing, 4)))
+            out.append(_place(scene, r * math.cos(theta), r * math.sin(theta), None, yaw))
     return out
 
 
@@ -106,6 +147,8 @@ def estimate_reach(xml_path, tool: Tool, pose: Pose, layout: Layout, cell: float
     scene = build_scene(xml_path, tool, pose.pos, pose.yaw, cell, layout=layout)
     ik = TipIK(scene, tip_down=not scene.planar)
     contact = ContactChecker(scene)
+    if contact.base_on_wall():
+        return 0.0, 0
     rng = rng if rng is not None else np.random.default_rng(0)
     cells = _lattice(layout, list(must))
     xy = layout.xy_of(np.array(cells)) * cell

@@ -355,6 +355,8 @@ class ContactChecker:
         self.data = mujoco.MjData(scene.model)
         self._env = scene.env_geoms
         self._moving = scene.arm_geoms
+        self._walls = np.array([(mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_GEOM, g) or "").startswith("wall_")
+                                for g in range(self.model.ngeom)], dtype=bool) & scene.env_geoms
         self._tip = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, scene.tip)
 
     def touches(self, q: np.ndarray) -> bool:
@@ -368,6 +370,19 @@ class ContactChecker:
         g1 = d.contact.geom1[:n]
         g2 = d.contact.geom2[:n]
         return bool(np.any((self._env[g1] & self._moving[g2]) | (self._env[g2] & self._moving[g1])))
+
+    def base_on_wall(self) -> bool:
+        """Does the arm's fixed base (collision geoms that no joint moves) stand in a wall?
+
+        MuJoCo never collides two bodies fixed to the world, so this asks for distances."""
+        m, d = self.model, self.data
+        d.qpos[:] = self.scene.home
+        mujoco.mj_kinematics(m, d)
+        solid = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
+        static = np.flatnonzero(solid & ~self._moving & ~self._env & (m.geom_bodyid != 0))
+        fromto = np.zeros(6)
+        return any(mujoco.mj_geomDistance(m, d, int(a), int(w), 0.01, fromto) < 0.0
+                   for a in static for w in np.flatnonzero(self._walls))
 
     def tip(self, q: np.ndarray) -> np.ndarray:
         """The tip position after the last ``touches`` call at q (or computed now)."""

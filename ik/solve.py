@@ -69,13 +69,16 @@ class TipIK:
         """Tip over (x, y) starting from q0; returns the best configuration found."""
         q0 = np.clip(np.asarray(q0, dtype=float), self.scene.lower + 1e-6, self.scene.upper - 1e-6)
         target = np.array([xy[0], xy[1], self.target_height(q0)])
-        rotation = _DOWN if self.tip_down else mink.SO3.identity()
-        self.frame.set_target(mink.SE3.from_rotation_and_translation(rotation, target))
         cfg = self.configuration
         cfg.update(q0)
+        self.frame.set_target(mink.SE3.from_rotation_and_translation(_DOWN, target))
         err = tilt = np.inf
         it = 0
         for it in range(1, self.max_iters + 1):
+            if not self.tip_down:  # orientation free: aim at the tool's own rotation, so the
+                # frame error (an SE(3) logarithm) is the position error alone
+                rotation = cfg.get_transform_frame_to_world(self.scene.tip, "site").rotation()
+                self.frame.set_target(mink.SE3.from_rotation_and_translation(rotation, target))
             v = mink.solve_ik(cfg, self.tasks, 1.0, solver="daqp", damping=self.damping,
                               limits=self.limits)
             cfg.integrate_inplace(v, 1.0)

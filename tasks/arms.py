@@ -29,6 +29,9 @@ from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.ik.workspace import DEFAULT_CELL, WALL_HEIGHT
 
 SIDECAR_FORMAT = "armtransfer-generated-arm/1"
+COVERS = 0.95
+"""A mount beside the table whose reach estimate is at least this share (with every Table I
+cell reached) is taken without trying mounts on the table."""
 """The JSON ``armtransfer arms generate`` writes beside an arm: its mount and tool."""
 
 
@@ -246,7 +249,7 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
     from armtransfer.ik import mount as _mount
     from armtransfer.tasks.catalog import TABLE_I
 
-    parts = {"version": 1, "what": "mount", "arm_xml": _sha(path.read_bytes()), "assets": _assets_sha(path),
+    parts = {"version": 3, "what": "mount", "covers": COVERS, "arm_xml": _sha(path.read_bytes()), "assets": _assets_sha(path),
              "tool": tool.key(), "cell": cell_size, "yaw": yaw, "layout": _layout_data(layout),
              "stride": _mount.STRIDE, "gaps": _mount.GAPS, "grid": _mount.PLANAR_GRID}
     key = _cache.cache_key(parts)
@@ -263,11 +266,18 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
     must = sorted({c for t in TABLE_I.values() for c in t.cells(layout)})
     poses = _mount.candidates(origin, layout.width * cell_size / 2, yaw)
     scored = []
-    for i, pose in enumerate(poses):
-        share, hit = _mount.estimate_reach(path, tool, pose, layout, cell_size, must=must,
-                                           rng=np.random.default_rng(i))
-        scored.append((hit, share, -i, pose))
-    scored.sort(key=lambda t: (t[0], t[1], t[2]), reverse=True)
+
+    def score(batch: list) -> None:
+        for pose in batch:
+            i = len(scored)
+            share, hit = _mount.estimate_reach(path, tool, pose, layout, cell_size, must=must,
+                                               rng=np.random.default_rng(i))
+            scored.append((hit, share, -i, pose))
+        scored.sort(key=lambda t: (t[0], t[1], t[2]), reverse=True)
+
+    score(poses)
+    if not origin.planar and not (scored and scored[0][0] == len(must) and scored[0][1] >= COVERS):
+        score(_mount.on_table(origin, yaw))  # too small to cover the table from beside it
     if not scored or scored[0][1] == 0.0:
         from armtransfer.errors import UnreachableTableError
 

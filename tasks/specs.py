@@ -11,17 +11,27 @@ CUSTOM = "custom"
 """The spec of a bring-your-own arm: ``custom`` or ``custom:ACTIONS`` with its file given."""
 
 
-def resolve(spec: str | DiscreteRobot, *, xml_path=None, progress: bool = False, **arm_options) -> DiscreteRobot:
+def resolve(spec: str | DiscreteRobot, *, xml_path=None, progress: bool = False, arms: dict | None = None,
+            **arm_options) -> DiscreteRobot:
     """A robot from its spec: ``fine``/``coarse`` (grid robots), ``planar2:joint`` (a built-in
     arm and action model; the arm's first model when omitted), ``PATH.xml[:ACTIONS]`` (an arm
     file), or ``custom[:ACTIONS]`` (the arm in ``xml_path``); ``arm_options`` such as
-    ``tip_site`` and ``base_pos`` go to arm files. A robot passes through unchanged."""
+    ``tip_site`` and ``base_pos`` go to arm files; ``arms`` names bring-your-own arms (a sweep
+    file's ``[arms.NAME]`` tables: ``NAME[:ACTIONS]``). A robot passes through unchanged."""
     if isinstance(spec, DiscreteRobot):
         return spec
     if not isinstance(spec, str):
         raise UnknownRobotError(f"a robot is a spec string or a DiscreteRobot, got {type(spec).__name__}")
     if spec in GRID_ROBOTS:
         return grid_robot(spec)
+    if arms and spec.partition(":")[0] in arms:
+        from armtransfer.tasks.arms import arm_robot
+
+        name, _, actions = spec.partition(":")
+        arm = arms[name]
+        options = {k: (tuple(v) if isinstance(v, list) else v) for k, v in arm.items() if k != "xml"}
+        return arm_robot(None, actions or "cartesian", xml_path=arm["xml"], arm_name=name, progress=progress,
+                         **options)
     from armtransfer.models import ARMS
 
     if ".xml" in spec:  # an arm file: PATH.xml or PATH.xml:ACTIONS

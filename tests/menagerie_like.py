@@ -22,9 +22,8 @@ file compiles with ``mujoco.MjModel.from_xml_path`` alone. Gripper tips are narr
 gripper is under 1 cm wide over its last 2 cm) so that, with the tip 4 mm above the table,
 it passes the rooms' 1-cell doors between 2 cm walls as the built-in arms' styluses do.
 
-``SUGGESTED`` gives a tip and a mount per arm that meet the bounds of
-tests/test_byo_arms.py; ``plain_copy`` writes a copy the compiler from before issue 11
-accepts, to measure them. Nothing here depends on pytest; ``python tests/menagerie_like.py
+``SUGGESTED`` gives a tip and a mount per arm (a mount a user could give by hand).
+Nothing here depends on pytest; ``python tests/menagerie_like.py
 DIR`` writes all of the arms.
 """
 
@@ -741,38 +740,6 @@ joint). Measured with the project's compiler on copies of these files with the c
 ``/`` replaced and a site at the tip (the fingers held closed): ur5e reaches 100% of the
 free cells, Table I 4/4; panda 96%, 4/4 (panda_nohand the same); so100 76%, 3/4; planar5
 cartesian 77%, 3/4, and joint with a 0.35 rad step 92%, 4/4 (494,461 states, 51 s)."""
-
-
-def plain_copy(xml_path, tip_frame: str, tip_offset=(0.0, 0.0, 0.0)) -> Path:
-    """A copy of an arm file that the compiler from before issue 11 accepts: every ``/`` in a
-    class name replaced by ``_`` and a site ``tip`` at ``tip_offset`` in the frame of the
-    site or body ``tip_frame``. Written beside the original (its meshdir still resolves), so
-    the geometry can be checked with ``arm_robot(..., tip_site="tip")``."""
-    import xml.etree.ElementTree as ET
-
-    path = Path(xml_path)
-    tree = ET.parse(path)
-    for el in tree.iter():
-        for attr in ("class", "childclass"):
-            if el.get(attr):
-                el.set(attr, el.get(attr).replace("/", "_"))
-    parents = {child: parent for parent in tree.iter() for child in parent}
-    frame = next((el for el in tree.iter() if el.tag in ("body", "site") and el.get("name") == tip_frame), None)
-    if frame is None:
-        raise ValueError(f"{path.name} has no body or site {tip_frame!r}")
-    offset = np.asarray(tip_offset, dtype=float)
-    if frame.tag == "body":
-        host, pos = frame, offset
-    else:  # a site: the tip goes beside it in its body, the offset turned by its quat
-        q = np.array([float(x) for x in (frame.get("quat") or "1 0 0 0").split()])
-        w, v = q[0] / np.linalg.norm(q), q[1:] / np.linalg.norm(q)
-        turned = offset + 2 * np.cross(v, np.cross(v, offset) + w * offset)
-        host = parents[frame]
-        pos = np.array([float(x) for x in (frame.get("pos") or "0 0 0").split()]) + turned
-    ET.SubElement(host, "site", name="tip", pos=_v(pos))
-    out = path.with_name(f"{path.stem}_plain.xml")
-    tree.write(out)
-    return out
 
 
 ALL = {"ur5e": ur5e_style, "panda": panda_style, "panda_nohand": lambda d: panda_style(d, hand=False),

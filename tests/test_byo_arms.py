@@ -17,7 +17,7 @@ import pytest
 
 import armtransfer
 import menagerie_like as ml
-from armtransfer.commands.arms import _solvable
+from armtransfer.tasks.arms import tasks_solvable
 from armtransfer.tasks.arms import arm_robot
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.layout import ROOMS
@@ -50,7 +50,7 @@ def so100(files):
 
 
 def _solved(robot) -> int:
-    return sum(_solvable(robot, task) for task in TABLE_I.values())
+    return tasks_solvable(robot)
 
 
 def _check_auto_mount(robot):
@@ -104,7 +104,7 @@ def test_planar5_straight_cartesian_from_its_singular_qpos0(files):
     assert r.name == "planar5:cartesian" and r.arm.dof == 5
     _check_auto_mount(r)
     assert r.arm.reach >= 0.6
-    assert _solvable(r, TABLE_I[1])
+    assert tasks_solvable(r, [TABLE_I[1]]) == 1
 
 
 @pytest.mark.slow
@@ -113,7 +113,7 @@ def test_planar5_straight_joint_model_automatic_mount(files):
     assert r.name == "planar5:joint" and r.arm.dof == 5 and r.n_actions == 10
     _check_auto_mount(r)
     assert r.arm.reach >= 0.6
-    assert _solvable(r, TABLE_I[1])
+    assert tasks_solvable(r, [TABLE_I[1]]) == 1
 
 
 @pytest.mark.parametrize("which, reach, solved", [("ur5e", 0.8, 4), ("so100", 0.6, 3)])
@@ -220,9 +220,11 @@ def test_cli_lists_a_menagerie_style_arm(files, ur5e):
     proc = run_cli("arms", "list", "--arm", "planar2", "--actions", "cartesian", "--arm-xml", str(files["ur5e"]),
                    "--tip-site", "attachment_site", "--tip-offset=0,0,0.12")
     assert proc.returncode == 0, proc.stderr
-    rows = {line.split()[0]: line.split() for line in proc.stdout.splitlines()[1:]}
+    table, _, notes = proc.stdout.partition("\n\n")
+    rows = {line.split()[0]: line.split() for line in table.splitlines()[1:]}
     assert set(rows) == {"planar2:cartesian", "ur5e:cartesian"}
     assert rows["ur5e:cartesian"][1] == "6" and rows["ur5e:cartesian"][5] == "4/4"
+    assert "automatic mount --base-pos=" in notes and "tool site attachment_site + (0, 0, 0.12) m" in notes
 
 
 def test_cli_unknown_tip_site_lists_the_sites(files):

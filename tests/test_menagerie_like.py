@@ -194,33 +194,3 @@ def test_planar5_is_straight_and_singular_at_qpos0(arms):
     assert not re.search(r"<key", arms["planar5"].read_text())
 
 
-@pytest.mark.parametrize("name, reach, solved", [("ur5e", 0.8, 4), ("panda_nohand", 0.8, 4), ("so100", 0.6, 3)])
-def test_the_suggested_tip_and_mount_cover_the_table(arms, name, reach, solved, tmp_path, monkeypatch):
-    """The geometry can meet test_byo_arms.py's bounds: measured with the compiler as it is
-    before issue 11, on a plain copy with a site at the suggested tip and the tool down."""
-    from armtransfer.commands.arms import _solvable
-    from armtransfer.tasks.arms import arm_robot
-    from armtransfer.tasks.catalog import TABLE_I
-
-    sug = ml.SUGGESTED[name]
-    frame = sug.get("tip_site") or sug["tip_body"]
-    plain = ml.plain_copy(arms[name], frame, sug["tip_offset"])
-    r = arm_robot(None, "cartesian", xml_path=plain, tip_site="tip", base_pos=sug["base_pos"],
-                  base_yaw=sug["base_yaw"], tip_down=True, cache=False)
-    assert r.arm.reach >= reach
-    assert sum(_solvable(r, t) for t in TABLE_I.values()) >= solved
-
-
-def test_plain_copy_puts_the_tip_at_the_offset(arms):
-    cases = (("ur5e", "attachment_site", (0, 0, 0.12)), ("panda_nohand", "attachment_site", (0.05, 0, 0.1)),
-             ("so100", "Fixed_Jaw", (0, 0, ml.SO100_JAW)))
-    for name, frame, offset in cases:
-        model = _model(ml.plain_copy(arms[name], frame, offset))
-        data = mujoco.MjData(model)
-        mujoco.mj_kinematics(model, data)
-        tip = data.site_xpos[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "tip")]
-        kind = mujoco.mjtObj.mjOBJ_SITE if frame.endswith("site") else mujoco.mjtObj.mjOBJ_BODY
-        i = mujoco.mj_name2id(model, kind, frame)
-        pos, mat = ((data.site_xpos[i], data.site_xmat[i]) if kind == mujoco.mjtObj.mjOBJ_SITE
-                    else (data.xpos[i], data.xmat[i]))
-        assert np.allclose(tip, pos + mat.reshape(3, 3) @ np.array(offset), atol=1e-6), name

@@ -19,6 +19,15 @@ A sweep file has one table, ``[sweep]``; every key but ``name``, ``trials`` and
     gamma = [0.99]
     wind = [0.0, 0.01]
 
+Bring-your-own arms (MJCF files, MuJoCo Menagerie ones as they are) are named in tables of
+their own and then used by name in ``pairs``, as ``NAME`` or ``NAME:ACTIONS``::
+
+    [arms.ur5e]
+    xml = "mujoco_menagerie/universal_robots_ur5e/ur5e.xml"   # relative to the sweep file
+    tip_site = "attachment_site"         # or tip_body = "hand"
+    tip_offset = [0, 0, 0.12]            # metres, in the site's or body's frame
+    # base_pos = [0, -0.4, 0]; base_yaw = 1.5708   (default: chosen automatically)
+
 One *run* is one combination: ``trials`` trials of one method, seeded by its seed. Its
 content key is a hash of its full, normalised configuration, so the same run is never done
 twice (``none`` ignores K, so its runs are shared by every K).
@@ -107,12 +116,53 @@ def size(spec: dict) -> int:
     return n
 
 
-def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS) -> dict:
-    """Validate a parsed sweep file; returns the spec with every key filled in."""
-    if set(raw) != {"sweep"} or not isinstance(raw.get("sweep"), dict):
-        extra = sorted(set(raw) - {"sweep"})
+ARM_KEYS = {"xml": str, "tip_site": str, "tip_body": str, "tip_offset": list, "base_pos": list,
+            "base_yaw": (int, float)}
+"""The keys of an ``[arms.NAME]`` table and their types."""
+
+
+def _arms(raw: object, where: str, base: Path | None) -> dict:
+    """The ``[arms.NAME]`` tables, checked; ``xml`` made absolute (relative to the sweep file)."""
+    import math
+
+    if not isinstance(raw, dict):
+        raise SweepFileError(f"{where}: arms must be tables [arms.NAME]")
+    out = {}
+    for name, body in raw.items():
+        w = f"{where}: arms.{name}"
+        if not name or ":" in name or not isinstance(body, dict):
+            raise SweepFileError(f"{w}: an arm is a table [arms.NAME] with a NAME without ':'")
+        for key, value in body.items():
+            if key not in ARM_KEYS:
+                raise SweepFileError(f"{w}: unknown key {key!r}; valid keys: {', '.join(ARM_KEYS)}")
+            if isinstance(value, bool) or not isinstance(value, ARM_KEYS[key]):
+                raise SweepFileError(f"{w}: {key} has the wrong type ({type(value).__name__})")
+        if "xml" not in body:
+            raise SweepFileError(f"{w}: needs xml = \"PATH\" (the arm's MJCF file)")
+        if "tip_site" in body and "tip_body" in body:
+            raise SweepFileError(f"{w}: give tip_site or tip_body, not both")
+        for key in ("tip_offset", "base_pos"):
+            if key in body and not (len(body[key]) == 3 and all(
+                    isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in body[key])):
+                raise SweepFileError(f"{w}: {key} must be three finite numbers [X, Y, Z] (metres)")
+        if "base_yaw" in body and not math.isfinite(body["base_yaw"]):
+            raise SweepFileError(f"{w}: base_yaw must be a finite number of radians")
+        arm = dict(body)
+        xml = Path(arm["xml"]).expanduser()
+        arm["xml"] = str(xml if xml.is_absolute() or base is None else (base / xml).resolve())
+        out[name] = arm
+    return out
+
+
+def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, base: Path | None = None) -> dict:
+    """Validate a parsed sweep file; returns the spec with every key filled in (``base``: the
+    folder that relative arm files are found in)."""
+    if not set(raw) <= {"sweep", "arms"} or not isinstance(raw.get("sweep"), dict):
+        extra = sorted(set(raw) - {"sweep", "arms"})
         what = f"unknown table {extra[0]!r}" if extra else "missing the [sweep] table"
-        raise SweepFileError(f"{where}: {what}; a sweep file has exactly one table, [sweep]")
+        raise SweepFileError(f"{where}: {what}; a sweep file has one table [sweep] and may name arms in "
+                             "[arms.NAME] tables")
+    arms = _arms(raw.get("arms", {}), where, base)
     body = raw["sweep"]
     valid = sorted([*_AXES, *_SCALARS])
     for key in body:
@@ -164,6 +214,7 @@ def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS) ->
             raise SweepFileError(f"{w}: {key} lists a value twice")
         if not spec[key] and key not in ("tasks", "start_goal"):
             raise SweepFileError(f"{w}: {key} is empty; give at least one value")
+    spec["arms"] = arms
     n = size(spec)
     if n > max_runs:
         raise SweepFileError(f"{w}: the sweep has {n:,} runs, over the limit of {max_runs:,}; "
@@ -198,6 +249,9 @@ def expand(spec: dict) -> list[dict]:
             "patience": spec["patience"],
             "max_episodes": spec["max_episodes"],
         }
+        used = {p.partition(":")[0] for p in pair} & set(spec.get("arms", {}))
+        if used:  # a named arm's definition is part of the run (and of its key)
+            run["arms"] = {name: spec["arms"][name] for name in sorted(used)}
         runs.setdefault(content_key(run), run)
     return [dict(r, key=k) for k, r in runs.items()]
 
@@ -211,7 +265,7 @@ def load(path: str | os.PathLike, max_runs: int = MAX_RUNS) -> Sweep:
         raise SweepFileError(f"cannot read {where}: {err.strerror}") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
         raise SweepFileError(f"{where} is not valid TOML: {str(err).splitlines()[0]}") from None
-    spec = normalise(raw, where, max_runs)
+    spec = normalise(raw, where, max_runs, base=p.parent)
     return Sweep(spec["name"], spec, tuple(expand(spec)))
 
 

@@ -62,7 +62,8 @@ def check_runs(runs: list[dict]) -> dict:
     at, is a one-line error naming the run's robot and task."""
     if not runs:
         raise sweeps.SweepFileError("the sweep has no runs")
-    robots = {spec: resolve(spec) for spec in robot_specs(runs)}
+    arms = {name: arm for run in runs for name, arm in run.get("arms", {}).items()}
+    robots = {spec: resolve(spec, arms=arms) for spec in robot_specs(runs)}
     seen = set()
     for run in runs:
         key = (run["source"], run["target"], tuple(run["start"]), tuple(run["goal"]))
