@@ -95,9 +95,12 @@ def transfer(
     for robot in (src, tgt):
         robot.start_state(start_cell)
         robot.start_state(goal_cell, what="goal")
-    path = tgt.shortest_path(tgt.start_state(start_cell), goal_cell)
-    if path is None:
-        raise InvalidTaskError(f"robot {tgt.name} cannot reach the goal {the_task.goal} from {the_task.start}")
+    paths = {}
+    for robot in (tgt, src):  # the source must solve the task too, to hand over its path
+        paths[robot.name] = robot.shortest_path(robot.start_state(start_cell), goal_cell)
+        if paths[robot.name] is None:
+            raise InvalidTaskError(f"robot {robot.name} cannot reach the goal {the_task.goal} from {the_task.start}")
+    path = paths[tgt.name]
 
     mapping_obj, mapping_path = None, None
     if uses_mapping:

@@ -87,6 +87,12 @@ def run(args: argparse.Namespace) -> int:
         options = arm_options(args)
         source = resolve(args.source, xml_path=args.arm_xml, progress=common.interactive(), **options)
         target = resolve(args.target, xml_path=args.arm_xml, progress=common.interactive(), **options)
+        if not args.no_video or args.render:  # a replay that cannot be made fails now, not after learning
+            from armtransfer.ik.replay import check_replayable
+
+            for robot in (source, target):
+                if robot.arm is not None:
+                    check_replayable(robot)
     with staged_directory(out) as tmp:
         result = _run_into(args, tmp, source, target, out)
         if args.json:

@@ -41,8 +41,9 @@ STRIDE = 4
 """Cells between the lattice points the estimate tries (every 4th cell each way)."""
 PLANAR_GRID = (-0.2, -0.1, 0.0, 0.1, 0.2)
 """Base positions (m, each axis) tried for an arm with vertical joint axes."""
-GAPS = (0.05, 0.15, 0.3)
-"""Distances (m) from the table's edge tried for a spatial arm standing beside it."""
+GAPS = (-0.04, 0.0, 0.05, 0.15, 0.3)
+"""Distances (m) of the base's axis from the table's edge tried for a spatial arm standing beside it
+(negative: on the table, inside its edge)."""
 
 
 @dataclass(frozen=True)
@@ -85,9 +86,13 @@ def _base(scene: ArmScene) -> tuple[np.ndarray, float]:
              if model.geom_bodyid[g] not in (0, table) and model.body_weldid[model.geom_bodyid[g]] == 0]
     bottom = float(anchor[2])
     for g in fixed:
-        centre, half = model.geom_aabb[g, :3], model.geom_aabb[g, 3:]
-        corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half + centre
-        bottom = min(bottom, float(np.min(data.geom_xpos[g][2] + corners @ data.geom_xmat[g].reshape(3, 3)[2])))
+        if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH:  # its vertices: a mesh's box is loose
+            m = model.geom_dataid[g]
+            points = model.mesh_vert[model.mesh_vertadr[m]:model.mesh_vertadr[m] + model.mesh_vertnum[m]]
+        else:
+            centre, half = model.geom_aabb[g, :3], model.geom_aabb[g, 3:]
+            points = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half + centre
+        bottom = min(bottom, float(np.min(data.geom_xpos[g][2] + points @ data.geom_xmat[g].reshape(3, 3)[2])))
     return anchor[:2].copy(), bottom
 
 

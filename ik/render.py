@@ -135,24 +135,37 @@ def _camera_axes(elevation: float, azimuth: float = 90.0) -> tuple[np.ndarray, n
     return forward, right, np.cross(right, forward)
 
 
-def scene_points(replay_or_scene, samples: int = 40) -> np.ndarray:
-    """Points the view must show: the table's corners at its walls' height, and every arm
-    body at up to ``samples`` configurations of the replay (at home for a bare scene)."""
+def scene_points(replay_or_scene, samples: int = 40) -> tuple[np.ndarray, np.ndarray]:
+    """(points, radii) the view must show: the table's corners at its walls' height, and
+    every arm geom (its centre and bounding radius) at up to ``samples`` configurations of
+    the replay (at home for a bare scene)."""
     scene = getattr(replay_or_scene, "scene", replay_or_scene)
+    model = scene.model
     half = scene.layout.width * scene.cell / 2
     corners = np.array([[sx * half, sy * half, z] for sx in (-1, 1) for sy in (-1, 1) for z in (0.0, WALL_HEIGHT)])
     qs = getattr(replay_or_scene, "qpos", None)
     qs = np.asarray(scene.home)[None] if qs is None else qs[np.unique(np.linspace(0, len(qs) - 1, samples).astype(int))]
-    data = mujoco.MjData(scene.model)
-    table = mujoco.mj_name2id(scene.model, mujoco.mjtObj.mjOBJ_BODY, "table")
-    arm = [b for b in range(1, scene.model.nbody) if b != table]
-    points = [corners]
+    data = mujoco.MjData(model)
+    table = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "table")
+    arm = np.flatnonzero((model.geom_bodyid != table) & (model.geom_bodyid != 0))
+    points, radii = [corners], [np.zeros(len(corners))]
     for q in qs:
         data.qpos[:] = q
-        mujoco.mj_kinematics(scene.model, data)
-        points.append(data.xpos[arm])
-        points.append(data.site_xpos)
-    return np.vstack(points)
+        mujoco.mj_kinematics(model, data)
+        points.append(data.geom_xpos[arm])
+        radii.append(model.geom_rbound[arm])
+    return np.vstack(points), np.concatenate(radii)
+
+
+def _spans(replay_or_scene, elevation: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The view's (right, up, forward) extents [lo, hi] of everything it must show."""
+    points, radii = scene_points(replay_or_scene)
+    forward, right, up = _camera_axes(elevation)
+    out = []
+    for axis in (right, up, forward):
+        c = points @ axis
+        out.append(np.array([float(np.min(c - radii)), float(np.max(c + radii))]))
+    return tuple(out)
 
 
 def table_camera(replay_or_scene, width: int = 320, height: int = 240, *,
@@ -160,16 +173,13 @@ def table_camera(replay_or_scene, width: int = 320, height: int = 240, *,
     """A fixed free camera from the front (-y side), ``elevation`` degrees down, looking at the
     middle of everything the replay shows: the table and the arm wherever it is mounted (see
     ``view_extent`` for the orthographic scale that fits it)."""
-    points = scene_points(replay_or_scene)
+    u, v, depth = _spans(replay_or_scene, elevation)
     forward, right, up = _camera_axes(elevation)
-    u, v = points @ right, points @ up
-    centre = right * (u.min() + u.max()) / 2 + up * (v.min() + v.max()) / 2
-    depth = points @ forward
-    centre = centre + forward * float(depth.mean())
+    centre = right * u.mean() + up * v.mean() + forward * depth.mean()
     cam = mujoco.MjvCamera()
     cam.type = mujoco.mjtCamera.mjCAMERA_FREE
     cam.lookat[:] = centre
-    cam.distance = float(np.ptp(depth)) + 2.0  # in front of everything; orthographic, so no zoom
+    cam.distance = float(depth[1] - depth[0]) + 2.0  # in front of everything; orthographic, so no zoom
     cam.azimuth = 90.0
     cam.elevation = elevation
     return cam
@@ -177,12 +187,9 @@ def table_camera(replay_or_scene, width: int = 320, height: int = 240, *,
 
 def view_extent(replay_or_scene, width: int, height: int, elevation: float = ELEVATION) -> float:
     """Vertical extent (m) of the orthographic view that shows the table, its walls and the
-    arm's bodies with a small margin at aspect ``width / height``."""
-    points = scene_points(replay_or_scene)
-    _, right, up = _camera_axes(elevation)
-    vertical = float(np.ptp(points @ up))
-    horizontal_as_vertical = float(np.ptp(points @ right)) * height / width
-    return 1.12 * max(vertical, horizontal_as_vertical)
+    arm's geoms with a small margin at aspect ``width / height``."""
+    u, v, _ = _spans(replay_or_scene, elevation)
+    return 1.08 * max(float(v[1] - v[0]), float(u[1] - u[0]) * height / width)
 
 
 def offscreen_model(replay_or_scene, width: int, height: int, samples: int = 4) -> mujoco.MjModel:

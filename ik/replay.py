@@ -177,6 +177,22 @@ def robot_scene(robot) -> ArmScene:
     return build_scene(arm.xml_path, arm.tool, arm.mount, arm.yaw, arm.cell_size, layout=arm.layout)
 
 
+def check_replayable(robot) -> ArmScene:
+    """Before any learning: the robot's scene rebuilds, every joint has a position servo, and
+    the rebuilt scene puts the tip where the compiled states say. Returns the scene."""
+    arm = arm_of(robot)
+    scene = robot_scene(robot)
+    model = scene.model
+    driven = set(model.actuator_trnid[model.actuator_trntype == mujoco.mjtTrn.mjTRN_JOINT, 0].tolist())
+    if driven != set(range(model.njnt)):
+        raise ReplayError(f"robot {robot.name}: not every joint of its scene has a servo to replay a path with")
+    tip_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, scene.tip)
+    data = mujoco.MjData(model)
+    if arm.tip is not None and np.linalg.norm(_fk(model, data, arm.qpos[0], tip_id) - arm.tip[0]) > 1e-5:
+        raise ReplayError(f"the rebuilt scene of {robot.name} does not match its compiled tips; recompile the robot")
+    return scene
+
+
 def _dedupe(cells: Sequence[int]) -> list[int]:
     out: list[int] = []
     for c in cells:
@@ -316,4 +332,4 @@ def _tune_gains(model: mujoco.MjModel, data: mujoco.MjData, bandwidth_hz: float)
     return kv
 
 
-__all__ = ["Replay", "ReplayError", "polyline_distance", "replay", "robot_scene"]
+__all__ = ["Replay", "ReplayError", "check_replayable", "polyline_distance", "replay", "robot_scene"]

@@ -249,7 +249,7 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
     from armtransfer.ik import mount as _mount
     from armtransfer.tasks.catalog import TABLE_I
 
-    parts = {"version": 3, "what": "mount", "covers": COVERS, "arm_xml": _sha(path.read_bytes()), "assets": _assets_sha(path),
+    parts = {"version": 4, "what": "mount", "covers": COVERS, "arm_xml": _sha(path.read_bytes()), "assets": _assets_sha(path),
              "tool": tool.key(), "cell": cell_size, "yaw": yaw, "layout": _layout_data(layout),
              "stride": _mount.STRIDE, "gaps": _mount.GAPS, "grid": _mount.PLANAR_GRID}
     key = _cache.cache_key(parts)

@@ -165,6 +165,7 @@ def test_the_camera_fits_an_arm_mounted_far_from_the_table(scara_xml):
     cam = table_camera(far, 320, 240)
     half_v = view_extent(far, 320, 240) / 2
     half_h = half_v * 320 / 240
-    rel = scene_points(far) - np.array(cam.lookat)
-    assert np.all(np.abs(rel @ up) <= half_v) and np.all(np.abs(rel @ right) <= half_h)
+    points, radii = scene_points(far)
+    rel = points - np.array(cam.lookat)
+    assert np.all(np.abs(rel @ up) + radii <= half_v) and np.all(np.abs(rel @ right) + radii <= half_h)
     assert math.isfinite(cam.distance) and cam.distance > 0
