@@ -169,3 +169,19 @@ def test_the_camera_fits_an_arm_mounted_far_from_the_table(scara_xml):
     rel = points - np.array(cam.lookat)
     assert np.all(np.abs(rel @ up) + radii <= half_v) and np.all(np.abs(rel @ right) + radii <= half_h)
     assert math.isfinite(cam.distance) and cam.distance > 0
+
+
+def test_arm_rooms_env_takes_the_tool_and_mount_options(gripper_xml):
+    import gymnasium as gym
+    from gymnasium.utils.env_checker import check_env
+
+    import armtransfer
+
+    armtransfer.register_envs()
+    env = gym.make("armtransfer/ArmRooms-v0", xml_path=str(gripper_xml), actions="cartesian", tip_body="pen",
+                   tip_offset=(0, 0, -0.116), base_pos=(-0.1, 0.0, 0.0), base_yaw=0.0, arm_name="grip",
+                   start=(10, 10), goal=(15, 16))
+    robot = env.unwrapped.robot
+    assert robot.name == "grip:cartesian" and robot.arm.tool.body == "pen" and robot.arm.mount_source == "given"
+    check_env(env.unwrapped, skip_render_check=True)
+    env.close()
