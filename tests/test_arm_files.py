@@ -185,3 +185,16 @@ def test_arm_rooms_env_takes_the_tool_and_mount_options(gripper_xml):
     assert robot.name == "grip:cartesian" and robot.arm.tool.body == "pen" and robot.arm.mount_source == "given"
     check_env(env.unwrapped, skip_render_check=True)
     env.close()
+
+
+def test_mount_candidates_script_lists_and_compiles(scara_xml, capsys):
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parent.parent / "scripts" / "mount_candidates.py"
+    spec = importlib.util.spec_from_file_location("mount_candidates", path)
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    assert script.main([str(scara_xml), "--tip-site", "pen_tip", "--compile", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "25 candidates estimated" in out and out.count("reach ") == 1 and "Table I solvable" in out
