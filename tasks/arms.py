@@ -2,11 +2,13 @@
 
 A robot name is ``ARM:ACTIONS``. The result is a ``tasks.robot.DiscreteRobot`` whose
 labels are the shared rooms-world cells, so every learner runs on it unchanged. Its
-``meta`` holds ``qpos`` [n_states, nq] (the joint configuration of every state, to replay
-paths with the position actuators), ``tip`` [n_states, 3], ``reach`` (fraction of free
-cells reached), ``cache`` ("hit", "miss", "stale", "corrupt") and the compile settings
-(``xml_path``, ``tip_site``, ``mount``, ``yaw``, ``cell_size``, ``layout``: enough to rebuild
-the exact MuJoCo scene, as ``armtransfer.ik.replay`` does).
+``arm`` (an ``ik.description.ArmDescription``) holds ``qpos`` [n_states, nq] (the joint
+configuration of every state, to replay paths with the position servos), ``tip``
+[n_states, 3], ``reach`` (fraction of free cells reached), ``cache`` ("hit", "miss",
+"stale", "corrupt") and the compile settings (``xml_path``, ``tool``, ``mount``, ``yaw``,
+``cell_size``, ``layout``: enough to rebuild the exact MuJoCo scene, as
+``armtransfer.ik.replay`` does). A bring-your-own arm file without a mount is mounted by
+:func:`automatic_mount`.
 """
 
 from __future__ import annotations
@@ -29,10 +31,10 @@ from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.ik.workspace import DEFAULT_CELL, WALL_HEIGHT
 
 SIDECAR_FORMAT = "armtransfer-generated-arm/1"
+"""The JSON ``armtransfer arms generate`` writes beside an arm: its mount and tool."""
 COVERS = 0.95
 """A mount beside the table whose reach estimate is at least this share (with every Table I
 cell reached) is taken without trying mounts on the table."""
-"""The JSON ``armtransfer arms generate`` writes beside an arm: its mount and tool."""
 
 
 def parse_robot_spec(spec: str) -> tuple[str, str]:
