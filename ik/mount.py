@@ -9,7 +9,8 @@ base poses worth trying:
 - any other arm stands on the table's plane beside it, on the four sides and at the four
   corners, at a few distances, turned so that its home tip points at the table's centre;
   an arm too small to cover the table from beside it may also stand on the table, inside
-  a room (``on_table``): its fixed base then stands on cells, never on a wall.
+  a room (``on_table``): its fixed base then stands on cells, never on a wall; and its best
+  few poses are also tried on a pedestal (``LIFTS``), which can free its lower links.
 
 ``estimate_reach`` scores one pose: inverse kinematics (the compile's own ``TipIK``, tool
 pointing down for spatial arms) over a sparse lattice of free cells, warm-started from
@@ -44,12 +45,18 @@ PLANAR_GRID = (-0.2, -0.1, 0.0, 0.1, 0.2)
 GAPS = (-0.04, 0.0, 0.05, 0.15, 0.3)
 """Distances (m) of the base's axis from the table's edge tried for a spatial arm standing beside it
 (negative: on the table, inside its edge)."""
+LIFTS = (0.05, 0.1)
+"""Heights (m) of a pedestal tried under the best few poses of a spatial arm that does not
+cover the table standing at the tabletop's height."""
 
 
 @dataclass(frozen=True)
 class Pose:
     pos: tuple[float, float, float]
     yaw: float
+
+    def lifted(self, height: float) -> "Pose":
+        return Pose((self.pos[0], self.pos[1], round(self.pos[2] + height, 4)), self.yaw)
 
     def describe(self) -> str:
         return f"base at ({self.pos[0]:.3f}, {self.pos[1]:.3f}, {self.pos[2]:.3f}) m, yaw {self.yaw:.3f} rad"

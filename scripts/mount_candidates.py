@@ -2,7 +2,8 @@
 
 The automatic mount (``armtransfer.tasks.arms.automatic_mount``) ranks its candidates by a
 quick IK estimate and compiles only the best few. This script shows all of them: the
-estimate for each, then a full compile of the ``--compile`` best by estimate, with the
+estimate for each, then a full compile of the ``--compile`` best (in the search's own order: Table I cells reached, then
+the estimate), with the
 share of free cells reached and the Table I tasks solvable. Use it to see why a mount was
 chosen, or to pick one by hand for ``--base-pos``/``--base-yaw``.
 
@@ -16,14 +17,10 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
 from armtransfer.errors import ArmTransferError
-from armtransfer.ik import mount
 from armtransfer.ik.tool import parse_offset
-from armtransfer.tasks.arms import arm_robot, arm_scene, make_tool, tasks_solvable
+from armtransfer.tasks.arms import arm_robot, make_tool, mount_search, tasks_solvable
 from armtransfer.tasks.catalog import TABLE_I
-from armtransfer.tasks.layout import ROOMS
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -37,24 +34,14 @@ def main(argv: list[str] | None = None) -> int:
     offset = parse_offset(args.tip_offset) if args.tip_offset else None
     tool = make_tool(args.tip_site, args.tip_body, offset)
     path = Path(args.xml)
-    origin = arm_scene(xml_path=path, tip_site=tool.site, tip_body=tool.body, tip_offset=tool.offset)
-    must = sorted({c for t in TABLE_I.values() for c in t.cells(ROOMS)})
-    poses = mount.candidates(origin, ROOMS.width * origin.cell / 2)
-    if not origin.planar:
-        poses += mount.on_table(origin)
-    rows = []
     t0 = time.perf_counter()
-    for i, pose in enumerate(poses):
-        share, hit = mount.estimate_reach(path, tool, pose, ROOMS, origin.cell, must=must,
-                                          rng=np.random.default_rng(i))
-        rows.append((share, hit, pose))
-    print(f"{len(poses)} candidates estimated in {time.perf_counter() - t0:.0f} s "
-          f"(share of a sparse lattice of free cells; Table I cells reached of {len(must)})")
-    rows.sort(key=lambda r: -r[0])
-    for share, hit, pose in rows:
-        print(f"  {pose.describe()}: estimate {share:.1%}, Table I cells {hit}/{len(must)}")
-    print(f"full compiles of the {args.compile} best by estimate:")
-    for share, hit, pose in rows[:args.compile]:
+    rows = mount_search(path, tool)
+    print(f"{len(rows)} candidates estimated in {time.perf_counter() - t0:.0f} s "
+          f"(share of a sparse lattice of free cells; Table I cells reached)")
+    for hit, share, pose in rows:
+        print(f"  {pose.describe()}: estimate {share:.1%}, Table I cells {hit}")
+    print(f"full compiles of the {args.compile} best:")
+    for hit, share, pose in rows[:args.compile]:
         robot = arm_robot(None, "cartesian", xml_path=path, tip_site=tool.site, tip_body=tool.body,
                           tip_offset=tool.offset, base_pos=pose.pos, base_yaw=pose.yaw)
         print(f"  --base-pos={','.join(f'{v:.4g}' for v in pose.pos)} --base-yaw={pose.yaw:.4g}: "

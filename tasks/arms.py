@@ -235,25 +235,56 @@ def _chain_of(arrays: dict) -> tuple[tuple[str, ...], tuple[tuple[str, float], .
     return chain, held
 
 
+def mount_search(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, layout: Layout = ROOMS,
+                 yaw: float | None = None) -> list[tuple[int, float, "object"]]:
+    """Every base pose the automatic mount tries, best first, as (Table I cells reached,
+    estimated share of free cells, ``ik.mount.Pose``).
+
+    First the poses of ``ik.mount.candidates`` (beside the table; over it for an arm with
+    vertical joint axes). A spatial arm that none of them lets cover the table (an estimate
+    of at least ``COVERS`` with every Table I cell) also tries ``ik.mount.on_table`` and its
+    best five poses on each pedestal of ``ik.mount.LIFTS``.
+    """
+    from armtransfer.ik import mount as _mount
+    from armtransfer.tasks.catalog import TABLE_I
+
+    origin = _scene(path, tool, (0.0, 0.0, 0.0), 0.0, cell_size, layout)
+    must = sorted({c for t in TABLE_I.values() for c in t.cells(layout)})
+    scored: list = []
+
+    def score(batch: list) -> None:
+        for pose in batch:
+            i = len(scored)
+            share, hit = _mount.estimate_reach(path, tool, pose, layout, cell_size, must=must,
+                                               rng=np.random.default_rng(i))
+            scored.append((hit, share, -i, pose))
+        scored.sort(key=lambda t: (t[0], t[1], t[2]), reverse=True)
+
+    score(_mount.candidates(origin, layout.width * cell_size / 2, yaw))
+    if not origin.planar and not (scored and scored[0][0] == len(must) and scored[0][1] >= COVERS):
+        score(_mount.on_table(origin, yaw))  # too small to cover the table from beside it
+        score([pose.lifted(h) for *_, pose in scored[:5] for h in _mount.LIFTS])  # on a pedestal
+    return [(hit, share, pose) for hit, share, _, pose in scored]
+
+
 def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, layout: Layout = ROOMS,
                     yaw: float | None = None, cache: bool = True, progress: bool = False):
     """A base pose for an arm that came without one (``ik.mount.Pose``).
 
-    The candidates of ``ik.mount.candidates`` are scored by a quick inverse-kinematics reach
-    estimate; the best three are compiled in full (the 1-cell cartesian model, or the joint
-    lattice for an arm with vertical joint axes is not needed: reach is a property of the
-    tool's workspace) and the one reaching the most free cells with the most Table I tasks
-    solvable wins. The choice is cached under the arm file's content, tool, cell size and
-    layout, so it is made once.
+    The poses of :func:`mount_search` are ranked by their quick estimate; the best three are
+    compiled in full (the 1-cell cartesian model: reach is the tool's workspace, whatever
+    the action model) and the one with the most Table I tasks solvable, then the most free
+    cells reached, wins. The choice is cached under the arm file's content (meshes
+    included), tool, cell size and layout, so it is made once.
     """
     import json
 
     from armtransfer.ik import mount as _mount
-    from armtransfer.tasks.catalog import TABLE_I
 
-    parts = {"version": 4, "what": "mount", "covers": COVERS, "arm_xml": _sha(path.read_bytes()), "assets": _assets_sha(path),
-             "tool": tool.key(), "cell": cell_size, "yaw": yaw, "layout": _layout_data(layout),
-             "stride": _mount.STRIDE, "gaps": _mount.GAPS, "grid": _mount.PLANAR_GRID}
+    parts = {"version": 4, "what": "mount", "covers": COVERS, "arm_xml": _sha(path.read_bytes()),
+             "assets": _assets_sha(path), "tool": tool.key(), "cell": cell_size, "yaw": yaw,
+             "layout": _layout_data(layout), "stride": _mount.STRIDE, "gaps": _mount.GAPS,
+             "grid": _mount.PLANAR_GRID, "lifts": _mount.LIFTS}
     key = _cache.cache_key(parts)
     entry = _cache.cache_dir() / f"mount-{key[:16]}.json"
     if cache:
@@ -264,30 +295,16 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
                 return _mount.Pose(tuple(data["pos"]), float(data["yaw"]))
         except (OSError, ValueError, KeyError, TypeError):
             pass
-    origin = _scene(path, tool, (0.0, 0.0, 0.0), 0.0, cell_size, layout)
-    must = sorted({c for t in TABLE_I.values() for c in t.cells(layout)})
-    poses = _mount.candidates(origin, layout.width * cell_size / 2, yaw)
-    scored = []
+    from armtransfer.errors import UnreachableTableError
 
-    def score(batch: list) -> None:
-        for pose in batch:
-            i = len(scored)
-            share, hit = _mount.estimate_reach(path, tool, pose, layout, cell_size, must=must,
-                                               rng=np.random.default_rng(i))
-            scored.append((hit, share, -i, pose))
-        scored.sort(key=lambda t: (t[0], t[1], t[2]), reverse=True)
-
-    score(poses)
-    if not origin.planar and not (scored and scored[0][0] == len(must) and scored[0][1] >= COVERS):
-        score(_mount.on_table(origin, yaw))  # too small to cover the table from beside it
+    unreachable = UnreachableTableError(
+        f"the arm's tool ({tool.describe()}) cannot reach the table from any base pose tried; give "
+        "--base-pos X,Y,Z and --base-yaw")
+    scored = mount_search(path, tool, cell_size=cell_size, layout=layout, yaw=yaw)
     if not scored or scored[0][1] == 0.0:
-        from armtransfer.errors import UnreachableTableError
-
-        raise UnreachableTableError(
-            f"the arm's tool ({tool.describe()}) cannot reach the table from any base pose tried; give "
-            "--base-pos X,Y,Z and --base-yaw")
+        raise unreachable
     best = None
-    for hit, share, _, pose in scored[:3]:
+    for hit, share, pose in scored[:3]:
         if progress:
             print(f"  mount candidate: {pose.describe()} (estimated reach {share:.0%})", file=sys.stderr, flush=True)
         try:
@@ -300,11 +317,7 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
         if best is None or rank > best[0]:
             best = (rank, pose)
     if best is None:
-        from armtransfer.errors import UnreachableTableError
-
-        raise UnreachableTableError(
-            f"the arm's tool ({tool.describe()}) cannot reach the table from any base pose tried; give "
-            "--base-pos X,Y,Z and --base-yaw")
+        raise unreachable
     pose = best[1]
     if cache:
         from armtransfer.io import write_json_atomic
@@ -401,5 +414,5 @@ def _compile(scene, model, tip_down, step, progress) -> dict:
     return arrays
 
 
-__all__ = ["arm_robot", "arm_scene", "automatic_mount", "make_tool", "parse_robot_spec", "robot", "robot_specs",
+__all__ = ["arm_robot", "arm_scene", "automatic_mount", "make_tool", "mount_search", "parse_robot_spec", "robot", "robot_specs",
            "tasks_solvable"]

@@ -198,3 +198,4 @@ def test_mount_candidates_script_lists_and_compiles(scara_xml, capsys):
     assert script.main([str(scara_xml), "--tip-site", "pen_tip", "--compile", "1"]) == 0
     out = capsys.readouterr().out
     assert "25 candidates estimated" in out and out.count("reach ") == 1 and "Table I solvable" in out
+    assert out.count("estimate ") == 25
