@@ -113,8 +113,9 @@ def guided_held_out(n: int, seed: int) -> dict:
 
 
 def score_guided(params: dict, held: dict, trials: int, cap: int = 50_000) -> dict:
-    """Geometric mean over the held-out tasks of first-exposure steps / optimal distance, per
-    robot pair and overall (an unreached trial counts at the cap)."""
+    """Mean over the held-out tasks and trials of first-exposure steps / optimal distance, per
+    robot pair, and the worst pair's (an unreached trial counts at the cap). The mean, not a
+    geometric mean: the issue's target is on the mean, which a rare long trial dominates."""
     from armtransfer.learning import guide
     from armtransfer.learning.shaping import MODE_NONE
 
@@ -129,8 +130,8 @@ def score_guided(params: dict, held: dict, trials: int, cap: int = 50_000) -> di
             for t in range(trials):
                 res = sarsa.learn(dst, dst.start_state(s), g, config, trial_rng(12345, t), shaping=shaping)
                 ratios.append((res.exploration_steps or cap) / optimal)
-        per[key] = float(np.exp(np.mean(np.log(ratios))))
-    per["all"] = float(np.exp(np.mean(np.log(list(per.values())))))
+        per[key] = float(np.mean(ratios))
+    per["all"] = max(per.values())
     return per
 
 

@@ -49,7 +49,13 @@ REACH = 1.0
 KNN = 8
 """Neighbours in configuration space a prediction for an untried pair averages."""
 MEMORY = 256
-"""States per action remembered for the neighbour search (the most recent).
+"""States per action remembered for the neighbour search (the most recent)."""
+WEIGHT = 2.0
+"""Preference per cell of predicted progress, in units of Q (one step costs -1; after one try
+a pair's Q is about -alpha)."""
+EPISODES = 1
+"""The model chooses in this many first episodes (1: until the goal is first reached, the
+exploration phase); afterwards Algorithm 1's epsilon-greedy chooses alone.
 
 WINDOW, REACH and KNN were chosen on held-out start/goal pairs for coarse <-> fine and
 planar2:joint <-> ur5e_like:cartesian (``scripts/select_defaults.py --method guided``), never
@@ -66,7 +72,7 @@ class Guide:
     ty: np.ndarray  # float64 [T]
     trem: np.ndarray  # float64 [T]: trajectory length (cells) from this cell to its end
     tstart: np.ndarray  # int64 [n_traj + 1]: where each trajectory starts in tx/ty/trem
-    params: np.ndarray  # float64 [4]: window, reach, knn, memory
+    params: np.ndarray  # float64 [6]: window, reach, knn, memory, weight, episodes
 
     @property
     def memory(self) -> int:
@@ -74,12 +80,13 @@ class Guide:
 
 
 def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW, reach: float = REACH,
-          knn: int = KNN, memory: int = MEMORY) -> Guide:
+          knn: int = KNN, memory: int = MEMORY, weight: float = WEIGHT, episodes: int = EPISODES) -> Guide:
     """The guide for ``robot`` following ``trajs`` (one or several)."""
-    if not (np.isfinite(window) and window >= 0 and np.isfinite(reach) and reach >= 0):
-        raise InvalidParameterError(f"window and reach must be non-negative numbers, got {window}, {reach}")
-    if int(knn) < 1 or int(memory) < 1:
-        raise InvalidParameterError(f"knn and memory must be positive integers, got {knn}, {memory}")
+    for name, v in (("window", window), ("reach", reach), ("weight", weight)):
+        if not (np.isfinite(v) and v >= 0):
+            raise InvalidParameterError(f"{name} must be a non-negative number, got {v}")
+    if int(knn) < 1 or int(memory) < 1 or int(episodes) < 1:
+        raise InvalidParameterError(f"knn, memory and episodes must be positive integers, got {knn}, {memory}, {episodes}")
     layout = robot.layout
     lxy = layout.xy_of(robot.label).astype(np.float64).reshape(-1, 2)
     if robot.arm is not None:
@@ -100,14 +107,15 @@ def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW,
         feat=np.ascontiguousarray(feat), lxy=np.ascontiguousarray(lxy),
         tx=np.concatenate(xs), ty=np.concatenate(ys), trem=np.concatenate(rem),
         tstart=np.array(starts, np.int64),
-        params=np.array([float(window), float(reach), float(int(knn)), float(int(memory))]),
+        params=np.array([float(window), float(reach), float(int(knn)), float(int(memory)), float(weight),
+                         float(int(episodes))]),
     )
 
 
 def inactive(n_actions: int) -> tuple:
     """(guide tuple, model tuple) for a trial without a guide: empty arrays of the right types."""
     g = (np.zeros((0, 1)), np.zeros((0, 2)), np.zeros(0), np.zeros(0), np.zeros(0),
-         np.zeros(1, np.int64), np.array([0.0, 0.0, 1.0, 1.0]))
+         np.zeros(1, np.int64), np.array([0.0, 0.0, 1.0, 1.0, 0.0, 0.0]))
     return g, model_arrays(0, n_actions, 1, 1)
 
 
@@ -120,7 +128,7 @@ def model_arrays(n_states: int, n_actions: int, memory: int, n_traj: int) -> tup
     remembered states [A, memory], pushes per action [A], progress index per trajectory)."""
     return (np.zeros((n_states, n_actions, 2)), np.zeros((n_states, n_actions), np.int64),
             np.zeros((n_actions, memory), np.int64), np.zeros(n_actions, np.int64),
-            np.zeros(max(n_traj, 1), np.int64))
+            np.zeros(max(n_traj, 1), np.int64), np.zeros((n_states, n_actions), np.bool_))
 
 
 @numba.njit(cache=True)
@@ -158,14 +166,15 @@ def update_progress(g, gm, s):
 def observe(g, gm, s, a, s2):
     """Record the move s --a--> s2 (s2: the state whose label robot 2 perceives after it)."""
     lxy, params = g[1], g[6]
-    dsum, dcnt, buf, bufn = gm[0], gm[1], gm[2], gm[3]
+    dsum, dcnt, buf, bufn, inbuf = gm[0], gm[1], gm[2], gm[3], gm[5]
     dsum[s, a, 0] += lxy[s2, 0] - lxy[s, 0]
     dsum[s, a, 1] += lxy[s2, 1] - lxy[s, 1]
-    if dcnt[s, a] == 0:
+    dcnt[s, a] += 1
+    if s2 != s and not inbuf[s, a]:  # a blocked move says nothing of the action elsewhere
+        inbuf[s, a] = True
         memory = int(params[3])
         buf[a, bufn[a] % memory] = s
         bufn[a] += 1
-    dcnt[s, a] += 1
 
 
 @numba.njit(cache=True)
@@ -226,34 +235,32 @@ def score(g, gm, x, y):
 
 @numba.njit(cache=True)
 def egreedy(Q, s, eps, rng, g, gm):
-    """Algorithm 1's epsilon-greedy with the model breaking ties among the best-Q actions.
+    """Epsilon-greedy over Q plus the model's preference, in the exploration phase.
 
-    Draws: u; if u < eps one more draw picks floor(u2 * n_actions); otherwise, when k > 1
-    actions tie for the largest Q, the model keeps those of the lowest score, and when m > 1
-    remain one more draw picks the floor(u2 * m)-th of them in index order."""
+    Draws: u; if u < eps one more draw picks floor(u2 * n_actions) (Algorithm 1's random
+    step). Otherwise the action of largest Q(s, a) - weight * score(predicted label of a)
+    is taken; an action never tried anywhere counts as the best (it is tried once early).
+    When m > 1 actions tie for the largest value, one more draw picks the floor(u2 * m)-th
+    of them in index order."""
     n_actions = Q.shape[1]
     if rng.random() < eps:
         return int(rng.random() * n_actions)
-    best = Q[s, 0]
-    for a in range(1, n_actions):
-        if Q[s, a] > best:
-            best = Q[s, a]
-    lxy = g[1]
+    lxy, params = g[1], g[6]
+    w = params[4]
     x = lxy[s, 0]
     y = lxy[s, 1]
-    sc = np.full(n_actions, np.inf)
-    low = np.inf
+    val = np.empty(n_actions)
+    best = -np.inf
     for a in range(n_actions):
-        if Q[s, a] == best:
-            known, dx, dy = predict(g, gm, s, a)
-            v = score(g, gm, x + dx, y + dy) if known else -np.inf
-            sc[a] = v
-            if v < low:
-                low = v
+        known, dx, dy = predict(g, gm, s, a)
+        v = Q[s, a] - w * score(g, gm, x + dx, y + dy) if known else np.inf
+        val[a] = v
+        if v > best:
+            best = v
     m = 0
     first = -1
     for a in range(n_actions):
-        if Q[s, a] == best and sc[a] == low:
+        if val[a] == best:
             if first < 0:
                 first = a
             m += 1
@@ -261,7 +268,7 @@ def egreedy(Q, s, eps, rng, g, gm):
         return first
     k = int(rng.random() * m)
     for a in range(n_actions):
-        if Q[s, a] == best and sc[a] == low:
+        if val[a] == best:
             if k == 0:
                 return a
             k -= 1

@@ -200,8 +200,10 @@ def _run_trial(
     converged_episode = -1
     episodes = 0
     has_macros = macro_actions.shape[0] > 0
-    guided = g[5].shape[0] > 1  # the guide has at least one trajectory (transfer.guide)
+    has_guide = g[5].shape[0] > 1  # the guide has at least one trajectory (transfer.guide)
+    guide_episodes = int(g[6][5])
     for ep in range(max_episodes):
+        guided = has_guide and ep < guide_episodes  # the model chooses in the exploration phase
         use_macros = has_macros and ep < macro_episodes
         # reset traces
         for k in range(n_tr):
@@ -209,7 +211,7 @@ def _run_trial(
         n_tr = 0
         s = start
         best = 0.0
-        if guided:
+        if has_guide:
             _guide.reset_progress(g, gm, s)
         # choose the first action (m_pos: position in the running macro, m_end: its end)
         a, in_macro, m_pos, m_end, macro_used = _choose(
@@ -226,7 +228,7 @@ def _run_trial(
                 s2 = wind_state[s2]
             blocked = s2 == s  # what the robot observes: it did not move (after wind)
             steps += 1
-            if guided:  # robot 2 records what its move did to the label it perceives
+            if has_guide:  # robot 2 records what its move did to the label it perceives
                 _guide.observe(g, gm, s, a, s2)
                 _guide.update_progress(g, gm, s2)
             terminal = label[s2] == goal
