@@ -73,9 +73,9 @@ def score(method: str, params: dict, pairs, trials: int) -> float:
     return float(np.exp(np.mean(np.log(ratios))))
 
 
-GUIDED = [{"window": w, "reach": r, "knn": k}
-          for w, r, k in itertools.product((1.0, 2.0, 4.0), (0.0, 1.0, 1.5), (1, 3, 8))]
-"""Candidates for method ``guided`` (transfer.guide: WINDOW, REACH, KNN)."""
+GUIDED = [{"weight": wt, "window": w, "reach": r, "knn": k, "blocked": b}
+          for wt, w, r, k, b in itertools.product((1.0, 2.0, 3.0), (1.0, 2.0, 4.0), (1.0, 1.5), (3, 8), (False, True))]
+"""Candidates for method ``guided`` (transfer.guide: WEIGHT, WINDOW, REACH, KNN, BLOCKED)."""
 GUIDED_PAIRS = [("coarse", "fine"), ("fine", "coarse"),
                 ("planar2:joint", "ur5e_like:cartesian"), ("ur5e_like:cartesian", "planar2:joint")]
 
@@ -146,7 +146,7 @@ def select_guided(pairs: int, trials: int, seed: int) -> None:
         print(f"guided       {c}: " + ", ".join(f"{k if k == 'all' else '->'.join(k)} {v:.2f}x"
                                             for k, v in per.items()), flush=True)
     best = min(results, key=lambda x: x[0])
-    print(f"-> guided: best {best[1]} ({best[0]:.2f} x optimal, geometric mean over the pairs)", flush=True)
+    print(f"-> guided: best {best[1]} ({best[0]:.2f} x optimal, mean over the worst pair's trials)", flush=True)
 
 
 def main() -> None:

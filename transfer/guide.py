@@ -53,6 +53,9 @@ MEMORY = 256
 WEIGHT = 2.0
 """Preference per cell of predicted progress, in units of Q (one step costs -1; after one try
 a pair's Q is about -alpha)."""
+BLOCKED = True
+"""Whether a blocked move (the robot did not move) is generalised to neighbouring states like any
+other observed effect (True), or kept to its own state (False)."""
 EPISODES = 1
 """The model chooses in this many first episodes (1: until the goal is first reached, the
 exploration phase); afterwards Algorithm 1's epsilon-greedy chooses alone.
@@ -72,7 +75,7 @@ class Guide:
     ty: np.ndarray  # float64 [T]
     trem: np.ndarray  # float64 [T]: trajectory length (cells) from this cell to its end
     tstart: np.ndarray  # int64 [n_traj + 1]: where each trajectory starts in tx/ty/trem
-    params: np.ndarray  # float64 [6]: window, reach, knn, memory, weight, episodes
+    params: np.ndarray  # float64 [7]: window, reach, knn, memory, weight, episodes, blocked (0/1)
 
     @property
     def memory(self) -> int:
@@ -80,7 +83,8 @@ class Guide:
 
 
 def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW, reach: float = REACH,
-          knn: int = KNN, memory: int = MEMORY, weight: float = WEIGHT, episodes: int = EPISODES) -> Guide:
+          knn: int = KNN, memory: int = MEMORY, weight: float = WEIGHT, episodes: int = EPISODES,
+          blocked: bool = BLOCKED) -> Guide:
     """The guide for ``robot`` following ``trajs`` (one or several)."""
     for name, v in (("window", window), ("reach", reach), ("weight", weight)):
         if not (np.isfinite(v) and v >= 0):
@@ -108,14 +112,14 @@ def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW,
         tx=np.concatenate(xs), ty=np.concatenate(ys), trem=np.concatenate(rem),
         tstart=np.array(starts, np.int64),
         params=np.array([float(window), float(reach), float(int(knn)), float(int(memory)), float(weight),
-                         float(int(episodes))]),
+                         float(int(episodes)), 1.0 if blocked else 0.0]),
     )
 
 
 def inactive(n_actions: int) -> tuple:
     """(guide tuple, model tuple) for a trial without a guide: empty arrays of the right types."""
     g = (np.zeros((0, 1)), np.zeros((0, 2)), np.zeros(0), np.zeros(0), np.zeros(0),
-         np.zeros(1, np.int64), np.array([0.0, 0.0, 1.0, 1.0, 0.0, 0.0]))
+         np.zeros(1, np.int64), np.array([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0]))
     return g, model_arrays(0, n_actions, 1, 1)
 
 
@@ -170,7 +174,7 @@ def observe(g, gm, s, a, s2):
     dsum[s, a, 0] += lxy[s2, 0] - lxy[s, 0]
     dsum[s, a, 1] += lxy[s2, 1] - lxy[s, 1]
     dcnt[s, a] += 1
-    if s2 != s and not inbuf[s, a]:  # a blocked move says nothing of the action elsewhere
+    if (s2 != s or params[6] > 0.0) and not inbuf[s, a]:  # generalise a blocked move only if asked
         inbuf[s, a] = True
         memory = int(params[3])
         buf[a, bufn[a] % memory] = s

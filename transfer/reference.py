@@ -65,7 +65,7 @@ class GuideModel:
         entry = self.sums.get((s, a))
         if entry is None:
             entry = self.sums[(s, a)] = [0.0, 0.0, 0]
-        if s2 != s and (s, a) not in self.generalised:  # only moves that were not blocked
+        if (s2 != s or g.params[6] > 0) and (s, a) not in self.generalised:  # blocked: only if asked
             self.generalised.add((s, a))
             self.tried_at[a].append(s)
         entry[0] += g.lxy[s2][0] - g.lxy[s][0]

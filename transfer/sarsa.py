@@ -182,8 +182,14 @@ def _run_trial(
     macro_steps_out,
     path_buf,
     prev_path,
+    fp_states,
+    fp_actions,
 ):
     n_states, n_actions = next_state.shape
+    # the first episode's path with its loops erased (for the online action sequence mapping):
+    # fp_states[0..fp_n-1], fp_actions[i] taken at fp_states[i]; fp_pos: a state's place in it
+    fp_pos = np.full(n_states, -1, np.int64)
+    fp_n = 0
     n_traj = traj_index.max() + 1 if traj_index.shape[0] > 0 else 1
     paid_stamp = np.full(max(n_traj, 1), -1, np.int64)
     stamp = np.full(n_states, -1, np.int64)
@@ -217,6 +223,10 @@ def _run_trial(
         a, in_macro, m_pos, m_end, macro_used = _choose(
             Q, s, eps, rng, False, 0, 0, use_macros, macro_start, macro_len, macro_actions, guided, g, gm
         )
+        if ep == 0:
+            fp_states[0] = s
+            fp_pos[s] = 0
+            fp_n = 1
         steps = 0
         reached = False
         limit = max_total_steps - total
@@ -228,6 +238,17 @@ def _run_trial(
                 s2 = wind_state[s2]
             blocked = s2 == s  # what the robot observes: it did not move (after wind)
             steps += 1
+            if ep == 0:  # loop erasure: back to s2's place if it is on the path, else append it
+                fp_actions[fp_n - 1] = a
+                p2 = fp_pos[s2]
+                if p2 >= 0:
+                    for i in range(p2 + 1, fp_n):
+                        fp_pos[fp_states[i]] = -1
+                    fp_n = p2 + 1
+                else:
+                    fp_states[fp_n] = s2
+                    fp_pos[s2] = fp_n
+                    fp_n += 1
             if has_guide:  # robot 2 records what its move did to the label it perceives
                 _guide.observe(g, gm, s, a, s2)
                 _guide.update_progress(g, gm, s2)
@@ -313,7 +334,9 @@ def _run_trial(
             break
     if stable < patience:
         converged_episode = -1
-    return episodes, converged_episode, prev_n
+    if not (episodes > 0 and episode_steps[0] > 0):
+        fp_n = 0  # the first episode did not reach the goal: no path
+    return episodes, converged_episode, prev_n, fp_n
 
 
 @dataclass
@@ -336,6 +359,10 @@ class TrialResult:
     """Primitive steps taken inside mapped macros, per episode."""
     greedy_path: list[tuple[int, int]] = field(default_factory=list)
     """The converged greedy path as (state, action) pairs ending with (goal state, -1)."""
+    first_path: list[tuple[int, int]] = field(default_factory=list)
+    """The first episode's path (until the goal was first reached) with its loops erased, as
+    (state, action) pairs ending with (goal state, -1); empty when the goal was not reached.
+    What the online action sequence mapping learns from (``mapping.ActionMapping.learn_from``)."""
     Q: np.ndarray | None = None
 
 
@@ -381,14 +408,16 @@ def learn(
     macro_steps = np.zeros(E, np.int64)
     path_buf = np.zeros(n + 1, np.int64)
     prev_path = np.zeros(n + 1, np.int64)
-    episodes, conv_ep, path_n = _run_trial(
+    fp_states = np.zeros(n + 1, np.int64)
+    fp_actions = np.zeros(n + 1, np.int64)
+    episodes, conv_ep, path_n, fp_n = _run_trial(
         robot.next_state, robot.wind_state, robot.label, int(start_state), int(goal_cell),
         sh.mode, sh.bonus, sh.traj_index, sh.phi,
         m_start, m_len, m_actions, config.max_episodes if m_episodes is None else int(m_episodes),
         config.alpha, config.gamma, config.lam, config.epsilon,
         config.step_reward, config.goal_reward, float(wind), config.trace_cutoff,
         config.max_episodes, config.max_total_steps, config.max_episode_steps, config.patience,
-        rng, g, gm, Q, episode_steps, greedy_len, macro_steps, path_buf, prev_path,
+        rng, g, gm, Q, episode_steps, greedy_len, macro_steps, path_buf, prev_path, fp_states, fp_actions,
     )
     episode_steps = episode_steps[:episodes].copy()
     first = int(episode_steps[0]) if episodes and episode_steps[0] > 0 else None
@@ -402,6 +431,9 @@ def learn(
             assert robot.next_state[s, a] == t
             path.append((s, a))
         path.append((int(states[-1]), -1))
+    first_path = [(int(fp_states[i]), int(fp_actions[i])) for i in range(fp_n - 1)]
+    if fp_n:
+        first_path.append((int(fp_states[fp_n - 1]), -1))
     return TrialResult(
         exploration_steps=first,
         converged=converged,
@@ -412,6 +444,7 @@ def learn(
         greedy_lengths=greedy_len[:episodes].copy(),
         macro_steps=macro_steps[:episodes].copy(),
         greedy_path=path,
+        first_path=first_path,
         Q=Q if keep_q else None,
     )
 
