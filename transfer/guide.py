@@ -132,7 +132,8 @@ def model_arrays(n_states: int, n_actions: int, memory: int, n_traj: int) -> tup
     remembered states [A, memory], pushes per action [A], progress index per trajectory)."""
     return (np.zeros((n_states, n_actions, 2)), np.zeros((n_states, n_actions), np.int64),
             np.zeros((n_actions, memory), np.int64), np.zeros(n_actions, np.int64),
-            np.zeros(max(n_traj, 1), np.int64), np.zeros((n_states, n_actions), np.bool_))
+            np.zeros(max(n_traj, 1), np.int64), np.zeros((n_states, n_actions), np.bool_),
+            np.zeros((n_states, n_actions), np.bool_))
 
 
 @numba.njit(cache=True)
@@ -170,7 +171,9 @@ def update_progress(g, gm, s):
 def observe(g, gm, s, a, s2):
     """Record the move s --a--> s2 (s2: the state whose label robot 2 perceives after it)."""
     lxy, params = g[1], g[6]
-    dsum, dcnt, buf, bufn, inbuf = gm[0], gm[1], gm[2], gm[3], gm[5]
+    dsum, dcnt, buf, bufn, inbuf, moved = gm[0], gm[1], gm[2], gm[3], gm[5], gm[6]
+    if s2 != s:
+        moved[s, a] = True
     dsum[s, a, 0] += lxy[s2, 0] - lxy[s, 0]
     dsum[s, a, 1] += lxy[s2, 1] - lxy[s, 1]
     dcnt[s, a] += 1
@@ -243,7 +246,8 @@ def egreedy(Q, s, eps, rng, g, gm):
 
     Draws: u; if u < eps one more draw picks floor(u2 * n_actions) (Algorithm 1's random
     step). Otherwise the action of largest Q(s, a) - weight * score(predicted label of a)
-    is taken; an action never tried anywhere counts as the best (it is tried once early).
+    is taken; an action never tried anywhere counts as the best (it is tried once early), and
+    one tried at s that was blocked every time (the robot did not move) as the worst.
     When m > 1 actions tie for the largest value, one more draw picks the floor(u2 * m)-th
     of them in index order."""
     n_actions = Q.shape[1]
@@ -255,9 +259,15 @@ def egreedy(Q, s, eps, rng, g, gm):
     y = lxy[s, 1]
     val = np.empty(n_actions)
     best = -np.inf
+    dcnt, moved = gm[1], gm[6]
     for a in range(n_actions):
         known, dx, dy = predict(g, gm, s, a)
-        v = Q[s, a] - w * score(g, gm, x + dx, y + dy) if known else np.inf
+        if dcnt[s, a] > 0 and not moved[s, a]:
+            v = -np.inf  # tried here and blocked every time: a wasted step, never the model's choice
+        elif known:
+            v = Q[s, a] - w * score(g, gm, x + dx, y + dy)
+        else:
+            v = np.inf
         val[a] = v
         if v > best:
             best = v

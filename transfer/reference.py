@@ -36,7 +36,8 @@ class GuideModel:
         self.episodes = int(guide.params[5])
         self.sums: dict[tuple[int, int], list[float]] = {}  # (s, a) -> [sum dx, sum dy, count]
         self.tried_at: list[list[int]] = [[] for _ in range(n_actions)]  # states, in order
-        self.generalised: set[tuple[int, int]] = set()  # pairs seen to move at least once
+        self.generalised: set[tuple[int, int]] = set()  # pairs whose effect is generalised
+        self.moved: set[tuple[int, int]] = set()  # pairs seen to move at least once
         self.n_traj = len(guide.tstart) - 1
         self.prog = [0] * self.n_traj
 
@@ -65,6 +66,8 @@ class GuideModel:
         entry = self.sums.get((s, a))
         if entry is None:
             entry = self.sums[(s, a)] = [0.0, 0.0, 0]
+        if s2 != s:
+            self.moved.add((s, a))
         if (s2 != s or g.params[6] > 0) and (s, a) not in self.generalised:  # blocked: only if asked
             self.generalised.add((s, a))
             self.tried_at[a].append(s)
@@ -124,7 +127,10 @@ class GuideModel:
         val = []
         for a in range(n_actions):
             p = self.predict(s, a)
-            val.append(np.inf if p is None else q_row[a] - w * self.score(x + p[0], y + p[1]))
+            if (s, a) in self.sums and (s, a) not in self.moved:
+                val.append(-np.inf)  # blocked at every try here
+            else:
+                val.append(np.inf if p is None else q_row[a] - w * self.score(x + p[0], y + p[1]))
         best = max(val)
         keep = [a for a in range(n_actions) if val[a] == best]
         if len(keep) == 1:
