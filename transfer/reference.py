@@ -46,6 +46,7 @@ class GuideModel:
 
     def start_episode(self, s: int) -> None:
         self.prog = [int(self.g.tstart[t]) for t in range(self.n_traj)]
+        self.wait = [0] * self.n_traj
         self.reached(s)
 
     def reached(self, s: int) -> None:
@@ -60,6 +61,14 @@ class GuideModel:
                     break
                 if np.sqrt((g.tx[j] - x) * (g.tx[j] - x) + (g.ty[j] - y) * (g.ty[j] - y)) <= self.reach:
                     self.prog[t] = j
+            if self.prog[t] != i0:
+                self.wait[t] = 0
+            else:
+                self.wait[t] += 1
+                last = int(g.tstart[t + 1]) - 1
+                if g.params[7] > 0 and self.wait[t] >= g.params[7] and self.prog[t] < last:
+                    self.prog[t] += 1
+                    self.wait[t] = 0
 
     def observe(self, s: int, a: int, s2: int) -> None:
         g = self.g
