@@ -10,7 +10,12 @@ pairs of exploration steps / optimal distance (first episode only, 20 trials per
     python scripts/select_defaults.py --method guided --pairs 6 --trials 10
 
 For ``guided`` the held-out pairs are drawn for each of coarse -> fine, fine -> coarse and
-planar2:joint <-> ur5e_like:cartesian, with the source's shortest path as the trajectory.
+planar2:joint <-> ur5e_like:cartesian, with the source's shortest path as the trajectory. A
+candidate's score is the mean first exposure / optimal distance of its worst robot pair (the
+issue's target is on the mean, which a rare long trial dominates). The grid GUIDED is
+searched first; then GIVE_UP with the best of it, taking the smallest value within 2% of
+never giving up. Chosen this way (8 pairs, 20 trials, seed 2026): weight 2, window 2,
+reach 1, knn 8, blocked moves generalised, give up after 100 moves (``transfer.guide``).
 """
 
 from __future__ import annotations
@@ -76,6 +81,8 @@ def score(method: str, params: dict, pairs, trials: int) -> float:
 GUIDED = [{"weight": wt, "window": w, "reach": r, "knn": k, "blocked": b}
           for wt, w, r, k, b in itertools.product((1.0, 2.0, 3.0), (1.0, 2.0, 4.0), (1.0, 1.5), (3, 8), (False, True))]
 """Candidates for method ``guided`` (transfer.guide: WEIGHT, WINDOW, REACH, KNN, BLOCKED)."""
+GIVE_UP = (25, 50, 100, 200)
+"""Then transfer.guide.GIVE_UP, smallest first."""
 GUIDED_PAIRS = [("coarse", "fine"), ("fine", "coarse"),
                 ("planar2:joint", "ur5e_like:cartesian"), ("ur5e_like:cartesian", "planar2:joint")]
 
@@ -124,7 +131,7 @@ def score_guided(params: dict, held: dict, trials: int, cap: int = 50_000) -> di
     for key, (dst, tasks) in held.items():
         ratios = []
         for s, g, traj, optimal in tasks:
-            gd = guide.build(dst, [traj], **params)
+            gd = guide.build(dst, [traj], **{"give_up": 0, **params})  # give_up is chosen afterwards
             n = dst.n_states
             shaping = Shaping(MODE_NONE, np.zeros(n), np.full(n, -1, np.int64), np.zeros(n), 0.0, guide=gd)
             for t in range(trials):
@@ -147,6 +154,13 @@ def select_guided(pairs: int, trials: int, seed: int) -> None:
                                             for k, v in per.items()), flush=True)
     best = min(results, key=lambda x: x[0])
     print(f"-> guided: best {best[1]} ({best[0]:.2f} x optimal, mean over the worst pair's trials)", flush=True)
+    never = score_guided({**best[1], "give_up": 0}, held, trials)["all"]
+    for g in GIVE_UP:
+        sc = score_guided({**best[1], "give_up": g}, held, trials)["all"]
+        print(f"guided       give_up {g}: {sc:.2f}x (never: {never:.2f}x)", flush=True)
+        if sc <= 1.02 * never:
+            print(f"-> guided: give_up {g}, the smallest within 2% of never giving up", flush=True)
+            break
 
 
 def main() -> None:

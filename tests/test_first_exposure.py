@@ -227,3 +227,39 @@ def test_the_online_mapping_is_learned_at_first_exposure_and_used_on_the_next_ta
     traj2 = trajectories.shortest(coarse, s2, g2)
     used, _ = experiment.run_mapping(fine, s2, g2, traj2, again, 3, 0, config)
     assert used.extra["macro_states"] > 0 and sum(used.extra["macro_steps_first_episode"]) > 0
+
+
+SCRIPT = __import__("pathlib").Path(__file__).resolve().parents[1] / "scripts" / "first_exposure.py"
+
+
+def test_the_benchmark_script_fast_mode_writes_its_table(tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    out = tmp_path / "fe"
+    proc = subprocess.run([sys.executable, str(SCRIPT), "--fast", "--out", str(out)], capture_output=True,
+                          text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    data = json.loads((out / "first_exposure.json").read_text())
+    assert data["fast"] and len(data["rows"]) == 4
+    for row in data["rows"]:
+        for label in ("none", "pseudo", "dense", "oracle", "guided", "guided [shuffled]", "guided [random]"):
+            entry = row["summary"][label]
+            assert len(entry["exploration_steps"]) == data["trials"]  # every trial counted, none dropped
+        assert row["verdict"]["first_exposure_ratio"] == row["summary"]["guided"]["mean"] / row["optimal"]
+    assert "mapping [online]" in data["rows"][1]["summary"]  # task 2 reuses task 1's online mapping
+    text = (out / "first_exposure.md").read_text()
+    assert "guided [shuffled]" in text and "mapping (online)" in text
+
+
+def test_the_benchmark_script_refuses_bad_input_in_one_line(tmp_path):
+    import subprocess
+    import sys
+
+    (tmp_path / "full").mkdir()
+    (tmp_path / "full" / "x").write_text("")
+    for args in (["--trials", "0", "--out", str(tmp_path / "a")], ["--out", str(tmp_path / "full")]):
+        proc = subprocess.run([sys.executable, str(SCRIPT), *args], capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 2
+        assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr

@@ -13,6 +13,9 @@ Faithful to Algorithm 1:
   * The shaping term r' is the paper's pseudo reward i*K on reaching the i-th trajectory
     state (``pseudo``), or one of the other methods in :mod:`transfer.rewards`.
 
+The first episode's path, its loops erased, is kept as ``TrialResult.first_path`` for the
+online action sequence mapping (``experiment.online_mapping``); it draws nothing.
+
 Sparse traces: only pairs with a non-zero trace are stored. A trace that decays below
 ``trace_cutoff`` is dropped; with ``trace_cutoff=0`` nothing is dropped until it underflows
 to 0, and the result is bit-for-bit the dense Algorithm 1 (``transfer.reference``), as a
@@ -30,9 +33,10 @@ The random stream, in the order it is drawn (the dense reference draws the same)
   2. epsilon-greedy: one draw u; if u < epsilon one more draw picks the action as
      floor(u2 * n_actions); otherwise, when k > 1 actions tie for the largest Q, one more
      draw picks the floor(u2 * k)-th of them in index order;
-     With a guide (method ``guided``, ``transfer.guide``) the tie is first narrowed by the
-     model to the actions of the lowest score, m of them; the extra draw is made only when
-     m > 1 and picks the floor(u2 * m)-th of them in index order (no other draw is added);
+     With a guide (method ``guided``, ``transfer.guide``), in its exploration phase, the
+     largest value is that of Q(s, a) - weight * score(a) instead of Q, and the extra draw
+     is made only when m > 1 actions tie for it, picking the floor(u2 * m)-th of them in
+     index order (no other draw is added);
   3. wind, only when its probability p > 0: one draw after every move, pushing when < p.
 """
 
