@@ -31,8 +31,9 @@ the learner's own exploration takes over there. After the exploration phase Algo
 chooses alone: the updates were SARSA(lambda)'s throughout, so the greedy path converges as
 SARSA(lambda)'s does, unbiased by the model. The model never reads the robot's transition
 table nor the map; the kernel reads ``next_state`` only to take the move chosen (a test
-changes every untried pair's transition and gets the same run, bit for bit).
-"""
+changes every transition not tried in the first exposure and gets the same first exposure,
+bit for bit; the convergence check after each episode, the experimenter's, follows the
+greedy path through the table as for every method)."""
 
 from __future__ import annotations
 
