@@ -10,7 +10,12 @@ pairs of exploration steps / optimal distance (first episode only, 20 trials per
     python scripts/select_defaults.py --method guided --pairs 6 --trials 10
 
 For ``guided`` the held-out pairs are drawn for each of coarse -> fine, fine -> coarse and
-planar2:joint <-> ur5e_like:cartesian, with the source's shortest path as the trajectory.
+planar2:joint <-> ur5e_like:cartesian, with the source's shortest path as the trajectory. A
+candidate's score is the mean first exposure / optimal distance of its worst robot pair (the
+issue's target is on the mean, which a rare long trial dominates). The grid GUIDED is
+searched first; then GIVE_UP with the best of it, taking the smallest value within 2% of
+never giving up. Chosen this way (8 pairs, 20 trials, seed 2026): weight 2, window 2,
+reach 1, knn 8, blocked moves generalised, give up after 100 moves (``transfer.guide``).
 """
 
 from __future__ import annotations
@@ -73,9 +78,11 @@ def score(method: str, params: dict, pairs, trials: int) -> float:
     return float(np.exp(np.mean(np.log(ratios))))
 
 
-GUIDED = [{"window": w, "reach": r, "knn": k}
-          for w, r, k in itertools.product((1.0, 2.0, 4.0), (0.0, 1.0, 1.5), (1, 3, 8))]
-"""Candidates for method ``guided`` (transfer.guide: WINDOW, REACH, KNN)."""
+GUIDED = [{"weight": wt, "window": w, "reach": r, "knn": k, "blocked": b}
+          for wt, w, r, k, b in itertools.product((1.0, 2.0, 3.0), (1.0, 2.0, 4.0), (1.0, 1.5), (3, 8), (False, True))]
+"""Candidates for method ``guided`` (transfer.guide: WEIGHT, WINDOW, REACH, KNN, BLOCKED)."""
+GIVE_UP = (25, 50, 100, 200)
+"""Then transfer.guide.GIVE_UP, smallest first."""
 GUIDED_PAIRS = [("coarse", "fine"), ("fine", "coarse"),
                 ("planar2:joint", "ur5e_like:cartesian"), ("ur5e_like:cartesian", "planar2:joint")]
 
@@ -113,8 +120,9 @@ def guided_held_out(n: int, seed: int) -> dict:
 
 
 def score_guided(params: dict, held: dict, trials: int, cap: int = 50_000) -> dict:
-    """Geometric mean over the held-out tasks of first-exposure steps / optimal distance, per
-    robot pair and overall (an unreached trial counts at the cap)."""
+    """Mean over the held-out tasks and trials of first-exposure steps / optimal distance, per
+    robot pair, and the worst pair's (an unreached trial counts at the cap). The mean, not a
+    geometric mean: the issue's target is on the mean, which a rare long trial dominates."""
     from armtransfer.learning import guide
     from armtransfer.learning.shaping import MODE_NONE
 
@@ -123,14 +131,14 @@ def score_guided(params: dict, held: dict, trials: int, cap: int = 50_000) -> di
     for key, (dst, tasks) in held.items():
         ratios = []
         for s, g, traj, optimal in tasks:
-            gd = guide.build(dst, [traj], **params)
+            gd = guide.build(dst, [traj], **{"give_up": 0, **params})  # give_up is chosen afterwards
             n = dst.n_states
             shaping = Shaping(MODE_NONE, np.zeros(n), np.full(n, -1, np.int64), np.zeros(n), 0.0, guide=gd)
             for t in range(trials):
                 res = sarsa.learn(dst, dst.start_state(s), g, config, trial_rng(12345, t), shaping=shaping)
                 ratios.append((res.exploration_steps or cap) / optimal)
-        per[key] = float(np.exp(np.mean(np.log(ratios))))
-    per["all"] = float(np.exp(np.mean(np.log(list(per.values())))))
+        per[key] = float(np.mean(ratios))
+    per["all"] = max(per.values())
     return per
 
 
@@ -145,7 +153,14 @@ def select_guided(pairs: int, trials: int, seed: int) -> None:
         print(f"guided       {c}: " + ", ".join(f"{k if k == 'all' else '->'.join(k)} {v:.2f}x"
                                             for k, v in per.items()), flush=True)
     best = min(results, key=lambda x: x[0])
-    print(f"-> guided: best {best[1]} ({best[0]:.2f} x optimal, geometric mean over the pairs)", flush=True)
+    print(f"-> guided: best {best[1]} ({best[0]:.2f} x optimal, mean over the worst pair's trials)", flush=True)
+    never = score_guided({**best[1], "give_up": 0}, held, trials)["all"]
+    for g in GIVE_UP:
+        sc = score_guided({**best[1], "give_up": g}, held, trials)["all"]
+        print(f"guided       give_up {g}: {sc:.2f}x (never: {never:.2f}x)", flush=True)
+        if sc <= 1.02 * never:
+            print(f"-> guided: give_up {g}, the smallest within 2% of never giving up", flush=True)
+            break
 
 
 def main() -> None:

@@ -157,6 +157,30 @@ def run_mapping(
     return res, learned
 
 
+def online_mapping(
+    source: DiscreteRobot,
+    target: DiscreteRobot,
+    start_cell: int,
+    goal_cell: int,
+    result: MethodResult,
+    traj: Trajectory,
+    mapping: ActionMapping | None = None,
+    max_span: int = DEFAULT_MAX_SPAN,
+) -> ActionMapping:
+    """The action sequence mapping learned *during* a task: ``mapping`` (default: empty) plus
+    what each trial's first exposure teaches, in trial order. A trial's first-episode path,
+    its loops erased (``sarsa.TrialResult.first_path``), is set beside ``traj`` as a converged
+    greedy path would be (``mapping.observe``: matched cells, the shorter target sequence wins),
+    so the mapping exists as soon as the goal is first reached, before any trial converges,
+    and the method ``mapping`` can use it on the next task at once."""
+    learned = ActionMapping.for_robots(source, target) if mapping is None else mapping.copy()
+    learned.learned_on(start_cell, goal_cell)
+    for t in result.trials:
+        if t.first_path:
+            learned.learn_from(target, t.first_path, traj, max_span)
+    return learned
+
+
 def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int | None = None) -> dict:
     """The JSON ``results`` block: per method, per-trial lists, means, CIs, improvement.
 

@@ -102,7 +102,7 @@ def _dense(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float)
 
 
 def _guided(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
-    # no reward term: Algorithm 1's updates unchanged; the model only breaks its ties
+    # no reward term: Algorithm 1's updates unchanged; the model chooses in the exploration phase
     _, ids = union_index(robot, trajs)
     n = robot.n_states
     return Shaping(modes.MODE_NONE, np.zeros(n), ids, np.zeros(n), k, guide=guide.build(robot, trajs))
@@ -124,8 +124,8 @@ METHODS: dict[str, Method] = {
                paper=False, build=_progress, auto_k=30.0),
         Method("dense", "potential from the progress along the trajectory and the distance to it",
                paper=False, build=_dense, auto_k=potentials.DENSE_K),
-        Method("guided", "a model of what robot 2's own actions do to its cell, learned while it "
-               "explores, breaks the ties of epsilon-greedy towards the trajectory's next cells",
+        Method("guided", "robot 2 learns while it explores what its own actions do to its cell and, until the "
+               "goal is first reached, prefers those predicted to lead on along the trajectory",
                paper=False, build=_guided, auto_k=0.0, chooses=True),
     )
 }

@@ -33,8 +33,11 @@ class GuideModel:
         self.g = guide
         self.window, self.reach = guide.params[0], guide.params[1]
         self.knn, self.memory = int(guide.params[2]), int(guide.params[3])
+        self.episodes = int(guide.params[5])
         self.sums: dict[tuple[int, int], list[float]] = {}  # (s, a) -> [sum dx, sum dy, count]
         self.tried_at: list[list[int]] = [[] for _ in range(n_actions)]  # states, in order
+        self.generalised: set[tuple[int, int]] = set()  # pairs whose effect is generalised
+        self.moved: set[tuple[int, int]] = set()  # pairs seen to move at least once
         self.n_traj = len(guide.tstart) - 1
         self.prog = [0] * self.n_traj
 
@@ -43,6 +46,7 @@ class GuideModel:
 
     def start_episode(self, s: int) -> None:
         self.prog = [int(self.g.tstart[t]) for t in range(self.n_traj)]
+        self.wait = [0] * self.n_traj
         self.reached(s)
 
     def reached(self, s: int) -> None:
@@ -57,12 +61,24 @@ class GuideModel:
                     break
                 if np.sqrt((g.tx[j] - x) * (g.tx[j] - x) + (g.ty[j] - y) * (g.ty[j] - y)) <= self.reach:
                     self.prog[t] = j
+            if self.prog[t] != i0:
+                self.wait[t] = 0
+            else:
+                self.wait[t] += 1
+                last = int(g.tstart[t + 1]) - 1
+                if g.params[7] > 0 and self.wait[t] >= g.params[7] and self.prog[t] < last:
+                    self.prog[t] += 1
+                    self.wait[t] = 0
 
     def observe(self, s: int, a: int, s2: int) -> None:
         g = self.g
         entry = self.sums.get((s, a))
         if entry is None:
             entry = self.sums[(s, a)] = [0.0, 0.0, 0]
+        if s2 != s:
+            self.moved.add((s, a))
+        if (s2 != s or g.params[6] > 0) and (s, a) not in self.generalised:  # blocked: only if asked
+            self.generalised.add((s, a))
             self.tried_at[a].append(s)
         entry[0] += g.lxy[s2][0] - g.lxy[s][0]
         entry[1] += g.lxy[s2][1] - g.lxy[s][1]
@@ -115,15 +131,17 @@ class GuideModel:
         n_actions = len(q_row)
         if rng.random() < eps:
             return int(rng.random() * n_actions)
-        best = q_row.max()
-        ties = [a for a in range(n_actions) if q_row[a] == best]
         x, y = self.g.lxy[s]
-        scores = {}
-        for a in ties:
+        w = self.g.params[4]
+        val = []
+        for a in range(n_actions):
             p = self.predict(s, a)
-            scores[a] = -np.inf if p is None else self.score(x + p[0], y + p[1])
-        low = min(scores.values())
-        keep = [a for a in ties if scores[a] == low]
+            if (s, a) in self.sums and (s, a) not in self.moved:
+                val.append(-np.inf)  # blocked at every try here
+            else:
+                val.append(np.inf if p is None else q_row[a] - w * self.score(x + p[0], y + p[1]))
+        best = max(val)
+        keep = [a for a in range(n_actions) if val[a] == best]
         if len(keep) == 1:
             return keep[0]
         return keep[int(rng.random() * len(keep))]
@@ -181,7 +199,7 @@ def learn(
         if may_start and s in seq_at and rng.random() < 1.0 - config.epsilon:
             seq = seq_at[s]
             return seq[0], seq[1:], True
-        if model is not None:
+        if model is not None and episode < model.episodes:
             return model.egreedy(Q[s], s, config.epsilon, rng), [], False
         return _egreedy(Q[s], config.epsilon, rng), [], False
 
@@ -189,7 +207,7 @@ def learn(
     decay = gamma * config.lam
     Q = np.zeros((robot.n_states, robot.n_actions))
     steps_per_episode = []
-    for _ in range(episodes):
+    for episode in range(episodes):
         e = np.zeros_like(Q)  # Initialize e(s, a) = 0 for all s, a
         s = start_state  # Initialize s, a
         if model is not None:

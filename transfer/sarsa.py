@@ -13,6 +13,9 @@ Faithful to Algorithm 1:
   * The shaping term r' is the paper's pseudo reward i*K on reaching the i-th trajectory
     state (``pseudo``), or one of the other methods in :mod:`transfer.rewards`.
 
+The first episode's path, its loops erased, is kept as ``TrialResult.first_path`` for the
+online action sequence mapping (``experiment.online_mapping``); it draws nothing.
+
 Sparse traces: only pairs with a non-zero trace are stored. A trace that decays below
 ``trace_cutoff`` is dropped; with ``trace_cutoff=0`` nothing is dropped until it underflows
 to 0, and the result is bit-for-bit the dense Algorithm 1 (``transfer.reference``), as a
@@ -30,9 +33,10 @@ The random stream, in the order it is drawn (the dense reference draws the same)
   2. epsilon-greedy: one draw u; if u < epsilon one more draw picks the action as
      floor(u2 * n_actions); otherwise, when k > 1 actions tie for the largest Q, one more
      draw picks the floor(u2 * k)-th of them in index order;
-     With a guide (method ``guided``, ``transfer.guide``) the tie is first narrowed by the
-     model to the actions of the lowest score, m of them; the extra draw is made only when
-     m > 1 and picks the floor(u2 * m)-th of them in index order (no other draw is added);
+     With a guide (method ``guided``, ``transfer.guide``), in its exploration phase, the
+     largest value is that of Q(s, a) - weight * score(a) instead of Q, and the extra draw
+     is made only when m > 1 actions tie for it, picking the floor(u2 * m)-th of them in
+     index order (no other draw is added);
   3. wind, only when its probability p > 0: one draw after every move, pushing when < p.
 """
 
@@ -182,8 +186,14 @@ def _run_trial(
     macro_steps_out,
     path_buf,
     prev_path,
+    fp_states,
+    fp_actions,
 ):
     n_states, n_actions = next_state.shape
+    # the first episode's path with its loops erased (for the online action sequence mapping):
+    # fp_states[0..fp_n-1], fp_actions[i] taken at fp_states[i]; fp_pos: a state's place in it
+    fp_pos = np.full(n_states, -1, np.int64)
+    fp_n = 0
     n_traj = traj_index.max() + 1 if traj_index.shape[0] > 0 else 1
     paid_stamp = np.full(max(n_traj, 1), -1, np.int64)
     stamp = np.full(n_states, -1, np.int64)
@@ -200,8 +210,10 @@ def _run_trial(
     converged_episode = -1
     episodes = 0
     has_macros = macro_actions.shape[0] > 0
-    guided = g[5].shape[0] > 1  # the guide has at least one trajectory (transfer.guide)
+    has_guide = g[5].shape[0] > 1  # the guide has at least one trajectory (transfer.guide)
+    guide_episodes = int(g[6][5])
     for ep in range(max_episodes):
+        guided = has_guide and ep < guide_episodes  # the model chooses in the exploration phase
         use_macros = has_macros and ep < macro_episodes
         # reset traces
         for k in range(n_tr):
@@ -209,12 +221,16 @@ def _run_trial(
         n_tr = 0
         s = start
         best = 0.0
-        if guided:
+        if has_guide:
             _guide.reset_progress(g, gm, s)
         # choose the first action (m_pos: position in the running macro, m_end: its end)
         a, in_macro, m_pos, m_end, macro_used = _choose(
             Q, s, eps, rng, False, 0, 0, use_macros, macro_start, macro_len, macro_actions, guided, g, gm
         )
+        if ep == 0:
+            fp_states[0] = s
+            fp_pos[s] = 0
+            fp_n = 1
         steps = 0
         reached = False
         limit = max_total_steps - total
@@ -226,7 +242,18 @@ def _run_trial(
                 s2 = wind_state[s2]
             blocked = s2 == s  # what the robot observes: it did not move (after wind)
             steps += 1
-            if guided:  # robot 2 records what its move did to the label it perceives
+            if ep == 0:  # loop erasure: back to s2's place if it is on the path, else append it
+                fp_actions[fp_n - 1] = a
+                p2 = fp_pos[s2]
+                if p2 >= 0:
+                    for i in range(p2 + 1, fp_n):
+                        fp_pos[fp_states[i]] = -1
+                    fp_n = p2 + 1
+                else:
+                    fp_states[fp_n] = s2
+                    fp_pos[s2] = fp_n
+                    fp_n += 1
+            if has_guide:  # robot 2 records what its move did to the label it perceives
                 _guide.observe(g, gm, s, a, s2)
                 _guide.update_progress(g, gm, s2)
             terminal = label[s2] == goal
@@ -311,7 +338,9 @@ def _run_trial(
             break
     if stable < patience:
         converged_episode = -1
-    return episodes, converged_episode, prev_n
+    if not (episodes > 0 and episode_steps[0] > 0):
+        fp_n = 0  # the first episode did not reach the goal: no path
+    return episodes, converged_episode, prev_n, fp_n
 
 
 @dataclass
@@ -334,6 +363,10 @@ class TrialResult:
     """Primitive steps taken inside mapped macros, per episode."""
     greedy_path: list[tuple[int, int]] = field(default_factory=list)
     """The converged greedy path as (state, action) pairs ending with (goal state, -1)."""
+    first_path: list[tuple[int, int]] = field(default_factory=list)
+    """The first episode's path (until the goal was first reached) with its loops erased, as
+    (state, action) pairs ending with (goal state, -1); empty when the goal was not reached.
+    What the online action sequence mapping learns from (``mapping.ActionMapping.learn_from``)."""
     Q: np.ndarray | None = None
 
 
@@ -379,14 +412,16 @@ def learn(
     macro_steps = np.zeros(E, np.int64)
     path_buf = np.zeros(n + 1, np.int64)
     prev_path = np.zeros(n + 1, np.int64)
-    episodes, conv_ep, path_n = _run_trial(
+    fp_states = np.zeros(n + 1, np.int64)
+    fp_actions = np.zeros(n + 1, np.int64)
+    episodes, conv_ep, path_n, fp_n = _run_trial(
         robot.next_state, robot.wind_state, robot.label, int(start_state), int(goal_cell),
         sh.mode, sh.bonus, sh.traj_index, sh.phi,
         m_start, m_len, m_actions, config.max_episodes if m_episodes is None else int(m_episodes),
         config.alpha, config.gamma, config.lam, config.epsilon,
         config.step_reward, config.goal_reward, float(wind), config.trace_cutoff,
         config.max_episodes, config.max_total_steps, config.max_episode_steps, config.patience,
-        rng, g, gm, Q, episode_steps, greedy_len, macro_steps, path_buf, prev_path,
+        rng, g, gm, Q, episode_steps, greedy_len, macro_steps, path_buf, prev_path, fp_states, fp_actions,
     )
     episode_steps = episode_steps[:episodes].copy()
     first = int(episode_steps[0]) if episodes and episode_steps[0] > 0 else None
@@ -400,6 +435,9 @@ def learn(
             assert robot.next_state[s, a] == t
             path.append((s, a))
         path.append((int(states[-1]), -1))
+    first_path = [(int(fp_states[i]), int(fp_actions[i])) for i in range(fp_n - 1)]
+    if fp_n:
+        first_path.append((int(fp_states[fp_n - 1]), -1))
     return TrialResult(
         exploration_steps=first,
         converged=converged,
@@ -410,6 +448,7 @@ def learn(
         greedy_lengths=greedy_len[:episodes].copy(),
         macro_steps=macro_steps[:episodes].copy(),
         greedy_path=path,
+        first_path=first_path,
         Q=Q if keep_q else None,
     )
 

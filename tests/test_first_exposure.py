@@ -1,0 +1,265 @@
+"""Issue 14: method ``guided`` (robot 2 learns what its own actions do to its label) and the
+online action sequence mapping learned from the first exposure."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import armtransfer
+from armtransfer.errors import InvalidParameterError
+from armtransfer.learning import experiment, guide, methods, reference, sarsa
+from armtransfer.learning import trajectory as trajectories
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.mapping import ActionMapping
+from armtransfer.tasks.catalog import TABLE_I
+from armtransfer.tasks.grid_robots import grid_robot
+from armtransfer.tasks.layout import Layout
+
+SMALL = Layout(lo=-4, hi=4, walls=(((0, -4), (0, 4)),), doors=((0, 2),))
+"""A 9 x 9 world with two rooms and one door: small enough for the dense reference."""
+
+FAST = LearnerConfig(max_episodes=40)
+
+
+def small_task():
+    fine, coarse = grid_robot("fine", SMALL), grid_robot("coarse", SMALL)
+    start, goal = SMALL.cell(-2, -2), SMALL.cell(2, -2)
+    return fine, coarse, start, goal
+
+
+def guided_shaping(robot, trajs, **params):
+    sh = methods.build_shaping("guided", robot, trajs, "auto", -1.0)
+    return replace(sh, guide=guide.build(robot, trajs, **params)) if params else sh
+
+
+def test_guided_is_registered_and_chooses_actions():
+    m = methods.get("guided")
+    assert m.chooses and m.shaped and not m.farmable
+    assert "guided" in armtransfer.METHODS
+    assert "guided" not in methods.REWARD_ONLY  # no reward wrapper can give it to another learner
+
+
+def test_bad_guide_parameters_are_one_line_errors():
+    fine, coarse, start, goal = small_task()
+    traj = trajectories.shortest(coarse, start, goal)
+    for bad in (dict(weight=-1.0), dict(window=float("nan")), dict(knn=0), dict(episodes=0)):
+        with pytest.raises(InvalidParameterError):
+            guide.build(fine, [traj], **bad)
+
+
+@pytest.mark.parametrize("wind", [0.0, 0.2])
+@pytest.mark.parametrize("several", [False, True])
+def test_kernel_is_bit_identical_to_the_dense_reference_with_the_guide(wind, several):
+    fine, coarse, start, goal = small_task()
+    trajs = [trajectories.shortest(coarse, start, goal)]
+    if several:  # a second, longer trajectory through the top of the rooms
+        mid = SMALL.cell(-2, 2)
+        a, b = trajectories.shortest(coarse, start, mid), trajectories.shortest(coarse, mid, goal)
+        trajs.append(trajectories.Trajectory(cells=[*a.cells, *b.cells], actions=[*a.actions, *b.actions],
+                                             goal=goal, source=coarse.name))
+    # the model chooses in the first 3 episodes, then Algorithm 1 alone
+    sh = guided_shaping(fine, trajs, episodes=3)
+    config = LearnerConfig(trace_cutoff=0.0, max_episodes=8, patience=1000)
+    s0 = fine.start_state(start)
+    fast = sarsa.learn(fine, s0, goal, config, np.random.default_rng(7), shaping=sh, wind=wind, keep_q=True)
+    Q, steps = reference.learn(fine, s0, goal, config, np.random.default_rng(7), episodes=8, guide=sh.guide,
+                               wind=wind)
+    assert fast.episode_steps.tolist() == steps
+    assert np.array_equal(fast.Q, Q)
+
+
+def test_same_seed_gives_bit_identical_results():
+    a = armtransfer.transfer("coarse", "fine", task=1, methods=["guided"], trials=3, seed=4, controls=False,
+                             trajectory="optimal", max_episodes=30)
+    b = armtransfer.transfer("coarse", "fine", task=1, methods=["guided"], trials=3, seed=4, controls=False,
+                             trajectory="optimal", max_episodes=30)
+    assert a.to_json() == b.to_json()
+    c = armtransfer.transfer("coarse", "fine", task=1, methods=["guided"], trials=3, seed=5, controls=False,
+                             trajectory="optimal", max_episodes=30)
+    assert c.methods["guided"].column("episode_steps")[0].tolist() != \
+        a.methods["guided"].column("episode_steps")[0].tolist() or \
+        c.methods["guided"].column("exploration_steps") != a.methods["guided"].column("exploration_steps")
+
+
+@pytest.mark.parametrize("target_name", ["fine", "planar2:joint"])
+def test_no_transition_of_an_untried_pair_is_used(target_name):
+    """Change every transition robot 2 did not try in a run; the same seed must then give
+    the same run, bit for bit: the learner and its model never read those pairs."""
+    from armtransfer.tasks.specs import resolve
+
+    source, target = grid_robot("coarse"), resolve(target_name)
+    start, goal = TABLE_I[1].cells()
+    traj = trajectories.shortest(source, start, goal)
+    sh = guided_shaping(target, [traj])
+    config = LearnerConfig(max_episodes=1)
+    s0 = target.start_state(start)
+    a = sarsa.learn(target, s0, goal, config, np.random.default_rng(1), shaping=sh, keep_q=True)
+    untried = a.Q == 0.0  # a pair tried gets a trace and an update; an untried one stays at exactly 0
+    assert untried.sum() > 0.9 * untried.size  # the first exposure tried few of the pairs
+    rng = np.random.default_rng(99)
+    ns = target.next_state.copy()
+    ns[untried] = rng.integers(0, target.n_states, int(untried.sum()))
+    assert (ns != target.next_state).sum() > 0.5 * untried.sum()
+    changed = replace(target, next_state=ns)
+    b = sarsa.learn(changed, s0, goal, config, np.random.default_rng(1), shaping=guided_shaping(changed, [traj]),
+                    keep_q=True)
+    assert a.episode_steps.tolist() == b.episode_steps.tolist()
+    assert np.array_equal(a.Q, b.Q)
+    assert a.first_path == b.first_path
+
+
+def test_the_guide_reads_only_configurations_labels_and_the_trajectory():
+    """What the model is built from: robot 2's own configuration (for an arm, arm.qpos),
+    the xy of its labels, the trajectory's cells; nothing of the transition table."""
+    from armtransfer.tasks.specs import resolve
+
+    arm = resolve("planar2:joint")
+    coarse = grid_robot("coarse")
+    start, goal = TABLE_I[1].cells()
+    g = guide.build(arm, [trajectories.shortest(coarse, start, goal)])
+    assert np.array_equal(g.feat, np.asarray(arm.arm.qpos, dtype=np.float64).reshape(arm.n_states, -1))
+    assert np.array_equal(g.lxy, arm.layout.xy_of(arm.label).astype(np.float64).reshape(-1, 2))
+    scrambled = replace(arm, next_state=np.zeros_like(arm.next_state))
+    g2 = guide.build(scrambled, [trajectories.shortest(coarse, start, goal)])
+    for x, y in zip(guide.as_tuple(g), guide.as_tuple(g2)):
+        assert np.array_equal(x, y)
+
+
+@pytest.mark.parametrize("source,target,options", [
+    ("coarse", "fine", {}),
+    ("fine", "coarse", {}),
+    ("planar2:joint", "ur5e_like:cartesian", {}),
+    ("coarse", "fine", {"wind": 0.05}),
+    ("coarse", "fine", {"trajectory": ["optimal", "learned"]}),
+])
+def test_it_runs_on_every_kind_of_robot_pair(source, target, options):
+    r = armtransfer.transfer(source, target, task=3, methods=["none", "guided"], trials=2, controls=False,
+                             **options)
+    for name in ("none", "guided"):
+        assert all(x is not None for x in r.methods[name].column("exploration_steps"))
+    # the first exposure with the guide is far shorter than without it on every trial
+    assert max(r.methods["guided"].column("exploration_steps")) < min(r.methods["none"].column("exploration_steps"))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("task", [2, 4])
+def test_it_runs_on_a_bring_your_own_arm(scara_xml, task):
+    """Task 2: every cell of the coarse robot's path is in the SCARA's reach, and the guide
+    shortens the first exposure; task 4: 6 of its 38 cells are not, and the guide gives them
+    up (``guide.GIVE_UP``) and still reaches the goal on every trial."""
+    r = armtransfer.transfer(source="coarse", target=f"{scara_xml}:cartesian", task=task,
+                             methods=["none", "guided"], trials=3, controls=False, trajectory="optimal",
+                             arm_options={"tip_site": "pen_tip", "base_pos": (-0.1, 0.0, 0.0)})
+    ex = r.methods["guided"].column("exploration_steps")
+    assert all(x is not None for x in ex)
+    if task == 2:
+        assert max(ex) < min(r.methods["none"].column("exploration_steps"))
+
+
+def test_first_exposure_is_within_three_times_the_optimal_distance_and_controls_are_worse():
+    """The issue's bound on one case (coarse -> fine, Table I task 1, 10 trials): the mean first
+    exposure is at most 3x the distance the test measures by breadth-first search, and the
+    shuffled control (the same cells in a random order) needs at least 3x more."""
+    coarse, fine = grid_robot("coarse"), grid_robot("fine")
+    start, goal = TABLE_I[1].cells()
+    optimal = len(fine.shortest_path(fine.start_state(start), goal)) - 1
+    config = LearnerConfig(max_episodes=1)
+    traj = experiment.source_trajectory("learned", coarse, start, goal, LearnerConfig(), 0)
+    real = experiment.run_method("guided", fine, start, goal, [traj], 10, 0, config)
+    fake = experiment.control_trajectories("shuffled", coarse, [traj], 0)
+    shuffled = experiment.run_method("guided", fine, start, goal, fake, 10, 0, config, control="shuffled")
+    ex, ex_shuffled = real.column("exploration_steps"), shuffled.column("exploration_steps")
+    assert all(x is not None for x in ex)
+    assert np.mean(ex) <= 3 * optimal
+    capped = [config.max_total_steps if x is None else x for x in ex_shuffled]
+    assert np.mean(capped) >= 3 * np.mean(ex)
+
+
+def test_the_greedy_path_converges_near_the_optimal_one():
+    """After the exploration phase the learner is Algorithm 1 alone, so the guide does not bias
+    the converged greedy path; on the small two-room task it is the shortest."""
+    fine, coarse, start, goal = small_task()
+    traj = trajectories.shortest(coarse, start, goal)
+    res = [sarsa.learn(fine, fine.start_state(start), goal, LearnerConfig(), np.random.default_rng(k),
+                       shaping=guided_shaping(fine, [traj])) for k in range(5)]
+    optimal = len(fine.shortest_path(fine.start_state(start), goal)) - 1
+    assert all(r.converged for r in res)
+    assert np.mean([r.greedy_steps for r in res]) <= 1.05 * optimal
+
+
+def test_first_path_is_the_first_episode_with_its_loops_erased():
+    fine, coarse, start, goal = small_task()
+    r = sarsa.learn(fine, fine.start_state(start), goal, LearnerConfig(max_episodes=1), np.random.default_rng(2))
+    path = r.first_path
+    states = [s for s, _ in path]
+    assert r.exploration_steps > len(path) - 1  # without transfer the first episode loops
+    assert states[0] == fine.start_state(start) and fine.label[states[-1]] == goal and path[-1][1] == -1
+    assert len(set(states)) == len(states)  # no loop left
+    for (s, a), (t, _) in zip(path, path[1:]):
+        assert fine.next_state[s, a] == t  # every step is a move robot 2 made (no wind here)
+
+
+def test_unreached_first_episode_has_no_first_path():
+    fine, coarse, start, goal = small_task()
+    r = sarsa.learn(fine, fine.start_state(start), goal, LearnerConfig(max_episodes=1, max_total_steps=3),
+                    np.random.default_rng(2))
+    assert r.exploration_steps is None and r.first_path == []
+
+
+def test_the_online_mapping_is_learned_at_first_exposure_and_used_on_the_next_task(tmp_path):
+    coarse, fine = grid_robot("coarse"), grid_robot("fine")
+    config = LearnerConfig(max_episodes=1)  # nothing converges: the mapping comes from first exposures
+    s1, g1 = TABLE_I[1].cells()
+    traj1 = trajectories.shortest(coarse, s1, g1)
+    res = experiment.run_method("guided", fine, s1, g1, [traj1], 3, 0, config)
+    assert not any(res.column("converged"))
+    online = experiment.online_mapping(coarse, fine, s1, g1, res, traj1)
+    assert len(online) > 0 and online.tasks == [(s1, g1)]
+    # the coarse robot's one move "forward" (two cells) is two moves "forward" of the fine robot
+    forward = coarse.action_names.index("1")
+    assert online.get([forward]) == (fine.action_names.index("F"),) * 2
+    # the existing file format and the method `mapping` take it as it is
+    online.save(tmp_path / "m.json")
+    again = ActionMapping.load(tmp_path / "m.json")
+    assert again.to_json() == online.to_json()
+    s2, g2 = TABLE_I[2].cells()
+    traj2 = trajectories.shortest(coarse, s2, g2)
+    used, _ = experiment.run_mapping(fine, s2, g2, traj2, again, 3, 0, config)
+    assert used.extra["macro_states"] > 0 and sum(used.extra["macro_steps_first_episode"]) > 0
+
+
+SCRIPT = __import__("pathlib").Path(__file__).resolve().parents[1] / "scripts" / "first_exposure.py"
+
+
+def test_the_benchmark_script_fast_mode_writes_its_table(tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    out = tmp_path / "fe"
+    proc = subprocess.run([sys.executable, str(SCRIPT), "--fast", "--out", str(out)], capture_output=True,
+                          text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    data = json.loads((out / "first_exposure.json").read_text())
+    assert data["fast"] and len(data["rows"]) == 4
+    for row in data["rows"]:
+        for label in ("none", "pseudo", "dense", "oracle", "guided", "guided [shuffled]", "guided [random]"):
+            entry = row["summary"][label]
+            assert len(entry["exploration_steps"]) == data["trials"]  # every trial counted, none dropped
+        assert row["verdict"]["first_exposure_ratio"] == row["summary"]["guided"]["mean"] / row["optimal"]
+    assert "mapping [online]" in data["rows"][1]["summary"]  # task 2 reuses task 1's online mapping
+    text = (out / "first_exposure.md").read_text()
+    assert "guided [shuffled]" in text and "mapping (online)" in text
+
+
+def test_the_benchmark_script_refuses_bad_input_in_one_line(tmp_path):
+    import subprocess
+    import sys
+
+    (tmp_path / "full").mkdir()
+    (tmp_path / "full" / "x").write_text("")
+    for args in (["--trials", "0", "--out", str(tmp_path / "a")], ["--out", str(tmp_path / "full")]):
+        proc = subprocess.run([sys.executable, str(SCRIPT), *args], capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 2
+        assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr
