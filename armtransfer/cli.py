@@ -84,5 +84,20 @@ def _main(argv: list[str]) -> int:
         return 2
 
 
+def run() -> None:
+    """The console script and ``python -m armtransfer.cli``: ``main``, then exit with its code.
+
+    After Ctrl-C the exit is ``os._exit(130)``: a KeyboardInterrupt raised while a C extension
+    runs Python code marks the interpreter, which then ends itself with SIGINT at shutdown
+    even though ``main`` caught it, and the shell would see a signal instead of code 130.
+    """
+    code = main()
+    if code == 130:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(130)
+    sys.exit(code)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    run()
