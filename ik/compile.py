@@ -59,6 +59,34 @@ def _progress(enabled: bool, text: str) -> None:
 # --------------------------------------------------------------------------- cartesian
 
 
+def reach_bound(scene: ArmScene) -> tuple[np.ndarray, float]:
+    """The first joint's anchor and the sum of the distances from joint to joint to the tip
+    at home: no tip position lies farther from the anchor than that."""
+    data = mujoco.MjData(scene.model)
+    data.qpos[:] = scene.home
+    mujoco.mj_kinematics(scene.model, data)
+    tip = data.site_xpos[mujoco.mj_name2id(scene.model, mujoco.mjtObj.mjOBJ_SITE, scene.tip)]
+    points = np.vstack([data.xanchor[np.argsort(scene.model.jnt_qposadr)], tip])
+    return points[0].copy(), float(np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1)))
+
+
+def _check_table_in_reach(scene: ArmScene, home_tip: np.ndarray) -> None:
+    """Fail at once, not after thousands of IK solves, when the tip cannot reach the table."""
+    if scene.planar:  # the tip rides at one height
+        if not -1e-3 <= home_tip[2] <= MAX_TIP_HEIGHT:
+            raise UnreachableTableError(
+                f"the arm's tip cannot reach the table: it moves {home_tip[2]:.3f} m above the tabletop "
+                f"(at most {MAX_TIP_HEIGHT} m allowed)")
+        return
+    anchor, reach = reach_bound(scene)
+    half = scene.layout.width * scene.cell / 2
+    nearest = np.array([np.clip(anchor[0], -half, half), np.clip(anchor[1], -half, half), 0.0])
+    if np.linalg.norm(anchor - nearest) > reach:
+        raise UnreachableTableError(
+            f"the arm's tip cannot reach the table: the table is {np.linalg.norm(anchor - nearest):.2f} m from "
+            f"its base, and the arm reaches at most {reach:.2f} m")
+
+
 def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = False) -> dict:
     layout, cell = scene.layout, scene.cell
     free = layout.free
@@ -68,6 +96,7 @@ def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = 
     home_tip = ik.configuration
     home_tip.update(scene.home)
     p = home_tip.get_transform_frame_to_world(scene.tip, "site").translation()
+    _check_table_in_reach(scene, p)
 
     q_of: dict[int, np.ndarray] = {}
     attempts = np.zeros(layout.n_cells, dtype=np.int8)

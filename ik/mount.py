@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from armtransfer.ik.compile import SEED_RESTARTS, seed_cells
+from armtransfer.ik.compile import SEED_RESTARTS, reach_bound, seed_cells
 from armtransfer.ik.labels import cells_of_xy
 from armtransfer.ik.scene import ArmScene, ContactChecker, build_scene
 from armtransfer.ik.solve import TIP_HEIGHT, TipIK
@@ -67,16 +67,6 @@ def _tip_at(scene: ArmScene, q: np.ndarray) -> np.ndarray:
     data.qpos[:] = q
     mujoco.mj_kinematics(scene.model, data)
     return data.site_xpos[mujoco.mj_name2id(scene.model, mujoco.mjtObj.mjOBJ_SITE, scene.tip)].copy()
-
-
-def _reach_bound(scene: ArmScene) -> tuple[np.ndarray, float]:
-    """The first joint's anchor and the sum of the distances from joint to joint to the tip
-    at home: no tip position lies farther from the anchor than that."""
-    data = mujoco.MjData(scene.model)
-    data.qpos[:] = scene.home
-    mujoco.mj_kinematics(scene.model, data)
-    points = np.vstack([data.xanchor[np.argsort(scene.model.jnt_qposadr)], _tip_at(scene, scene.home)])
-    return points[0], float(np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1)))
 
 
 def _base(scene: ArmScene) -> tuple[np.ndarray, float]:
@@ -130,7 +120,7 @@ def on_table(scene: ArmScene, yaw: float | None = None) -> list[Pose]:
 
 def candidates(scene: ArmScene, table_half: float, yaw: float | None = None) -> list[Pose]:
     """Base poses to try for the arm of ``scene`` (built at the origin, yaw 0)."""
-    anchor, reach = _reach_bound(scene)
+    anchor, reach = reach_bound(scene)
     tip = _tip_at(scene, scene.home)
     if scene.planar:  # hung so that the tip rides just above the tabletop
         z = TIP_HEIGHT / 2 - float(tip[2])

@@ -95,8 +95,14 @@ def run(args: argparse.Namespace) -> int:
             jobs.append(dict(arm=None, actions=a, xml_path=args.arm_xml, **options))
     from armtransfer.tasks.arms import tasks_solvable
 
-    robots = [arm_robot(job.pop("arm"), job.pop("actions"), cell_size=args.cell_size, cache=not args.no_cache,
-                        progress=common.interactive(), **job) for job in jobs]
+    def build(job: dict):
+        job = dict(job)
+        return arm_robot(job.pop("arm"), job.pop("actions"), cell_size=args.cell_size, cache=not args.no_cache,
+                         progress=common.interactive(), **job)
+
+    # the bring-your-own arm first: a file that cannot be compiled fails before the long listing
+    built = {i: build(job) for i, job in enumerate(jobs) if job.get("xml_path")}
+    robots = [built[i] if i in built else build(job) for i, job in enumerate(jobs)]
     header = f"{'robot':<24} {'dof':>3} {'actions':>7} {'states':>7} {'reach':>6} {'tableI':>6} {'cache':>6}"
     print(header)
     for r in robots:
