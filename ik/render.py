@@ -6,7 +6,7 @@ works without a display and without a GPU through Mesa's EGL (llvmpipe).
 
 Each panel is one ``Replay`` (``armtransfer.ik.replay``) rendered with its own model and
 ``mujoco.Renderer`` from a fixed free camera that fits the whole scene: the table, its walls
-and the arm wherever it is mounted; the tool tip's path is drawn on the table as dots.
+and the arm wherever it is mounted; the tool tip's path is drawn on the table as a line.
 Markers are drawn as MuJoCo user geoms added to the renderer's scene (they are not part
 of the model, so they never collide): the transferred trajectory's cells as orange
 tiles, the goal cell as a green disc. Panels are concatenated left to right; a shorter
@@ -53,8 +53,8 @@ TRAJECTORY_RGBA = (1.0, 0.55, 0.1, 1.0)
 GOAL_RGBA = (0.1, 0.75, 0.2, 1.0)
 START_RGBA = (0.15, 0.35, 0.9, 1.0)
 TIP_PATH_RGBA = (0.85, 0.1, 0.6, 1.0)
-TIP_PATH_POINTS = 300
-"""At most this many dots mark the tool tip's path."""
+TIP_PATH_POINTS = 40
+"""The tool tip's path is drawn as this many line segments."""
 MAX_SIZE = 4096
 
 
@@ -74,7 +74,7 @@ class RolloutPanel:
     show_start: bool = True
     """A blue tile under the first planned cell."""
     show_tip_path: bool = True
-    """Small dots on the table where the tool tip went during the replay."""
+    """A line on the table where the tool tip went during the replay."""
 
 
 @dataclass
@@ -280,11 +280,11 @@ def _markers(panel: RolloutPanel) -> list[tuple[int, np.ndarray, np.ndarray, np.
     goal = rp.goal_cell if panel.goal_cell is None else panel.goal_cell
     out.append((int(mujoco.mjtGeom.mjGEOM_CYLINDER), np.array([1.2 * cell, thin, 0.0]),
                 centre(goal, thin), np.array(GOAL_RGBA)))
-    if panel.show_tip_path:  # where the tool tip went, drawn on the table
-        sphere = int(mujoco.mjtGeom.mjGEOM_SPHERE)
-        step = max(1, len(rp.tip) // TIP_PATH_POINTS)
-        for p in rp.tip[::step]:
-            out.append((sphere, np.array([0.15 * cell, 0.0, 0.0]), np.array([p[0], p[1], 3 * thin]),
+    if panel.show_tip_path:  # where the tool tip went, as a line on the table (lines are cheap to draw)
+        line = int(mujoco.mjtGeom.mjGEOM_LINE)
+        points = rp.tip[np.unique(np.linspace(0, len(rp.tip) - 1, TIP_PATH_POINTS + 1).astype(int))]
+        for a, b in zip(points[:-1], points[1:]):
+            out.append((line, 2.0, (np.array([a[0], a[1], 3 * thin]), np.array([b[0], b[1], 3 * thin])),
                         np.array(TIP_PATH_RGBA)))
     return out
 
