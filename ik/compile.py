@@ -70,13 +70,18 @@ def reach_bound(scene: ArmScene) -> tuple[np.ndarray, float]:
     return points[0].copy(), float(np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1)))
 
 
+def _check_tip_height(z: float) -> None:
+    """A planar arm's tip rides at one height: it must be on the table."""
+    if not -1e-3 <= z <= MAX_TIP_HEIGHT:
+        raise UnreachableTableError(
+            f"the arm's tip cannot reach the table: it moves {z:.3f} m above the tabletop "
+            f"(at most {MAX_TIP_HEIGHT} m allowed)")
+
+
 def _check_table_in_reach(scene: ArmScene, home_tip: np.ndarray) -> None:
     """Fail at once, not after thousands of IK solves, when the tip cannot reach the table."""
-    if scene.planar:  # the tip rides at one height
-        if not -1e-3 <= home_tip[2] <= MAX_TIP_HEIGHT:
-            raise UnreachableTableError(
-                f"the arm's tip cannot reach the table: it moves {home_tip[2]:.3f} m above the tabletop "
-                f"(at most {MAX_TIP_HEIGHT} m allowed)")
+    if scene.planar:
+        _check_tip_height(float(home_tip[2]))
         return
     anchor, reach = reach_bound(scene)
     half = scene.layout.width * scene.cell / 2
@@ -210,11 +215,6 @@ def _segment_clear(contact: ContactChecker, qa, qb, pa, pb, n_points: int, cell,
     return True
 
 
-def _nearest_free_cell(xy, cell, layout) -> int:
-    order = _cells_by_distance(xy, cell, layout)
-    return int(order[0]) if len(order) else -1
-
-
 def _cells_by_distance(xy, cell, layout) -> np.ndarray:
     ids = np.flatnonzero(layout.free)
     centres = layout.xy_of(ids) * cell
@@ -319,10 +319,7 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
     contact = ContactChecker(scene)
     free = layout.free
     near = _near_wall_mask(layout)
-    if not -1e-3 <= fk.tip_z <= MAX_TIP_HEIGHT:
-        raise UnreachableTableError(
-            f"the arm's tip cannot reach the table: it moves {fk.tip_z:.3f} m above the "
-            f"tabletop (at most {MAX_TIP_HEIGHT} m allowed)")
+    _check_tip_height(fk.tip_z)
     home = _lattice_origin(scene, fk)
     dof = len(home)
     lo = np.where(np.isfinite(scene.lower), scene.lower, home - np.pi)

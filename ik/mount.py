@@ -93,38 +93,41 @@ def _base(scene: ArmScene) -> tuple[np.ndarray, float]:
     return anchor[:2].copy(), bottom
 
 
-def _facing(scene: ArmScene) -> float:
-    """The direction (rad, in the file's frame) from the base's axis to the tip at home."""
-    anchor, _ = _base(scene)
-    tip = _tip_at(scene, scene.home)[:2] - anchor
-    return math.atan2(tip[1], tip[0]) if np.linalg.norm(tip) > 1e-6 else 0.0
+class _Placer:
+    """Mounts (the file frame's pose) that stand the base's axis at a point of the table frame,
+    its bottom on the tabletop (or at a given height), turned so that home points at the
+    table's centre. The base and its home direction are found once per arm."""
 
+    def __init__(self, scene: ArmScene) -> None:
+        self.anchor, self.bottom = _base(scene)
+        tip = _tip_at(scene, scene.home)
+        self.tip_z = float(tip[2])
+        d = tip[:2] - self.anchor
+        self.facing = math.atan2(d[1], d[0]) if np.linalg.norm(d) > 1e-6 else 0.0
 
-def _place(scene: ArmScene, x: float, y: float, z: float | None, yaw: float | None) -> Pose:
-    """The mount (the file frame's pose) that stands the base's axis at (x, y), its bottom on
-    the tabletop (or at height ``z``), turned so that home points at the table's centre."""
-    anchor, bottom = _base(scene)
-    if yaw is None:
-        yaw = (math.atan2(-y, -x) if (x, y) != (0.0, 0.0) else 0.0) - _facing(scene)
-    yaw = (yaw + math.pi) % (2 * math.pi) - math.pi
-    c, s = math.cos(yaw), math.sin(yaw)
-    ax, ay = c * anchor[0] - s * anchor[1], s * anchor[0] + c * anchor[1]
-    height = -bottom if z is None else z
-    return Pose((round(x - ax, 4), round(y - ay, 4), round(height, 4)), round(yaw, 4))
+    def __call__(self, x: float, y: float, z: float | None, yaw: float | None) -> Pose:
+        if yaw is None:
+            yaw = (math.atan2(-y, -x) if (x, y) != (0.0, 0.0) else 0.0) - self.facing
+        yaw = (yaw + math.pi) % (2 * math.pi) - math.pi
+        c, s = math.cos(yaw), math.sin(yaw)
+        ax, ay = c * self.anchor[0] - s * self.anchor[1], s * self.anchor[0] + c * self.anchor[1]
+        height = -self.bottom if z is None else z
+        return Pose((round(x - ax, 4), round(y - ay, 4), round(height, 4)), round(yaw, 4))
 
 
 def on_table(scene: ArmScene, yaw: float | None = None) -> list[Pose]:
     """Base poses on the table itself, over the grid of ``PLANAR_GRID`` (spatial arms)."""
-    return [_place(scene, x, y, None, yaw) for x in PLANAR_GRID for y in PLANAR_GRID]
+    place = _Placer(scene)
+    return [place(x, y, None, yaw) for x in PLANAR_GRID for y in PLANAR_GRID]
 
 
 def candidates(scene: ArmScene, table_half: float, yaw: float | None = None) -> list[Pose]:
     """Base poses to try for the arm of ``scene`` (built at the origin, yaw 0)."""
-    anchor, reach = reach_bound(scene)
-    tip = _tip_at(scene, scene.home)
+    place = _Placer(scene)
     if scene.planar:  # hung so that the tip rides just above the tabletop
-        z = TIP_HEIGHT / 2 - float(tip[2])
-        return [_place(scene, x, y, z, 0.0 if yaw is None else yaw) for x in PLANAR_GRID for y in PLANAR_GRID]
+        z = TIP_HEIGHT / 2 - place.tip_z
+        return [place(x, y, z, 0.0 if yaw is None else yaw) for x in PLANAR_GRID for y in PLANAR_GRID]
+    _, reach = reach_bound(scene)
     out = []
     for gap in GAPS:
         d = table_half + gap
@@ -133,7 +136,7 @@ def candidates(scene: ArmScene, table_half: float, yaw: float | None = None) -> 
             r = d * (math.sqrt(2) if k % 2 == 1 else 1.0)
             if r - table_half > reach:  # cannot reach even the nearest edge
                 continue
-            out.append(_place(scene, r * math.cos(theta), r * math.sin(theta), None, yaw))
+            out.append(place(r * math.cos(theta), r * math.sin(theta), None, yaw))
     return out
 
 
