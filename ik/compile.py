@@ -185,18 +185,28 @@ SEED_RESTARTS = 8
 def seed_cells(scene: ArmScene, home_tip: np.ndarray, n: int = 6) -> list[int]:
     """Cells to try first: those nearest the tip at home, then those nearest the point halfway
     from the arm's base to the table's centre (a straight or folded home may put the tip
-    far off the table, or at a singular pose, where IK from home cannot start)."""
+    far off the table, or at a singular pose, where IK from home cannot start), then the
+    cell nearest each of 8 points around the base at half its reach (a base standing on the
+    table near its centre: the halfway point is then inside the circle no tool-down pose
+    reaches)."""
     layout, cell = scene.layout, scene.cell
     data = mujoco.MjData(scene.model)
     data.qpos[:] = scene.home
     mujoco.mj_kinematics(scene.model, data)
     base = data.xanchor[int(np.argmin(scene.model.jnt_qposadr))][:2]
+    _, reach = reach_bound(scene)
+    ring = [(base + 0.5 * reach * np.array([np.cos(t), np.sin(t)]), 1)
+            for t in np.arange(RING) * 2 * np.pi / RING]
     out: list[int] = []
-    for point in (home_tip[:2], base / 2):
-        for c in _cells_by_distance(point, cell, layout)[:n]:
+    for point, k in [(home_tip[:2], n), (base / 2, n), *ring]:
+        for c in _cells_by_distance(point, cell, layout)[:k]:
             if int(c) not in out:
                 out.append(int(c))
     return out
+
+
+RING = 8
+"""Points around the base, at half its reach, that ``seed_cells`` also tries."""
 
 
 def _segment_clear(contact: ContactChecker, qa, qb, pa, pb, n_points: int, cell, layout) -> bool:

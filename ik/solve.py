@@ -5,6 +5,13 @@ leaving the rotation about the tool axis free), a low-weight ``PostureTask`` tow
 home configuration to pick among redundant solutions, and the joint limits
 (``ConfigurationLimit``), solved with ``mink.solve_ik(..., solver="daqp")`` and iterated
 as Gauss-Newton steps until the tip is within ``tol`` of the target.
+
+Pointing down is exact (within ``TILT_TOL``) for an arm of six joints or more. An arm with
+fewer has no joint to spare: holding the tool straight down takes two of them, and a
+5-joint arm is then left with a thin ring of the table (the SO-ARM100: 6-32 cm from its
+axis). Such an arm keeps its tool within ``TILT_CONE`` of straight down instead: IK first
+tries straight down, and where that fails it solves again with a light downward pull, so
+the tip's position comes first and the tool tilts only as far as the position needs.
 """
 
 from __future__ import annotations
@@ -20,6 +27,23 @@ TIP_HEIGHT = 0.004
 """Height IK puts the tool tip at above the tabletop (m). Planar arms keep their own."""
 MAX_TIP_HEIGHT = 0.01
 """A tip higher than this above the tabletop (m) is not on the table."""
+
+TILT_TOL = 0.05
+"""Largest tilt (rad) of the tool axis from straight down, for an arm of six joints or more."""
+TILT_CONE = 0.5
+"""Largest tilt (rad, about 29 degrees) for a spatial arm of fewer than six joints. The
+wrist then stays high over the table: a tool 13 cm long tilted this far still holds its
+far end 11 cm above the tip."""
+CONE_COST = 1e-3
+"""Weight of "pointing down" for those arms, against 1 for the tip's position."""
+FULL_DOF = 6
+"""Joints an arm needs to put its tool tip anywhere within reach pointing straight down."""
+
+
+def tilt_limit(scene: ArmScene) -> float:
+    """The largest tilt of the tool from straight down that IK accepts for this arm."""
+    return TILT_TOL if scene.nq >= FULL_DOF else TILT_CONE
+
 
 # Tool z axis pointing down: a rotation of pi about the world x axis.
 _DOWN = mink.SO3.from_x_radians(np.pi)
@@ -39,11 +63,13 @@ class IKResult:
 
 class TipIK:
     def __init__(self, scene: ArmScene, tip_down: bool, posture_cost: float = 1e-3,
-                 damping: float = 1e-4, tol: float = 5e-4, tilt_tol: float = 0.05,
+                 damping: float = 1e-4, tol: float = 5e-4, tilt_tol: float | None = None,
                  max_iters: int = 40) -> None:
+        """``tilt_tol`` None: ``tilt_limit(scene)``."""
         self.scene = scene
         self.tip_down = tip_down
         self.configuration = mink.Configuration(scene.model)
+        tilt_tol = tilt_limit(scene) if tilt_tol is None else tilt_tol
         self.frame = mink.FrameTask(
             frame_name=scene.tip, frame_type="site",
             position_cost=np.array([1.0, 1.0, 0.0]) if scene.planar else 1.0,
@@ -56,6 +82,9 @@ class TipIK:
         self.damping = damping
         self.tol = tol
         self.tilt_tol = tilt_tol
+        self.cone = tip_down and tilt_tol > TILT_TOL
+        """Tool within a cone: where pointing straight down fails, a second solve with a light
+        downward pull from the first's result."""
         self.max_iters = max_iters
         self.tasks = [self.frame, self.posture]
 
@@ -66,12 +95,25 @@ class TipIK:
         return float(self.configuration.get_transform_frame_to_world(self.scene.tip, "site").translation()[2])
 
     def solve(self, xy: np.ndarray, q0: np.ndarray) -> IKResult:
-        """Tip over (x, y) starting from q0; returns the best configuration found."""
+        """Tip over (x, y) starting from q0; returns the best configuration found. An arm whose
+        tool may tilt (``cone``) first tries straight down, and only where that fails lets
+        the tool tilt, starting from where the first try ended."""
         q0 = np.clip(np.asarray(q0, dtype=float), self.scene.lower + 1e-6, self.scene.upper - 1e-6)
         target = np.array([xy[0], xy[1], self.target_height(q0)])
-        cfg = self.configuration
-        cfg.update(q0)
+        self.configuration.update(q0)
         self.frame.set_target(mink.SE3.from_rotation_and_translation(_DOWN, target))
+        res = self._iterate(target, min(self.tilt_tol, TILT_TOL) * 0.2)
+        if self.cone and not (res.error <= self.tol and res.tilt <= TILT_TOL):
+            self.frame.set_orientation_cost(np.array([CONE_COST, CONE_COST, 0.0]))
+            try:  # within the cone any tilt will do: the light pull leaves the position exact
+                tilted = self._iterate(target, self.tilt_tol, res.iterations)
+            finally:
+                self.frame.set_orientation_cost(np.array([1.0, 1.0, 0.0]))
+            res = tilted
+        return res
+
+    def _iterate(self, target: np.ndarray, tilt_stop: float, done: int = 0) -> IKResult:
+        cfg = self.configuration
         err = tilt = np.inf
         it = 0
         for it in range(1, self.max_iters + 1):
@@ -83,10 +125,10 @@ class TipIK:
                               limits=self.limits)
             cfg.integrate_inplace(v, 1.0)
             err, tilt = self._residual(target)
-            if err < self.tol * 0.2 and tilt < self.tilt_tol * 0.2:
+            if err < self.tol * 0.2 and tilt < tilt_stop:
                 break
         height = float(cfg.get_transform_frame_to_world(self.scene.tip, "site").translation()[2])
-        return IKResult(cfg.q.copy(), float(err), float(tilt), it, height)
+        return IKResult(cfg.q.copy(), float(err), float(tilt), done + it, height)
 
     def solve_any(self, xy: np.ndarray, q0: np.ndarray, rng: np.random.Generator,
                   restarts: int = 8) -> IKResult:
