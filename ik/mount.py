@@ -9,8 +9,10 @@ base poses worth trying:
 - any other arm stands on the table's plane beside it, on the four sides and at the four
   corners, at a few distances, turned so that its home tip points at the table's centre;
   an arm too small to cover the table from beside it may also stand on the table, inside
-  a room (``on_table``): its fixed base then stands on cells, never on a wall; and its best
-  few poses are also tried on a pedestal (``LIFTS``), which can free its lower links.
+  a room (``on_table``): its fixed base then stands on cells, never on a wall, on the
+  tabletop and on a pedestal (its links turn a few centimetres from the 2 cm walls, and
+  the pedestal lifts them clear); and its best few poses are also tried on each pedestal
+  of ``LIFTS``.
 
 ``estimate_reach`` scores one pose: inverse kinematics (the compile's own ``TipIK``, tool
 pointing down for spatial arms) over a sparse lattice of free cells, warm-started from

@@ -2,9 +2,10 @@
 
 The automatic mount (``armtransfer.tasks.arms.automatic_mount``) ranks its candidates by a
 quick IK estimate and compiles only the best few. This script shows all of them: the
-estimate for each, then a full compile of the ``--compile`` best (in the search's own order: Table I cells reached, then
-the estimate), with the
-share of free cells reached and the Table I tasks solvable. Use it to see why a mount was
+estimate for each, then a full compile of the ``--compile`` first in the order the automatic
+mount compiles them (``compile_order``: the best by Table I cells reached then the estimate,
+then the best by the estimate alone), with the share of free cells reached and the Table I
+tasks solvable; the automatic mount takes the best of its first six. Use it to see why a mount was
 chosen, or to pick one by hand for ``--base-pos``/``--base-yaw``.
 
     python scripts/mount_candidates.py PATH.xml --tip-body Fixed_Jaw --tip-offset=-0.015,-0.13,0
@@ -19,7 +20,7 @@ from pathlib import Path
 
 from armtransfer.errors import ArmTransferError
 from armtransfer.ik.tool import parse_offset
-from armtransfer.tasks.arms import arm_robot, make_tool, mount_search, tasks_solvable
+from armtransfer.tasks.arms import arm_robot, compile_order, make_tool, mount_search, tasks_solvable
 from armtransfer.tasks.catalog import TABLE_I
 
 
@@ -29,7 +30,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--tip-site", default=None)
     p.add_argument("--tip-body", default=None)
     p.add_argument("--tip-offset", default=None, metavar="X,Y,Z")
-    p.add_argument("--compile", type=int, default=6, metavar="N", help="compile the N best in full (default 6)")
+    p.add_argument("--compile", type=int, default=6, metavar="N",
+                   help="compile the first N of the automatic mount's order in full (default 6)")
     args = p.parse_args(argv)
     offset = parse_offset(args.tip_offset) if args.tip_offset else None
     tool = make_tool(args.tip_site, args.tip_body, offset)
@@ -40,8 +42,8 @@ def main(argv: list[str] | None = None) -> int:
           f"(share of a sparse lattice of free cells; Table I cells reached)")
     for hit, share, pose in rows:
         print(f"  {pose.describe()}: estimate {share:.1%}, Table I cells {hit}")
-    print(f"full compiles of the {args.compile} best:")
-    for hit, share, pose in rows[:args.compile]:
+    print(f"full compiles of the first {args.compile} in the automatic mount's order:")
+    for hit, share, pose in compile_order(rows, args.compile)[:args.compile]:
         robot = arm_robot(None, "cartesian", xml_path=path, tip_site=tool.site, tip_body=tool.body,
                           tip_offset=tool.offset, base_pos=pose.pos, base_yaw=pose.yaw)
         print(f"  --base-pos={','.join(f'{v:.4g}' for v in pose.pos)} --base-yaw={pose.yaw:.4g}: "

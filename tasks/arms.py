@@ -174,7 +174,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
         kind, tip_down = info.kind, info.tip_down
         step = joint_step or info.joint_step
     parts = {
-        "version": 2, "arm_xml": _sha(xml_bytes), "assets": _assets_sha(path), "tool": tool.key(),
+        "version": 4, "arm_xml": _sha(xml_bytes), "assets": _assets_sha(path), "tool": tool.key(),
         "mount": mount, "yaw": yaw, "actions": model.name, "cells": model.cells, "tip_down": tip_down,
         "joint_step": step if model.kind == "joint" else None, "cell": cell_size,
         "wall_height": WALL_HEIGHT, "layout": _layout_data(layout),
@@ -242,8 +242,10 @@ def mount_search(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, lay
 
     First the poses of ``ik.mount.candidates`` (beside the table; over it for an arm with
     vertical joint axes). A spatial arm that none of them lets cover the table (an estimate
-    of at least ``COVERS`` with every Table I cell) also tries ``ik.mount.on_table`` and its
-    best five poses on each pedestal of ``ik.mount.LIFTS``.
+    of at least ``COVERS`` with every Table I cell) also tries ``ik.mount.on_table``, each
+    pose standing on the tabletop and on the lowest pedestal of ``ik.mount.LIFTS`` (on the
+    table its turning links pass a few centimetres from the 2 cm walls; the pedestal lifts
+    them clear), and the best five poses standing on the tabletop on each pedestal.
     """
     from armtransfer.ik import mount as _mount
     from armtransfer.tasks.catalog import TABLE_I
@@ -262,26 +264,47 @@ def mount_search(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, lay
 
     score(_mount.candidates(origin, layout.width * cell_size / 2, yaw))
     if not origin.planar and not (scored and scored[0][0] == len(must) and scored[0][1] >= COVERS):
-        score(_mount.on_table(origin, yaw))  # too small to cover the table from beside it
-        score([pose.lifted(h) for *_, pose in scored[:5] for h in _mount.LIFTS])  # on a pedestal
+        standing = {pose for *_, pose in scored}
+        inside = _mount.on_table(origin, yaw)  # too small to cover the table from beside it
+        standing |= set(inside)
+        score(inside + [pose.lifted(_mount.LIFTS[0]) for pose in inside])
+        tried = {pose for *_, pose in scored}
+        best = [pose for *_, pose in scored if pose in standing][:5]
+        score([lifted for pose in best for h in _mount.LIFTS  # on a pedestal
+               if (lifted := pose.lifted(h)) not in tried])
     return [(hit, share, pose) for hit, share, _, pose in scored]
+
+
+COMPILES = 3
+"""Poses the automatic mount compiles in full from each of its two rankings."""
+
+
+def compile_order(scored: list, n: int = COMPILES) -> list:
+    """The poses of ``mount_search`` (best first) that ``automatic_mount`` compiles in full, in
+    order: the best ``n`` as ranked, then the ``n`` best by the estimate alone that are not
+    among them."""
+    first = scored[:n]
+    by_share = sorted(scored, key=lambda t: t[1], reverse=True)  # stable: ties keep their rank
+    return first + [t for t in by_share if t not in first][:n]
 
 
 def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, layout: Layout = ROOMS,
                     yaw: float | None = None, cache: bool = True, progress: bool = False):
     """A base pose for an arm that came without one (``ik.mount.Pose``).
 
-    The poses of :func:`mount_search` are ranked by their quick estimate; the best three are
+    The poses of :func:`mount_search` are ranked by their quick estimate. The best three (by
+    Table I cells reached, then the estimate) and the three with the best estimate alone are
     compiled in full (the 1-cell cartesian model: reach is the tool's workspace, whatever
-    the action model) and the one with the most Table I tasks solvable, then the most free
-    cells reached, wins. The choice is cached under the arm file's content (meshes
+    the action model), and the one with the most Table I tasks solvable, then the most free
+    cells reached, wins. (The estimate is a sparse lattice: for a small arm it can put a
+    pose that reaches more below one that reaches less.) The choice is cached under the arm file's content (meshes
     included), tool, cell size and layout, so it is made once.
     """
     import json
 
     from armtransfer.ik import mount as _mount
 
-    parts = {"version": 4, "what": "mount", "covers": COVERS, "arm_xml": _sha(path.read_bytes()),
+    parts = {"version": 7, "what": "mount", "covers": COVERS, "arm_xml": _sha(path.read_bytes()),
              "assets": _assets_sha(path), "tool": tool.key(), "cell": cell_size, "yaw": yaw,
              "layout": _layout_data(layout), "stride": _mount.STRIDE, "gaps": _mount.GAPS,
              "grid": _mount.PLANAR_GRID, "lifts": _mount.LIFTS}
@@ -304,7 +327,7 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
     if not scored or scored[0][1] == 0.0:
         raise unreachable
     best = None
-    for hit, share, pose in scored[:3]:
+    for hit, share, pose in compile_order(scored):
         if progress:
             print(f"  mount candidate: {pose.describe()} (estimated reach {share:.0%})", file=sys.stderr, flush=True)
         try:
@@ -414,5 +437,5 @@ def _compile(scene, model, tip_down, step, progress) -> dict:
     return arrays
 
 
-__all__ = ["arm_robot", "arm_scene", "automatic_mount", "make_tool", "mount_search", "parse_robot_spec", "robot", "robot_specs",
+__all__ = ["arm_robot", "arm_scene", "automatic_mount", "make_tool", "compile_order", "mount_search", "parse_robot_spec", "robot", "robot_specs",
            "tasks_solvable"]
