@@ -137,9 +137,12 @@ def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = 
             if free[n] and n not in q_of and attempts[n] < 3 and try_cell(n, q_of[c]):
                 queue.append(n)
     if not q_of:
+        axis = "" if not tip_down or scene.tool.has_offset else (
+            f", the tool pointing down (its axis is the tip {'site' if scene.tool.site else 'body'}'s z axis: "
+            "if the tool points another way, give --tip-offset along it)")
         raise UnreachableTableError(
             "the arm's tip cannot reach the table: IK finds no configuration with the tip "
-            "over a free cell, at most 1 cm above the tabletop")
+            f"over a free cell, at most 1 cm above the tabletop{axis}")
     _progress(progress, f"  IK: {len(q_of)} cells reached")
 
     cells = np.array(sorted(q_of), dtype=np.int64)

@@ -320,9 +320,15 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
             pass
     from armtransfer.errors import UnreachableTableError
 
+    axis = ("" if tool.has_offset else
+            f"; the tool's axis, kept pointing down, is the {'site' if tool.site else 'body'}'s z axis: if the "
+            "tool points another way, give --tip-offset along it")
     unreachable = UnreachableTableError(
         f"the arm's tool ({tool.describe()}) cannot reach the table from any base pose tried; give "
-        "--base-pos X,Y,Z and --base-yaw")
+        f"--base-pos X,Y,Z and --base-yaw{axis}")
+    if progress:
+        print(f"choosing a mount for {path.name}: estimating the reach of base poses (once; the choice is "
+              "cached) ...", file=sys.stderr, flush=True)
     scored = mount_search(path, tool, cell_size=cell_size, layout=layout, yaw=yaw)
     if not scored or scored[0][1] == 0.0:
         raise unreachable
