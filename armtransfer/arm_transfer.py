@@ -87,14 +87,15 @@ def run(args: argparse.Namespace) -> int:
         options = arm_options(args)
         source = resolve(args.source, xml_path=args.arm_xml, progress=common.interactive(), **options)
         target = resolve(args.target, xml_path=args.arm_xml, progress=common.interactive(), **options)
+        scenes: dict = {}  # the checked scenes, rendered from: each is built once
         if not args.no_video or args.render:  # a replay that cannot be made fails now, not after learning
             from armtransfer.ik.replay import check_replayable
 
             for robot in (source, target):
                 if robot.arm is not None:
-                    check_replayable(robot)
+                    scenes[id(robot)] = check_replayable(robot)
     with staged_directory(out) as tmp:
-        result = _run_into(args, tmp, source, target, out)
+        result = _run_into(args, tmp, source, target, out, scenes)
         if args.json:
             write_json_atomic(args.json, result["json"])
         if args.render and result["video"]:
@@ -103,14 +104,15 @@ def run(args: argparse.Namespace) -> int:
             if target.suffix.lower() == tmp_video.suffix.lower():
                 copy_atomic(tmp_video, target)
             else:
-                _video(result, args, target)
+                _video(result, args, target, scenes)
     print(f"wrote {out}/ ({', '.join(sorted(p.name for p in out.iterdir()))}) in {time.perf_counter() - t0:.0f} s")
     return 0
 
 
 def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target: DiscreteRobot,
-              final: Path) -> dict:
-    """Everything into ``tmp``, which becomes ``final`` when complete (paths in results.json name ``final``)."""
+              final: Path, scenes: dict | None = None) -> dict:
+    """Everything into ``tmp``, which becomes ``final`` when complete (paths in results.json name ``final``).
+    ``scenes``: the robots' checked scenes by ``id(robot)``, rendered from."""
     kwargs = {**common.transfer_kwargs(args), **_fast_overrides(args)}
     if args.source_planner == "learn" and not args.trajectory:
         kwargs["trajectory"] = ["learned"]
@@ -140,7 +142,7 @@ def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target
     video = None
     if not args.no_video:
         video = "rollout.mp4"
-        stats = _video({"paths": paths, "source": source, "target": target}, args, tmp / video)
+        stats = _video({"paths": paths, "source": source, "target": target}, args, tmp / video, scenes)
         # results.json stays the same for the same seed: wall-clock timings go to timings.json
         out_json["rollout"] = {k: v for k, v in stats.items() if k not in TIMINGS} | {"video": str(final / video)}
         write_json_atomic(tmp / "timings.json", {"rollout": {k: stats[k] for k in TIMINGS if k in stats}})
@@ -205,7 +207,7 @@ def _states_along(robot: DiscreteRobot, start: int, steps: list[dict], goal: int
     return states
 
 
-def _video(result: dict, args, path: Path) -> dict:
+def _video(result: dict, args, path: Path, scenes: dict | None = None) -> dict:
     from armtransfer.ik.render import rollout_video
 
     paths = result["paths"]
@@ -216,6 +218,7 @@ def _video(result: dict, args, path: Path) -> dict:
             [(result["source"], paths["source_states"]), (result["target"], paths["target_states"])],
             path, trajectory_cells=paths["trajectory_cells"], goal_cell=paths["goal"],
             width=size[0], height=size[1], fps=fps,
+            scenes=[(scenes or {}).get(id(result[k])) for k in ("source", "target")],
         )
 
 

@@ -407,17 +407,22 @@ def rollout_video(rollouts: Sequence[tuple[object, Sequence[int]]],
                   path: str | os.PathLike, *, trajectory_cells: Sequence[int] = (),
                   goal_cell: int | None = None, width: int = 320, height: int = 240,
                   fps: float = 30.0, format: str | None = None, shadows: bool = False,
-                  replay_options: dict | None = None) -> dict:
+                  replay_options: dict | None = None, scenes: Sequence | None = None) -> dict:
     """Replay each (robot, path states) in MuJoCo and render them side by side to ``path``.
 
     ``trajectory_cells`` (the transferred trajectory) and ``goal_cell`` are marked in every
-    panel. Returns a JSON-able report: the video's stats and, per panel, the replay's
-    ``max_deviation_cells``, ``reached_goal`` and friends (``Replay.report()``).
+    panel. ``scenes``, one per rollout (None: rebuilt), are the robots' own scenes, e.g. those
+    ``check_replayable`` returned. Returns a JSON-able report: the video's stats and, per
+    panel, the replay's ``max_deviation_cells``, ``reached_goal`` and friends
+    (``Replay.report()``).
     """
     video_format(path, format)  # fail on bad input before the replays
     check_writable(path)
-    replays = [replay(robot, states, goal_cell=goal_cell, **(replay_options or {}))
-               for robot, states in rollouts]
+    scenes = list(scenes) if scenes is not None else [None] * len(rollouts)
+    if len(scenes) != len(rollouts):
+        raise RenderError(f"{len(scenes)} scenes for {len(rollouts)} rollouts")
+    replays = [replay(robot, states, goal_cell=goal_cell, scene=scene, **(replay_options or {}))
+               for (robot, states), scene in zip(rollouts, scenes)]
     panels = [RolloutPanel(rp, trajectory_cells, goal_cell) for rp in replays]
     stats = render_rollouts(panels, path, width=width, height=height, fps=fps, format=format,
                             shadows=shadows)

@@ -134,6 +134,28 @@ def test_rollout_video_report(robots, tmp_path):
     assert rep["replays"][0]["max_deviation_cells"] < 0.75
 
 
+def test_rollout_video_renders_from_a_scene_it_is_given(robots, tmp_path, monkeypatch):
+    from armtransfer.ik import replay as replay_module
+    from armtransfer.ik.replay import check_replayable
+
+    r = robots["planar2:cartesian"]
+    states, g = _path(r)
+    options = dict(goal_cell=g, width=64, height=48, fps=10,
+                   replay_options={"segment_seconds": 0.05, "settle_seconds": 0.0})
+    built = rollout_video([(r, states)], tmp_path / "built.gif", **options)
+    scene = check_replayable(r)
+
+    def no_rebuild(robot):
+        raise AssertionError("the scene was rebuilt")
+
+    monkeypatch.setattr(replay_module, "robot_scene", no_rebuild)
+    given = rollout_video([(r, states)], tmp_path / "given.gif", scenes=[scene], **options)
+    assert given["replays"] == built["replays"]
+    assert (tmp_path / "given.gif").read_bytes() == (tmp_path / "built.gif").read_bytes()
+    with pytest.raises(RenderError, match="1 scenes for 2 rollouts"):
+        rollout_video([(r, states), (r, states)], tmp_path / "two.gif", scenes=[scene], **options)
+
+
 def test_unknown_format_is_one_line_error(replays, tmp_path):
     with pytest.raises(RenderError) as err:
         render_rollouts([RolloutPanel(replays["planar2:cartesian"])], tmp_path / "x.avi")
