@@ -100,9 +100,10 @@ def test_no_transition_of_an_untried_pair_is_used(target_name, episodes):
     s0 = target.start_state(start)
     a = sarsa.learn(target, s0, goal, config, np.random.default_rng(1), shaping=sh, keep_q=True)
     assert a.episodes == episodes
-    # a pair tried gets a trace, an update and a planned value r + gamma V <= -1; an untried one
-    # stays at exactly 0
-    untried = a.Q == 0.0
+    # a pair tried gets a trace, an update and a planned value r + gamma V < 0; an untried one
+    # gets the plan's guide.UNTRIED, just above 0
+    untried = a.Q >= 0.0
+    assert np.all(a.Q[untried] == guide.UNTRIED)
     assert untried.sum() > (0.9 if episodes == 1 else 0.05) * untried.size  # pairs were left untried
     rng = np.random.default_rng(99)
     ns = target.next_state.copy()
@@ -197,10 +198,10 @@ def test_the_greedy_path_converges_to_a_shortest_one():
 
 
 def _residual(robot, Q, goal, gamma=0.99):
-    """Largest |Q(s, a) - (-1 + gamma max Q(s', .))| over the pairs with Q != 0 (tried), s' the
+    """Largest |Q(s, a) - (-1 + gamma max Q(s', .))| over the pairs with Q < 0 (tried), s' the
     table's successor (no wind: the one observed), 0 at the goal."""
     worst = 0.0
-    for s, a in zip(*np.nonzero(Q)):
+    for s, a in zip(*np.nonzero(Q < 0)):
         y = robot.next_state[s, a]
         target = -1.0 + (0.0 if robot.label[y] == goal else gamma * Q[y].max())
         worst = max(worst, abs(Q[s, a] - target))
@@ -209,7 +210,8 @@ def _residual(robot, Q, goal, gamma=0.99):
 
 def test_after_each_episode_the_tried_pairs_hold_their_planned_values():
     """Planning (``guide.plan``) makes every tried pair's Q exactly r + gamma V(s') on what robot 2
-    observed, untried pairs left at 0; SARSA(lambda) alone (plan=False) leaves them far from it."""
+    observed, untried pairs at guide.UNTRIED; SARSA(lambda) alone (plan=False) leaves them far
+    from it."""
     fine, coarse, start, goal = small_task()
     traj = trajectories.shortest(coarse, start, goal)
     config = LearnerConfig(max_episodes=6, patience=1000)
@@ -219,7 +221,8 @@ def test_after_each_episode_the_tried_pairs_hold_their_planned_values():
     plain = sarsa.learn(fine, s0, goal, config, np.random.default_rng(3), keep_q=True,
                         shaping=guided_shaping(fine, [traj], plan=False))
     assert planned.episode_steps[0] == plain.episode_steps[0]  # planning starts after the first exposure
-    assert np.count_nonzero(planned.Q) > 20
+    assert np.count_nonzero(planned.Q < 0) > 20
+    assert set(planned.Q[planned.Q >= 0].tolist()) == {guide.UNTRIED}
     assert _residual(fine, planned.Q, goal) == 0.0
     assert _residual(fine, plain.Q, goal) > 0.5
 

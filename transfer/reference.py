@@ -106,6 +106,10 @@ class GuideModel:
         states (``transfer.guide.plan``, written out plainly)."""
         tol = self.g.params[9]
         n_states, n_actions = Q.shape
+        for x in range(n_states):
+            for a in range(n_actions):
+                if (x, a) not in self.successors:
+                    Q[x, a] = guide_module.UNTRIED
         v = [float(Q[x].max()) for x in range(n_states)]
         queue = deque(sorted({s for s, _ in self.successors}))
         queued = set(queue)
