@@ -22,16 +22,28 @@ The model (all of it from what robot 2 observes):
     trajectory length, of |q - c_j| + (the trajectory's length from c_j to its end); lower is
     better. With several trajectories the smallest score counts.
 
+Planning, after every episode (``plan``): robot 2 also counts, for every pair (s, a) it has
+tried, the states s' it observed after it (with wind, how often each), and runs value iteration
+over those pairs on those counts: Q(s, a) = sum over s' of P(s' | s, a) (r + gamma max Q(s', .)).
+A pair never tried gets Q = UNTRIED, just above 0, an optimistic bound (every return is <= 0)
+that wins ties, so the planned
+greedy policy leads to the untried pairs that could still shorten the way, and once the greedy
+path reaches the goal no untried pair could make it shorter: the path is a shortest one (in
+expectation, with wind). Why: SARSA(lambda) evaluates the wandering policy that tried a pair,
+so pairs tried in long early episodes keep values far below their optimal ones and the greedy
+path never comes back to them; on planar2:joint it converged to paths 9-21% longer than the
+shortest (Table I tasks, 20 trials). Planning uses robot 2's own observed moves only.
+
 How it chooses, in the exploration phase only (the first ``episodes`` episodes; 1: until the
 goal is first reached): epsilon-greedy over Q(s, a) - weight * score(predicted label of a).
 An action never tried anywhere counts as the best, one tried at s and blocked every time as
 the worst. A wrong prediction (a wall, a joint limit, a cell it cannot reach) costs a step:
 the pair is then tried, its Q falls and its own observed effect replaces the prediction, so
-the learner's own exploration takes over there. After the exploration phase Algorithm 1
-chooses alone: the updates were SARSA(lambda)'s throughout, so the greedy path converges as
-SARSA(lambda)'s does, unbiased by the model. The model never reads the robot's transition
+the learner's own exploration takes over there. After the exploration phase Algorithm 1's
+epsilon-greedy chooses alone on Q: SARSA(lambda)'s updates during an episode, the plan after it;
+the displacement model never biases the greedy path. The model never reads the robot's transition
 table nor the map; the kernel reads ``next_state`` only to take the move chosen (a test
-changes every transition not tried in the first exposure and gets the same first exposure,
+changes every transition not tried in a run of several episodes and gets the same run,
 bit for bit; the convergence check after each episode, the experimenter's, follows the
 greedy path through the table as for every method)."""
 
@@ -77,6 +89,28 @@ coarse <-> fine and planar2:joint <-> ur5e_like:cartesian (``scripts/select_defa
 --method guided``: the smallest mean first exposure of the worst robot pair, 1.96x the optimal
 distance), never on Table I; EPISODES is the exploration phase, as for the mapping's macros;
 MEMORY was not tuned."""
+PLAN = True
+"""Whether robot 2 plans over the moves it has tried, after every episode (see :func:`plan`)."""
+PLAN_TOL = 1e-12
+"""A state's planned value that changes by at most this does not re-plan its predecessors.
+Without wind the values converge exactly (a change is never this small); with wind they
+converge geometrically. A numerical guard, not a tuned parameter: with 0 here one planning
+in 3 windy trials (wind 0.05) of ur5e_like:cartesian -> planar2:joint, Table I task 1, ran
+into PLAN_CAP, with 1e-12 none did; on 3 held-out pairs x 3 windy trials of that robot pair
+and of coarse -> fine neither ran into it (all 36 trials converged)."""
+PLAN_CAP = 1000
+"""Backups per planning at most, in units of robot 2's number of states (a guard: with gamma = 1
+a state whose every tried move loops has no finite value)."""
+UNTRIED = 1e-9
+"""The Q a plan gives every pair not yet tried: just above 0, the bound on every return, so that
+where a route through an untried pair ties with a tried one (the untried pair counts as ending
+the way at no cost) the untried one is preferred, by the greedy path and by epsilon-greedy
+alike, and gets tried. With 0 the lowest-index greedy path could keep such a pair while the
+episodes' uniform tie-breaking seldom took it: on the held-out pairs of ur5e_like:cartesian ->
+planar2:joint one trial in 40 never converged and one converged 1 step long (47 for 48). Far
+below any real difference: routes of L and L + 1 steps differ by gamma^L (0.0067 at L = 500)."""
+SUCCESSORS = 4
+"""Distinct observed successors kept per pair (a move and its wind push are at most 2)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -89,7 +123,8 @@ class Guide:
     ty: np.ndarray  # float64 [T]
     trem: np.ndarray  # float64 [T]: trajectory length (cells) from this cell to its end
     tstart: np.ndarray  # int64 [n_traj + 1]: where each trajectory starts in tx/ty/trem
-    params: np.ndarray  # float64 [8]: window, reach, knn, memory, weight, episodes, blocked (0/1), give_up
+    params: np.ndarray  # float64 [10]: window, reach, knn, memory, weight, episodes, blocked (0/1), give_up,
+    #                    plan (0/1), plan tolerance
 
     @property
     def memory(self) -> int:
@@ -98,7 +133,7 @@ class Guide:
 
 def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW, reach: float = REACH,
           knn: int = KNN, memory: int = MEMORY, weight: float = WEIGHT, episodes: int = EPISODES,
-          blocked: bool = BLOCKED, give_up: int = GIVE_UP) -> Guide:
+          blocked: bool = BLOCKED, give_up: int = GIVE_UP, plan: bool = PLAN) -> Guide:
     """The guide for ``robot`` following ``trajs`` (one or several)."""
     for name, v in (("window", window), ("reach", reach), ("weight", weight)):
         if not (np.isfinite(v) and v >= 0):
@@ -128,14 +163,15 @@ def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW,
         tx=np.concatenate(xs), ty=np.concatenate(ys), trem=np.concatenate(rem),
         tstart=np.array(starts, np.int64),
         params=np.array([float(window), float(reach), float(int(knn)), float(int(memory)), float(weight),
-                         float(int(episodes)), 1.0 if blocked else 0.0, float(int(give_up))]),
+                         float(int(episodes)), 1.0 if blocked else 0.0, float(int(give_up)),
+                         1.0 if plan else 0.0, PLAN_TOL]),
     )
 
 
 def inactive(n_actions: int) -> tuple:
     """(guide tuple, model tuple) for a trial without a guide: empty arrays of the right types."""
     g = (np.zeros((0, 1)), np.zeros((0, 2)), np.zeros(0), np.zeros(0), np.zeros(0),
-         np.zeros(1, np.int64), np.array([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0]))
+         np.zeros(1, np.int64), np.array([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]))
     return g, model_arrays(0, n_actions, 1, 1)
 
 
@@ -145,11 +181,23 @@ def as_tuple(g: Guide) -> tuple:
 
 def model_arrays(n_states: int, n_actions: int, memory: int, n_traj: int) -> tuple:
     """What the model learns during a trial: (displacement sums [S, A, 2], counts [S, A],
-    remembered states [A, memory], pushes per action [A], progress index per trajectory)."""
+    remembered states [A, memory], pushes per action [A], progress index per trajectory,
+    generalised [S, A], moved [S, A], moves without progress per trajectory), then what
+    :func:`plan` reads: the observed successors of each pair s * A + a (states [S*A, M], counts
+    [S*A, M], how many [S*A]), the observed predecessors of each state as a linked list in the
+    order first seen (head [S], tail [S], next [S*A*M], pair [S*A*M], edges used [1]), and
+    planning scratch (values [S], queue [S], queued [S], has a tried pair [S]) and its counts
+    (plannings, most backups in one, plannings that hit the cap)."""
+    pairs = n_states * n_actions
     return (np.zeros((n_states, n_actions, 2)), np.zeros((n_states, n_actions), np.int64),
             np.zeros((n_actions, memory), np.int64), np.zeros(n_actions, np.int64),
             np.zeros(max(n_traj, 1), np.int64), np.zeros((n_states, n_actions), np.bool_),
-            np.zeros((n_states, n_actions), np.bool_), np.zeros(max(n_traj, 1), np.int64))
+            np.zeros((n_states, n_actions), np.bool_), np.zeros(max(n_traj, 1), np.int64),
+            np.zeros((pairs, SUCCESSORS), np.int64), np.zeros((pairs, SUCCESSORS), np.int64),
+            np.zeros(pairs, np.int64), np.full(n_states, -1, np.int64), np.full(n_states, -1, np.int64),
+            np.full(pairs * SUCCESSORS, -1, np.int64), np.zeros(pairs * SUCCESSORS, np.int64),
+            np.zeros(1, np.int64), np.zeros(n_states), np.zeros(n_states, np.int64),
+            np.zeros(n_states, np.bool_), np.zeros(n_states, np.bool_), np.zeros(3, np.int64))
 
 
 @numba.njit(cache=True)
@@ -209,6 +257,121 @@ def observe(g, gm, s, a, s2):
         memory = int(params[3])
         buf[a, bufn[a] % memory] = s
         bufn[a] += 1
+    if params[8] > 0.0:
+        record_successor(gm, s * dcnt.shape[1] + a, s, s2)
+
+
+@numba.njit(cache=True)
+def record_successor(gm, sa, s, s2):
+    """Count s2 as an observed successor of the pair sa (at state s); a new one makes sa a
+    predecessor of s2."""
+    succ, scnt, nsucc = gm[8], gm[9], gm[10]
+    head, tail, enext, epair, nedge, has_pair = gm[11], gm[12], gm[13], gm[14], gm[15], gm[19]
+    has_pair[s] = True
+    for j in range(nsucc[sa]):
+        if succ[sa, j] == s2:
+            scnt[sa, j] += 1
+            return
+    j = nsucc[sa]
+    if j >= succ.shape[1]:
+        raise ValueError("more distinct successors of one move than the planner keeps (guide.SUCCESSORS)")
+    succ[sa, j] = s2
+    scnt[sa, j] = 1
+    nsucc[sa] = j + 1
+    e = nedge[0]
+    nedge[0] = e + 1
+    epair[e] = sa
+    if tail[s2] < 0:
+        head[s2] = e
+    else:
+        enext[tail[s2]] = e
+    tail[s2] = e
+
+
+@numba.njit(cache=True)
+def plan(g, gm, Q, label, goal, gamma, r_step, r_goal):
+    """Value iteration over the pairs robot 2 has tried, on what it observed of them, after an
+    episode: Q(s, a) = sum over the observed successors s' of (count / tries) * (r + gamma V(s')),
+    r = r_step (+ r_goal when s' is labelled the goal, where V = 0), V(s') = max over a' of
+    Q(s', a'). A pair never tried gets Q = UNTRIED, just above 0 (all returns are <= 0, so it is
+    an optimistic bound, and the plan leads to it). Returns the number of backups.
+
+    Order: every state with a tried pair, in index order, is queued; a state taken from the
+    front of the queue gets its tried pairs (in action order) backed up from the planned values
+    V of their successors; when its own V changes by more than the tolerance, V is set and every
+    predecessor not already queued is queued, in the order first observed. V starts as max Q.
+    The transitions read are those observed (never the robot's table)."""
+    params = g[6]
+    tol = params[9]
+    succ, scnt, nsucc = gm[8], gm[9], gm[10]
+    head, enext, epair = gm[11], gm[13], gm[14]
+    vp, queue, inq, has_pair = gm[16], gm[17], gm[18], gm[19]
+    n_states, n_actions = Q.shape
+    for x in range(n_states):
+        for a in range(n_actions):
+            if nsucc[x * n_actions + a] == 0:
+                Q[x, a] = UNTRIED
+        best = Q[x, 0]
+        for a in range(1, n_actions):
+            if Q[x, a] > best:
+                best = Q[x, a]
+        vp[x] = best
+    qh = 0
+    qn = 0
+    for x in range(n_states):
+        if has_pair[x]:
+            queue[(qh + qn) % n_states] = x
+            inq[x] = True
+            qn += 1
+    backups = 0
+    cap = PLAN_CAP * n_states
+    while qn > 0 and backups < cap:
+        x = queue[qh]
+        qh = (qh + 1) % n_states
+        qn -= 1
+        inq[x] = False
+        for a in range(n_actions):
+            sa = x * n_actions + a
+            k = nsucc[sa]
+            if k == 0:
+                continue
+            n = 0
+            for j in range(k):
+                n += scnt[sa, j]
+            acc = 0.0
+            for j in range(k):
+                y = succ[sa, j]
+                w = scnt[sa, j] / n  # exactly 1.0 for a single successor: equal paths get equal values
+                if label[y] == goal:
+                    acc += w * (r_step + r_goal)
+                else:
+                    acc += w * (r_step + gamma * vp[y])
+            Q[x, a] = acc
+            backups += 1
+        best = Q[x, 0]
+        for a in range(1, n_actions):
+            if Q[x, a] > best:
+                best = Q[x, a]
+        if abs(best - vp[x]) > tol:
+            vp[x] = best
+            e = head[x]
+            while e >= 0:
+                p = epair[e] // n_actions
+                if not inq[p]:
+                    queue[(qh + qn) % n_states] = p
+                    inq[p] = True
+                    qn += 1
+                e = enext[e]
+    stats = gm[20]
+    stats[0] += 1
+    stats[1] = max(stats[1], backups)
+    if qn > 0:
+        stats[2] += 1
+    while qn > 0:  # the cap was hit: leave the queue empty for the next planning
+        inq[queue[qh]] = False
+        qh = (qh + 1) % n_states
+        qn -= 1
+    return backups
 
 
 @numba.njit(cache=True)

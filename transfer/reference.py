@@ -7,8 +7,11 @@ same generator and ``trace_cutoff=0`` the two give bit-identical Q tables.
 
 from __future__ import annotations
 
+from collections import deque
+
 import numpy as np
 
+from armtransfer.learning import guide as guide_module
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.trajectory import Trajectory
@@ -40,6 +43,9 @@ class GuideModel:
         self.moved: set[tuple[int, int]] = set()  # pairs seen to move at least once
         self.n_traj = len(guide.tstart) - 1
         self.prog = [0] * self.n_traj
+        self.plans = guide.params[8] > 0
+        self.successors: dict[tuple[int, int], list[list[int]]] = {}  # (s, a) -> [[s2, count], ...] first seen first
+        self.preds: dict[int, list[int]] = {}  # s2 -> the states of the pairs it followed, first seen first
 
     def cells(self, t: int) -> range:
         return range(int(self.g.tstart[t]), int(self.g.tstart[t + 1]))
@@ -83,6 +89,55 @@ class GuideModel:
         entry[0] += g.lxy[s2][0] - g.lxy[s][0]
         entry[1] += g.lxy[s2][1] - g.lxy[s][1]
         entry[2] += 1
+        if self.plans:
+            seen = self.successors.setdefault((s, a), [])
+            for item in seen:
+                if item[0] == s2:
+                    item[1] += 1
+                    break
+            else:
+                if len(seen) >= guide_module.SUCCESSORS:
+                    raise ValueError("more distinct successors of one move than the planner keeps")
+                seen.append([s2, 1])
+                self.preds.setdefault(s2, []).append(s)
+
+    def plan(self, Q: np.ndarray, label: np.ndarray, goal: int, config: LearnerConfig) -> None:
+        """Value iteration over the tried pairs on their observed successors, with a queue of
+        states (``transfer.guide.plan``, written out plainly)."""
+        tol = self.g.params[9]
+        n_states, n_actions = Q.shape
+        for x in range(n_states):
+            for a in range(n_actions):
+                if (x, a) not in self.successors:
+                    Q[x, a] = guide_module.UNTRIED
+        v = [float(Q[x].max()) for x in range(n_states)]
+        queue = deque(sorted({s for s, _ in self.successors}))
+        queued = set(queue)
+        backups = 0
+        while queue and backups < guide_module.PLAN_CAP * n_states:
+            x = queue.popleft()
+            queued.discard(x)
+            for a in range(n_actions):
+                seen = self.successors.get((x, a))
+                if seen is None:
+                    continue
+                n = sum(c for _, c in seen)
+                total = 0.0
+                for y, c in seen:
+                    w = c / n
+                    if label[y] == goal:
+                        total += w * (config.step_reward + config.goal_reward)
+                    else:
+                        total += w * (config.step_reward + config.gamma * v[y])
+                Q[x, a] = total
+                backups += 1
+            best = float(Q[x].max())
+            if abs(best - v[x]) > tol:
+                v[x] = best
+                for p in self.preds.get(x, []):
+                    if p not in queued:
+                        queue.append(p)
+                        queued.add(p)
 
     def predict(self, s: int, a: int):
         if (s, a) in self.sums:
@@ -248,5 +303,7 @@ def learn(
             s, a = s2, a2
             if terminal:  # until s is terminal
                 break
+        if model is not None and model.plans:  # robot 2 plans over the moves it has tried
+            model.plan(Q, robot.label, goal_cell, config)
         steps_per_episode.append(steps)
     return Q, steps_per_episode

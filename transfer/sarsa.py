@@ -13,6 +13,9 @@ Faithful to Algorithm 1:
   * The shaping term r' is the paper's pseudo reward i*K on reaching the i-th trajectory
     state (``pseudo``), or one of the other methods in :mod:`transfer.rewards`.
 
+Method ``guided`` adds one step after every episode: value iteration over the pairs robot 2
+has tried, on the successors it observed (``transfer.guide.plan``); it draws nothing.
+
 The first episode's path, its loops erased, is kept as ``TrialResult.first_path`` for the
 online action sequence mapping (``experiment.online_mapping``); it draws nothing.
 
@@ -212,6 +215,7 @@ def _run_trial(
     has_macros = macro_actions.shape[0] > 0
     has_guide = g[5].shape[0] > 1  # the guide has at least one trajectory (transfer.guide)
     guide_episodes = int(g[6][5])
+    plan = g[6][8] > 0.0
     for ep in range(max_episodes):
         guided = has_guide and ep < guide_episodes  # the model chooses in the exploration phase
         use_macros = has_macros and ep < macro_episodes
@@ -313,6 +317,8 @@ def _run_trial(
             s = s2
             a = a2
         total += steps
+        if has_guide and plan:  # robot 2 plans over the moves it has tried (transfer.guide.plan)
+            _guide.plan(g, gm, Q, label, goal, gamma, r_step, r_goal)
         episode_steps[ep] = steps if reached else -steps
         macro_steps_out[ep] = macro_used
         episodes = ep + 1
