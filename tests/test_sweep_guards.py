@@ -91,8 +91,11 @@ def test_a_second_sweep_on_a_store_in_use_is_refused_in_one_line(tmp_path):
 
 @pytest.mark.parametrize("delay", [0.6, 1.5])  # inside the imports, and later
 def test_ctrl_c_during_start_up_is_one_line(tmp_path, delay):
+    # SIGINT back to its default in the child: a suite started in the background by a
+    # non-interactive shell inherits SIGINT ignored, and Python then never raises Ctrl-C
     proc = subprocess.Popen([sys.executable, "-m", "armtransfer.cli", "rooms", "--trials", "50"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     time.sleep(delay)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=120)
