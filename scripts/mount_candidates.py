@@ -2,10 +2,10 @@
 
 The automatic mount (``armtransfer.tasks.arms.automatic_mount``) ranks its candidates by a
 quick IK estimate and compiles only the best few. This script shows all of them: the
-estimate for each, then a full compile of the ``--compile`` first in the order the automatic
-mount compiles them (``compile_order``: the best by Table I cells reached then the estimate,
-then the best by the estimate alone), with the share of free cells reached and the Table I
-tasks solvable; the automatic mount takes the best of its first six. Use it to see why a mount was
+estimate for each, then a full compile of the poses the automatic mount compiles, in its
+order (``compile_order``: the best three by Table I cells reached then the estimate, then up
+to three more whose estimate beats one of those; ``--compile`` keeps the first N), with the
+share of free cells reached and the Table I tasks solvable. Use it to see why a mount was
 chosen, or to pick one by hand for ``--base-pos``/``--base-yaw``.
 
     python scripts/mount_candidates.py PATH.xml --tip-body Fixed_Jaw --tip-offset=-0.015,-0.13,0
@@ -31,7 +31,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--tip-body", default=None)
     p.add_argument("--tip-offset", default=None, metavar="X,Y,Z")
     p.add_argument("--compile", type=int, default=6, metavar="N",
-                   help="compile the first N of the automatic mount's order in full (default 6)")
+                   help="compile at most the first N of the automatic mount's compiles (default 6)")
     args = p.parse_args(argv)
     offset = parse_offset(args.tip_offset) if args.tip_offset else None
     tool = make_tool(args.tip_site, args.tip_body, offset)
@@ -42,8 +42,9 @@ def main(argv: list[str] | None = None) -> int:
           f"(share of a sparse lattice of free cells; Table I cells reached)")
     for hit, share, pose in rows:
         print(f"  {pose.describe()}: estimate {share:.1%}, Table I cells {hit}")
-    print(f"full compiles of the first {args.compile} in the automatic mount's order:")
-    for hit, share, pose in compile_order(rows, args.compile)[:args.compile]:
+    order = compile_order(rows)[:args.compile]
+    print(f"full compiles of the {len(order)} poses the automatic mount compiles, in its order:")
+    for hit, share, pose in order:
         robot = arm_robot(None, "cartesian", xml_path=path, tip_site=tool.site, tip_body=tool.body,
                           tip_offset=tool.offset, base_pos=pose.pos, base_yaw=pose.yaw)
         print(f"  --base-pos={','.join(f'{v:.4g}' for v in pose.pos)} --base-yaw={pose.yaw:.4g}: "

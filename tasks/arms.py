@@ -281,11 +281,14 @@ COMPILES = 3
 
 def compile_order(scored: list, n: int = COMPILES) -> list:
     """The poses of ``mount_search`` (best first) that ``automatic_mount`` compiles in full, in
-    order: the best ``n`` as ranked, then the ``n`` best by the estimate alone that are not
-    among them."""
+    order: the best ``n`` as ranked, then up to ``n`` more, best estimate first, whose
+    estimate beats the lowest of those (none when the ranking is by the estimate alone)."""
     first = scored[:n]
+    if not first:
+        return []
+    floor = min(t[1] for t in first)
     by_share = sorted(scored, key=lambda t: t[1], reverse=True)  # stable: ties keep their rank
-    return first + [t for t in by_share if t not in first][:n]
+    return first + [t for t in by_share if t not in first and t[1] > floor][:n]
 
 
 def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, layout: Layout = ROOMS,
@@ -293,18 +296,21 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
     """A base pose for an arm that came without one (``ik.mount.Pose``).
 
     The poses of :func:`mount_search` are ranked by their quick estimate. The best three (by
-    Table I cells reached, then the estimate) and the three with the best estimate alone are
-    compiled in full (the 1-cell cartesian model: reach is the tool's workspace, whatever
-    the action model), and the one with the most Table I tasks solvable, then the most free
-    cells reached, wins. (The estimate is a sparse lattice: for a small arm it can put a
-    pose that reaches more below one that reaches less.) The choice is cached under the arm file's content (meshes
-    included), tool, cell size and layout, so it is made once.
+    Table I cells reached, then the estimate), and up to three more whose estimate beats
+    one of those (:func:`compile_order`), are compiled in full (the 1-cell cartesian model:
+    reach is the tool's workspace, whatever the action model), and the one with the most
+    Table I tasks solvable, then the most free cells reached, wins; a pose that solves every
+    task and reaches every free cell ends the compiles. (The estimate is a sparse lattice:
+    for a small arm it can put a pose that reaches more below one that reaches less.) The
+    choice is cached under the arm file's content (meshes included), tool, cell size and
+    layout, so it is made once.
     """
     import json
 
     from armtransfer.ik import mount as _mount
+    from armtransfer.tasks.catalog import TABLE_I as _TABLE_I
 
-    parts = {"version": 7, "what": "mount", "covers": COVERS, "arm_xml": _sha(path.read_bytes()),
+    parts = {"version": 8, "what": "mount", "covers": COVERS, "arm_xml": _sha(path.read_bytes()),
              "assets": _assets_sha(path), "tool": tool.key(), "cell": cell_size, "yaw": yaw,
              "layout": _layout_data(layout), "stride": _mount.STRIDE, "gaps": _mount.GAPS,
              "grid": _mount.PLANAR_GRID, "lifts": _mount.LIFTS}
@@ -345,6 +351,8 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
         rank = (tasks_solvable(robot), robot.arm.reach)
         if best is None or rank > best[0]:
             best = (rank, pose)
+        if rank == (len(_TABLE_I), 1.0):  # every task and every free cell: nothing can beat it
+            break
     if best is None:
         raise unreachable
     pose = best[1]

@@ -91,3 +91,6 @@ def test_the_automatic_mount_compiles_the_best_ranked_then_the_best_estimates():
     order = [pose for *_, pose in compile_order(scored, 2)]
     assert order == ["a", "b", "e", "c"]
     assert [pose for *_, pose in compile_order(scored[:2], 3)] == ["a", "b"]
+    same = [(8, 0.9, "a"), (8, 0.8, "b"), (8, 0.7, "c")]  # ranked by the estimate alone: nothing to add
+    assert [pose for *_, pose in compile_order(same, 2)] == ["a", "b"]
+    assert compile_order([], 3) == []
