@@ -137,9 +137,8 @@ def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = 
             if free[n] and n not in q_of and attempts[n] < 3 and try_cell(n, q_of[c]):
                 queue.append(n)
     if not q_of:
-        axis = "" if not tip_down or scene.tool.has_offset else (
-            f", the tool pointing down (its axis is the tip {'site' if scene.tool.site else 'body'}'s z axis: "
-            "if the tool points another way, give --tip-offset along it)")
+        hint = scene.tool.axis_hint() if tip_down else ""
+        axis = f"; {hint}" if hint else ""
         raise UnreachableTableError(
             "the arm's tip cannot reach the table: IK finds no configuration with the tip "
             f"over a free cell, at most 1 cm above the tabletop{axis}")
@@ -193,11 +192,8 @@ def seed_cells(scene: ArmScene, home_tip: np.ndarray, n: int = 6) -> list[int]:
     table near its centre: the halfway point is then inside the circle no tool-down pose
     reaches)."""
     layout, cell = scene.layout, scene.cell
-    data = mujoco.MjData(scene.model)
-    data.qpos[:] = scene.home
-    mujoco.mj_kinematics(scene.model, data)
-    base = data.xanchor[int(np.argmin(scene.model.jnt_qposadr))][:2]
-    _, reach = reach_bound(scene)
+    anchor, reach = reach_bound(scene)  # the first joint's anchor at home: the base
+    base = anchor[:2]
     ring = [(base + 0.5 * reach * np.array([np.cos(t), np.sin(t)]), 1)
             for t in np.arange(RING) * 2 * np.pi / RING]
     out: list[int] = []

@@ -41,6 +41,14 @@ class Tool:
         """What the compiled arrays depend on (for the cache key)."""
         return {"site": self.site, "body": self.body, "offset": list(self.offset)}
 
+    def axis_hint(self) -> str:
+        """For errors when the tool cannot reach the table: without an offset its axis, kept
+        pointing down, is the site's (or body's) z axis, which may not be the tool's."""
+        if self.has_offset:
+            return ""
+        return (f"the tool's axis, kept pointing down, is the {'site' if self.site is not None else 'body'}'s "
+                "z axis: if the tool points another way, give --tip-offset along it")
+
     def describe(self) -> str:
         where = f"site {self.site}" if self.site is not None else f"body {self.body}"
         if self.has_offset:

@@ -326,9 +326,8 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
             pass
     from armtransfer.errors import UnreachableTableError
 
-    axis = ("" if tool.has_offset else
-            f"; the tool's axis, kept pointing down, is the {'site' if tool.site else 'body'}'s z axis: if the "
-            "tool points another way, give --tip-offset along it")
+    hint = tool.axis_hint()
+    axis = f"; {hint}" if hint else ""
     unreachable = UnreachableTableError(
         f"the arm's tool ({tool.describe()}) cannot reach the table from any base pose tried; give "
         f"--base-pos X,Y,Z and --base-yaw{axis}")

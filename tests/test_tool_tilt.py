@@ -94,3 +94,11 @@ def test_the_automatic_mount_compiles_the_best_ranked_then_the_best_estimates():
     same = [(8, 0.9, "a"), (8, 0.8, "b"), (8, 0.7, "c")]  # ranked by the estimate alone: nothing to add
     assert [pose for *_, pose in compile_order(same, 2)] == ["a", "b"]
     assert compile_order([], 3) == []
+
+
+def test_a_tool_without_offset_says_its_axis_is_the_frames_z_axis():
+    from armtransfer.ik.tool import Tool
+
+    assert "site's z axis" in Tool(site="tcp").axis_hint() and "--tip-offset" in Tool(site="tcp").axis_hint()
+    assert "body's z axis" in Tool(site=None, body="jaw").axis_hint()
+    assert Tool(site="tcp", offset=(0.0, 0.0, 0.1)).axis_hint() == ""
