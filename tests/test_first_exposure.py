@@ -320,3 +320,46 @@ def test_the_benchmark_script_refuses_bad_input_in_one_line(tmp_path):
         proc = subprocess.run([sys.executable, str(SCRIPT), *args], capture_output=True, text=True, timeout=120)
         assert proc.returncode == 2
         assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr
+
+
+BOUNDS = SCRIPT.parent / "first_exposure_bounds.py"
+
+
+def test_the_bounds_script_gives_the_learner_the_trajectories_it_claims(tmp_path):
+    import importlib.util
+    import json
+    import subprocess
+    import sys
+
+    from armtransfer.tasks.specs import resolve
+
+    spec = importlib.util.spec_from_file_location("first_exposure_bounds", BOUNDS)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    src, dst = resolve("ur5e_like:cartesian"), resolve("planar2:joint")
+    start, goal = TABLE_I[1].cells()
+    traj = experiment.source_trajectory("learned", src, start, goal, LearnerConfig(), 0)  # the script's
+    labels = set(np.unique(dst.label).tolist())
+    cut = mod.reachable_only(traj, dst)
+    assert all(int(c) in labels for c in cut.cells) and cut.goal == traj.goal
+    assert len(cut) == sum(int(c) in labels for c in traj.cells) < len(traj)  # task 1 crosses cells it cannot reach
+    own = mod.own_path(dst, start, goal)
+    path = dst.shortest_path(dst.start_state(start), goal)
+    assert own.cells[0] == start and own.goal == goal
+    assert all(a != b for a, b in zip(own.cells, own.cells[1:]))  # repeats in a row merged
+    assert set(own.cells) == {int(dst.label[s]) for s, _ in path[:-1]}
+
+    out = tmp_path / "b"
+    proc = subprocess.run([sys.executable, str(BOUNDS), "--fast", "--out", str(out)], capture_output=True,
+                          text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    data = json.loads((out / "first_exposure_bounds.json").read_text())
+    (row,) = data["rows"]
+    assert row["unreachable_cells"] == len(traj) - len(cut) and row["cells"]["trajectory"] == len(traj)
+    for name in mod.VARIANTS:
+        assert len(row["stats"][name]["exploration_steps"]) == data["trials"] == 2  # every trial counted
+    assert "target's own shortest path" in (out / "first_exposure_bounds.md").read_text()
+    for args in (["--tasks", "9", "--out", str(tmp_path / "c")], ["--target", "nope", "--out", str(tmp_path / "d")]):
+        proc = subprocess.run([sys.executable, str(BOUNDS), *args], capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+        assert not (tmp_path / args[-1]).exists()
