@@ -54,6 +54,7 @@ from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.learning.config import LearnerConfig
 
 from armtransfer.learning import guide as _guide
+from armtransfer.learning import jitcache as _jitcache
 from armtransfer.learning.shaping import (  # noqa: E402  (the kernel's shaping modes)
     MODE_FIRST_VISIT,
     MODE_NONE,
@@ -462,3 +463,8 @@ def learn(
 def _greedy_action(Q: np.ndarray, s: int) -> int:
     """argmax with the lowest index on ties, as the kernel's greedy path uses."""
     return int(np.argmax(Q[s]))
+
+
+# The kernels above call the guide's jitted functions; numba's cache does not notice an edit to
+# guide.py alone (``jitcache``), so their cache is emptied when that file changes.
+_jitcache.invalidate_stale(__name__, [_egreedy, _choose, _greedy_path, _shaping, _run_trial], [_guide.__file__])
