@@ -2,7 +2,7 @@
 
 Numba keys a cached kernel on its own file's time stamp and its own bytecode, not on the jitted
 functions it calls from other files. So after an edit to ``guide.py`` alone, ``sarsa.py``'s
-cached ``_run_trial`` (which inlines the guide's functions) would load, still running the old
+cached trial kernels (which inline the guide's functions) would load, still running the old
 guide, and a run would silently measure code that is no longer there.
 
 :func:`invalidate_stale` closes that gap: the caller names its cached kernels and the files they

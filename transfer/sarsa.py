@@ -154,200 +154,216 @@ def _shaping(mode, s, s2, terminal, bonus, traj_index, phi, gamma, paid_stamp, e
     return 0.0, best
 
 
-@numba.njit(cache=True)
-def _run_trial(
-    next_state,
-    wind_state,
-    label,
-    start,
-    goal,
-    mode,
-    bonus,
-    traj_index,
-    phi,
-    macro_start,
-    macro_len,
-    macro_actions,
-    macro_episodes,
-    alpha,
-    gamma,
-    lam,
-    eps,
-    r_step,
-    r_goal,
-    wind_p,
-    cutoff,
-    max_episodes,
-    max_total_steps,
-    max_episode_steps,
-    patience,
-    rng,
-    g,
-    gm,
-    Q,
-    episode_steps,
-    greedy_len,
-    macro_steps_out,
-    path_buf,
-    prev_path,
-    fp_states,
-    fp_actions,
-):
-    n_states, n_actions = next_state.shape
-    # the first episode's path with its loops erased (for the online action sequence mapping):
-    # fp_states[0..fp_n-1], fp_actions[i] taken at fp_states[i]; fp_pos: a state's place in it
-    fp_pos = np.full(n_states, -1, np.int64)
-    fp_n = 0
-    n_traj = traj_index.max() + 1 if traj_index.shape[0] > 0 else 1
-    paid_stamp = np.full(max(n_traj, 1), -1, np.int64)
-    stamp = np.full(n_states, -1, np.int64)
-    # sparse traces: tr_sa holds s * n_actions + a, pos maps a pair to its slot
-    cap = n_states * n_actions
-    tr_sa = np.empty(cap, np.int64)
-    tr_e = np.empty(cap, np.float64)
-    pos = np.full(cap, -1, np.int64)
-    n_tr = 0
-    decay = gamma * lam
-    total = 0
-    prev_n = 0
-    stable = 0
-    converged_episode = -1
-    episodes = 0
-    has_macros = macro_actions.shape[0] > 0
-    has_guide = g[5].shape[0] > 1  # the guide has at least one trajectory (transfer.guide)
-    guide_episodes = int(g[6][5])
-    plan = g[6][8] > 0.0
-    for ep in range(max_episodes):
-        guided = has_guide and ep < guide_episodes  # the model chooses in the exploration phase
-        use_macros = has_macros and ep < macro_episodes
-        # reset traces
-        for k in range(n_tr):
-            pos[tr_sa[k]] = -1
+def _make_run_trial(with_guide: bool):
+    """The trial kernel, compiled with or without the guide (``with_guide``, a constant to numba).
+
+    Why two: the guide's arrays and per-step calls in the loop cost the plain methods about a
+    quarter of their speed even where a run has no guide (``armtransfer bench``, BENCHMARKS.md);
+    compiled without it, the loop is the plain Algorithm 1 alone. Both come from this one body,
+    so they cannot drift apart; numba caches each (the constant is part of its cache key)."""
+
+    @numba.njit(cache=True)
+    def _run_trial(
+        next_state,
+        wind_state,
+        label,
+        start,
+        goal,
+        mode,
+        bonus,
+        traj_index,
+        phi,
+        macro_start,
+        macro_len,
+        macro_actions,
+        macro_episodes,
+        alpha,
+        gamma,
+        lam,
+        eps,
+        r_step,
+        r_goal,
+        wind_p,
+        cutoff,
+        max_episodes,
+        max_total_steps,
+        max_episode_steps,
+        patience,
+        rng,
+        g,
+        gm,
+        Q,
+        episode_steps,
+        greedy_len,
+        macro_steps_out,
+        path_buf,
+        prev_path,
+        fp_states,
+        fp_actions,
+    ):
+        n_states, n_actions = next_state.shape
+        # the first episode's path with its loops erased (for the online action sequence mapping):
+        # fp_states[0..fp_n-1], fp_actions[i] taken at fp_states[i]; fp_pos: a state's place in it
+        fp_pos = np.full(n_states, -1, np.int64)
+        fp_n = 0
+        n_traj = traj_index.max() + 1 if traj_index.shape[0] > 0 else 1
+        paid_stamp = np.full(max(n_traj, 1), -1, np.int64)
+        stamp = np.full(n_states, -1, np.int64)
+        # sparse traces: tr_sa holds s * n_actions + a, pos maps a pair to its slot
+        cap = n_states * n_actions
+        tr_sa = np.empty(cap, np.int64)
+        tr_e = np.empty(cap, np.float64)
+        pos = np.full(cap, -1, np.int64)
         n_tr = 0
-        s = start
-        best = 0.0
-        if has_guide:
-            _guide.reset_progress(g, gm, s)
-        # choose the first action (m_pos: position in the running macro, m_end: its end)
-        a, in_macro, m_pos, m_end, macro_used = _choose(
-            Q, s, eps, rng, False, 0, 0, use_macros, macro_start, macro_len, macro_actions, guided, g, gm
-        )
-        if ep == 0:
-            fp_states[0] = s
-            fp_pos[s] = 0
-            fp_n = 1
-        steps = 0
-        reached = False
-        limit = max_total_steps - total
-        if ep > 0 and max_episode_steps < limit:
-            limit = max_episode_steps
-        while steps < limit:
-            s2 = next_state[s, a]
-            if wind_p > 0.0 and rng.random() < wind_p:
-                s2 = wind_state[s2]
-            blocked = s2 == s  # what the robot observes: it did not move (after wind)
-            steps += 1
-            if ep == 0:  # loop erasure: back to s2's place if it is on the path, else append it
-                fp_actions[fp_n - 1] = a
-                p2 = fp_pos[s2]
-                if p2 >= 0:
-                    for i in range(p2 + 1, fp_n):
-                        fp_pos[fp_states[i]] = -1
-                    fp_n = p2 + 1
-                else:
-                    fp_states[fp_n] = s2
-                    fp_pos[s2] = fp_n
-                    fp_n += 1
-            if has_guide:  # robot 2 records what its move did to the label it perceives
-                _guide.observe(g, gm, s, a, s2)
-                _guide.update_progress(g, gm, s2)
-            terminal = label[s2] == goal
-            r = r_step
-            if terminal:
-                r += r_goal
-            if mode != MODE_NONE:
-                term, best = _shaping(
-                    mode, s, s2, terminal, bonus, traj_index, phi, gamma, paid_stamp, ep, best
-                )
-                r += term
-            if terminal:
-                q_next = 0.0
-                a2 = 0
-            else:
-                abandoned = False
-                if in_macro and (blocked or m_pos >= m_end):
-                    abandoned = blocked
-                    in_macro = False
-                # right after an abandoned macro, Algorithm 1 chooses (no immediate retry)
-                a2, in_macro, m_pos, m_end, used = _choose(
-                    Q, s2, eps, rng, in_macro, m_pos, m_end, use_macros and not abandoned,
-                    macro_start, macro_len, macro_actions, guided, g, gm,
-                )
-                macro_used += used
-                q_next = Q[s2, a2]
-            sa = s * n_actions + a
-            delta = r + gamma * q_next - Q[s, a]
-            p = pos[sa]
-            if p < 0:
-                pos[sa] = n_tr
-                tr_sa[n_tr] = sa
-                tr_e[n_tr] = 1.0
-                n_tr += 1
-            else:
-                tr_e[p] += 1.0
-            k = 0
-            while k < n_tr:
-                pair = tr_sa[k]
-                e = tr_e[k]
-                Q[pair // n_actions, pair % n_actions] += alpha * delta * e
-                e *= decay
-                if e < cutoff or e == 0.0:
-                    # drop: move the last trace into this slot
-                    pos[pair] = -1
-                    n_tr -= 1
-                    if k < n_tr:
-                        tr_sa[k] = tr_sa[n_tr]
-                        tr_e[k] = tr_e[n_tr]
-                        pos[tr_sa[k]] = k
-                    continue
-                tr_e[k] = e
-                k += 1
-            if terminal:
-                reached = True
-                break
-            s = s2
-            a = a2
-        total += steps
-        if has_guide and plan:  # robot 2 plans over the moves it has tried (transfer.guide.plan)
-            _guide.plan(g, gm, Q, label, goal, gamma, r_step, r_goal)
-        episode_steps[ep] = steps if reached else -steps
-        macro_steps_out[ep] = macro_used
-        episodes = ep + 1
-        n = _greedy_path(Q, next_state, label, start, goal, stamp, ep, path_buf)
-        greedy_len[ep] = n - 1 if n > 0 else -1
-        same = n > 0 and n == prev_n
-        if same:
-            for i in range(n):
-                if path_buf[i] != prev_path[i]:
-                    same = False
-                    break
-        if same:
-            stable += 1
-        else:
-            stable = 0
-            converged_episode = ep if n > 0 else -1
-            prev_n = n
-            for i in range(abs(n)):
-                prev_path[i] = path_buf[i]
-        if n > 0 and stable >= patience:
-            break
-        if total >= max_total_steps:
-            break
-    if stable < patience:
+        decay = gamma * lam
+        total = 0
+        prev_n = 0
+        stable = 0
         converged_episode = -1
-    if not (episodes > 0 and episode_steps[0] > 0):
-        fp_n = 0  # the first episode did not reach the goal: no path
-    return episodes, converged_episode, prev_n, fp_n
+        episodes = 0
+        has_macros = macro_actions.shape[0] > 0
+        has_guide = with_guide and g[5].shape[0] > 1  # the guide has at least one trajectory (transfer.guide)
+        guide_episodes = int(g[6][5])
+        plan = g[6][8] > 0.0
+        for ep in range(max_episodes):
+            guided = has_guide and ep < guide_episodes  # the model chooses in the exploration phase
+            use_macros = has_macros and ep < macro_episodes
+            # reset traces
+            for k in range(n_tr):
+                pos[tr_sa[k]] = -1
+            n_tr = 0
+            s = start
+            best = 0.0
+            if has_guide:
+                _guide.reset_progress(g, gm, s)
+            # choose the first action (m_pos: position in the running macro, m_end: its end)
+            a, in_macro, m_pos, m_end, macro_used = _choose(
+                Q, s, eps, rng, False, 0, 0, use_macros, macro_start, macro_len, macro_actions, guided, g, gm
+            )
+            if ep == 0:
+                fp_states[0] = s
+                fp_pos[s] = 0
+                fp_n = 1
+            steps = 0
+            reached = False
+            limit = max_total_steps - total
+            if ep > 0 and max_episode_steps < limit:
+                limit = max_episode_steps
+            while steps < limit:
+                s2 = next_state[s, a]
+                if wind_p > 0.0 and rng.random() < wind_p:
+                    s2 = wind_state[s2]
+                blocked = s2 == s  # what the robot observes: it did not move (after wind)
+                steps += 1
+                if ep == 0:  # loop erasure: back to s2's place if it is on the path, else append it
+                    fp_actions[fp_n - 1] = a
+                    p2 = fp_pos[s2]
+                    if p2 >= 0:
+                        for i in range(p2 + 1, fp_n):
+                            fp_pos[fp_states[i]] = -1
+                        fp_n = p2 + 1
+                    else:
+                        fp_states[fp_n] = s2
+                        fp_pos[s2] = fp_n
+                        fp_n += 1
+                if has_guide:  # robot 2 records what its move did to the label it perceives
+                    _guide.observe(g, gm, s, a, s2)
+                    _guide.update_progress(g, gm, s2)
+                terminal = label[s2] == goal
+                r = r_step
+                if terminal:
+                    r += r_goal
+                if mode != MODE_NONE:
+                    term, best = _shaping(
+                        mode, s, s2, terminal, bonus, traj_index, phi, gamma, paid_stamp, ep, best
+                    )
+                    r += term
+                if terminal:
+                    q_next = 0.0
+                    a2 = 0
+                else:
+                    abandoned = False
+                    if in_macro and (blocked or m_pos >= m_end):
+                        abandoned = blocked
+                        in_macro = False
+                    # right after an abandoned macro, Algorithm 1 chooses (no immediate retry)
+                    a2, in_macro, m_pos, m_end, used = _choose(
+                        Q, s2, eps, rng, in_macro, m_pos, m_end, use_macros and not abandoned,
+                        macro_start, macro_len, macro_actions, guided, g, gm,
+                    )
+                    macro_used += used
+                    q_next = Q[s2, a2]
+                sa = s * n_actions + a
+                delta = r + gamma * q_next - Q[s, a]
+                p = pos[sa]
+                if p < 0:
+                    pos[sa] = n_tr
+                    tr_sa[n_tr] = sa
+                    tr_e[n_tr] = 1.0
+                    n_tr += 1
+                else:
+                    tr_e[p] += 1.0
+                k = 0
+                while k < n_tr:
+                    pair = tr_sa[k]
+                    e = tr_e[k]
+                    Q[pair // n_actions, pair % n_actions] += alpha * delta * e
+                    e *= decay
+                    if e < cutoff or e == 0.0:
+                        # drop: move the last trace into this slot
+                        pos[pair] = -1
+                        n_tr -= 1
+                        if k < n_tr:
+                            tr_sa[k] = tr_sa[n_tr]
+                            tr_e[k] = tr_e[n_tr]
+                            pos[tr_sa[k]] = k
+                        continue
+                    tr_e[k] = e
+                    k += 1
+                if terminal:
+                    reached = True
+                    break
+                s = s2
+                a = a2
+            total += steps
+            if has_guide and plan:  # robot 2 plans over the moves it has tried (transfer.guide.plan)
+                _guide.plan(g, gm, Q, label, goal, gamma, r_step, r_goal)
+            episode_steps[ep] = steps if reached else -steps
+            macro_steps_out[ep] = macro_used
+            episodes = ep + 1
+            n = _greedy_path(Q, next_state, label, start, goal, stamp, ep, path_buf)
+            greedy_len[ep] = n - 1 if n > 0 else -1
+            same = n > 0 and n == prev_n
+            if same:
+                for i in range(n):
+                    if path_buf[i] != prev_path[i]:
+                        same = False
+                        break
+            if same:
+                stable += 1
+            else:
+                stable = 0
+                converged_episode = ep if n > 0 else -1
+                prev_n = n
+                for i in range(abs(n)):
+                    prev_path[i] = path_buf[i]
+            if n > 0 and stable >= patience:
+                break
+            if total >= max_total_steps:
+                break
+        if stable < patience:
+            converged_episode = -1
+        if not (episodes > 0 and episode_steps[0] > 0):
+            fp_n = 0  # the first episode did not reach the goal: no path
+        return episodes, converged_episode, prev_n, fp_n
+
+    return _run_trial
+
+
+_run_trial = _make_run_trial(False)
+"""The kernel for a run without a guide."""
+_run_trial_guided = _make_run_trial(True)
+"""The kernel for method ``guided``."""
 
 
 @dataclass
@@ -421,7 +437,8 @@ def learn(
     prev_path = np.zeros(n + 1, np.int64)
     fp_states = np.zeros(n + 1, np.int64)
     fp_actions = np.zeros(n + 1, np.int64)
-    episodes, conv_ep, path_n, fp_n = _run_trial(
+    kernel = _run_trial if guide is None else _run_trial_guided
+    episodes, conv_ep, path_n, fp_n = kernel(
         robot.next_state, robot.wind_state, robot.label, int(start_state), int(goal_cell),
         sh.mode, sh.bonus, sh.traj_index, sh.phi,
         m_start, m_len, m_actions, config.max_episodes if m_episodes is None else int(m_episodes),
@@ -467,4 +484,4 @@ def _greedy_action(Q: np.ndarray, s: int) -> int:
 
 # The kernels above call the guide's jitted functions; numba's cache does not notice an edit to
 # guide.py alone (``jitcache``), so their cache is emptied when that file changes.
-_jitcache.invalidate_stale(__name__, [_egreedy, _choose, _greedy_path, _shaping, _run_trial], [_guide.__file__])
+_jitcache.invalidate_stale(__name__, [_egreedy, _choose, _greedy_path, _shaping, _run_trial, _run_trial_guided], [_guide.__file__])
