@@ -363,3 +363,41 @@ def test_the_bounds_script_gives_the_learner_the_trajectories_it_claims(tmp_path
         proc = subprocess.run([sys.executable, str(BOUNDS), *args], capture_output=True, text=True, timeout=120)
         assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
         assert not (tmp_path / args[-1]).exists()
+
+
+CHECK = SCRIPT.parent / "online_mapping_check.py"
+
+
+def test_the_mapping_check_counts_what_macros_do(tmp_path):
+    import importlib.util
+    import json
+    import subprocess
+    import sys
+
+    spec = importlib.util.spec_from_file_location("online_mapping_check", CHECK)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    fine = grid_robot("fine")
+    start, goal = TABLE_I[1].cells()
+    traj = trajectories.shortest(fine, start, goal)
+    same = ActionMapping.for_robots(fine, fine)  # each action mapped to itself: does what robot 1 did
+    flipped = ActionMapping.for_robots(fine, fine)  # F <-> B, R <-> L: the opposite move
+    for a, b in ((0, 1), (1, 0), (2, 3), (3, 2)):
+        same.add((a,), (a,))
+        flipped.add((a,), (b,))
+    right, wrong = mod.check_macros(same, traj, fine), mod.check_macros(flipped, traj, fine)
+    assert right["runs"] == wrong["runs"] == right["cells_with_macro"] == len(set(traj.cells))  # one state per cell
+    assert right["ends_at_robot1_cell"] == right["ends_closer"] == right["runs"]
+    assert wrong["ends_at_robot1_cell"] == 0 and wrong["ends_closer"] == 0
+
+    out = tmp_path / "m"
+    proc = subprocess.run([sys.executable, str(CHECK), "--fast", "--out", str(out)], capture_output=True,
+                          text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    data = json.loads((out / "online_mapping_check.json").read_text())
+    assert [(r["pair"], r["task"]) for r in data["rows"]] == [("coarse → fine", 2), ("fine → coarse", 2)]
+    for r in data["rows"]:
+        assert r["runs"] > 0 and max(r["ends_at_robot1_cell"], r["ends_closer"]) <= r["runs"]
+    proc = subprocess.run([sys.executable, str(CHECK), "--trials", "0", "--out", str(tmp_path / "n")],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1 and not (tmp_path / "n").exists()
