@@ -186,3 +186,18 @@ def test_reproduce_refuses_a_non_empty_out_in_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "not empty" in err
     assert [p.name for p in out.iterdir()] == ["old.txt"]
+
+
+def test_bench_kernels_fast_mode_times_both_kernels_and_refuses_a_bad_revision():
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parents[1] / "scripts" / "bench_kernels.py"
+    proc = subprocess.run([sys.executable, str(script), "--fast"], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert "plain kernel (no guide compiled in): median" in proc.stdout
+    assert "guided kernel, run without a guide: median" in proc.stdout
+    proc = subprocess.run([sys.executable, str(script), "--fast", "--against", "no-such-revision"],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr

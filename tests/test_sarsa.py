@@ -128,3 +128,26 @@ def test_config_rejects_out_of_range_parameters():
         LearnerConfig(epsilon=1.5)
     with pytest.raises(InvalidParameterError, match="alpha"):
         LearnerConfig(alpha=0)
+
+
+def test_the_plain_kernel_is_the_guided_kernel_without_a_guide_bit_for_bit():
+    """The kernel is compiled twice from one body (``sarsa._make_run_trial``); with no guide the
+    one without the guide compiled in must learn exactly what the other does."""
+    from armtransfer.tasks.catalog import TABLE_I
+
+    S = sarsa
+    robot = grid_robot("coarse")
+    start, goal = TABLE_I[2].cells()
+    config = LearnerConfig(max_episodes=30)
+    runs = []
+    for kernel in (S._run_trial, S._run_trial_guided):
+        plain, S._run_trial = S._run_trial, kernel
+        try:
+            runs.append(S.learn(robot, robot.start_state(start), goal, config, np.random.default_rng(7), wind=0.1,
+                                keep_q=True))
+        finally:
+            S._run_trial = plain
+    a, b = runs
+    assert S._run_trial is not S._run_trial_guided
+    assert np.array_equal(a.Q, b.Q) and np.array_equal(a.episode_steps, b.episode_steps)
+    assert a.greedy_path == b.greedy_path and a.first_path == b.first_path and a.episodes == b.episodes == 30
