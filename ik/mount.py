@@ -33,7 +33,7 @@ import numpy as np
 
 from armtransfer.ik.compile import SEED_RESTARTS, reach_bound, seed_cells
 from armtransfer.ik.labels import cells_of_xy
-from armtransfer.ik.scene import ArmScene, ContactChecker, build_scene
+from armtransfer.ik.scene import ArmScene, ContactChecker, base_footing, build_scene
 from armtransfer.ik.solve import TIP_HEIGHT, TipIK
 from armtransfer.ik.tool import Tool
 
@@ -72,26 +72,9 @@ def _tip_at(scene: ArmScene, q: np.ndarray) -> np.ndarray:
 
 
 def _base(scene: ArmScene) -> tuple[np.ndarray, float]:
-    """Where the arm's base is in its file's frame: the (x, y) of its first joint's axis and
-    the height of the bottom of the geometry no joint moves (the stand it comes on), or of
-    that joint's anchor when nothing is fixed. A file may put its base far from its origin."""
-    model = scene.model
-    data = mujoco.MjData(model)
-    data.qpos[:] = scene.home
-    mujoco.mj_kinematics(model, data)
-    anchor = data.xanchor[int(np.argmin(model.jnt_qposadr))]
-    table = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "table")
-    fixed = [g for g in range(model.ngeom)
-             if model.geom_bodyid[g] not in (0, table) and model.body_weldid[model.geom_bodyid[g]] == 0]
-    bottom = float(anchor[2])
-    for g in fixed:
-        if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH:  # its vertices: a mesh's box is loose
-            m = model.geom_dataid[g]
-            points = model.mesh_vert[model.mesh_vertadr[m]:model.mesh_vertadr[m] + model.mesh_vertnum[m]]
-        else:
-            centre, half = model.geom_aabb[g, :3], model.geom_aabb[g, 3:]
-            points = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half + centre
-        bottom = min(bottom, float(np.min(data.geom_xpos[g][2] + points @ data.geom_xmat[g].reshape(3, 3)[2])))
+    """Where the arm's base is in its file's frame (``ik.scene.base_footing``): a file may put
+    its base far from its origin."""
+    anchor, bottom = base_footing(scene.model, scene.home)
     return anchor[:2].copy(), bottom
 
 

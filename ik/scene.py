@@ -17,7 +17,8 @@ Any MJCF serial arm works as it is, MuJoCo Menagerie files included (class names
   actuators the file has.
 - The file's keyframes are dropped (the scene keeps the arm's home separately), its options
   are the scene's, and the whole arm is attached under the prefix ``arm/`` at its mounting
-  pose.
+  pose. A base mounted above the tabletop stands on a drawn column, ``pedestal``, that
+  collides with nothing.
 """
 
 from __future__ import annotations
@@ -43,6 +44,10 @@ PREFIX = "arm/"
 TOOL_SITE = "tool_tip"
 SERVO_KP = 100.0
 """Stiffness of a servo the scene adds (N m/rad); a replay retunes every servo anyway."""
+PEDESTAL = "pedestal"
+"""Name of the column drawn under a base mounted above the tabletop (``mount_pos`` z > 0)."""
+PEDESTAL_RADIUS = 0.05
+"""Its radius (m). It is drawn only: it collides with nothing and is not part of the table."""
 
 
 @dataclass(frozen=True)
@@ -79,6 +84,31 @@ class ArmScene:
 
     def digest(self) -> str:
         return hashlib.sha256(self.xml.encode()).hexdigest()
+
+
+def base_footing(model: mujoco.MjModel, qpos: np.ndarray) -> tuple[np.ndarray, float]:
+    """(the first joint's anchor, the height of the bottom of the geometry no joint moves) in
+    the model's world frame at ``qpos``: where the arm's base stands. The bottom is the
+    anchor's height when nothing is fixed. The table, its walls and the pedestal do not count.
+    Mesh geoms count by their vertices (a mesh's box is loose), others by their box."""
+    data = mujoco.MjData(model)
+    data.qpos[:] = qpos
+    mujoco.mj_kinematics(model, data)
+    anchor = data.xanchor[int(np.argmin(model.jnt_qposadr))].copy()
+    scenery = {mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, n) for n in ("table", PEDESTAL)} | {0}
+    bottom = float(anchor[2])
+    for g in range(model.ngeom):
+        body = model.geom_bodyid[g]
+        if body in scenery or model.body_weldid[body] != 0:
+            continue
+        if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH:
+            m = model.geom_dataid[g]
+            points = model.mesh_vert[model.mesh_vertadr[m]:model.mesh_vertadr[m] + model.mesh_vertnum[m]]
+        else:
+            centre, half = model.geom_aabb[g, :3], model.geom_aabb[g, 3:]
+            points = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half + centre
+        bottom = min(bottom, float(np.min(data.geom_xpos[g][2] + points @ data.geom_xmat[g].reshape(3, 3)[2])))
+    return anchor, bottom
 
 
 def _first_line(err: BaseException) -> str:
@@ -280,6 +310,22 @@ def _copy_options(src: mujoco.MjSpec, dst: mujoco.MjSpec) -> None:
             pass
 
 
+def _pedestal(scene_spec: mujoco.MjSpec, model: mujoco.MjModel, q: np.ndarray, mount_pos, mount_yaw: float,
+              half: float) -> None:
+    """Draw a column from the tabletop up to a base mounted above it, so that the arm does not
+    float in a video. Only a base over the table gets one; it collides with nothing."""
+    anchor, bottom = base_footing(model, q)
+    c, s = math.cos(mount_yaw), math.sin(mount_yaw)
+    x = float(mount_pos[0]) + c * anchor[0] - s * anchor[1]
+    y = float(mount_pos[1]) + s * anchor[0] + c * anchor[1]
+    lift = float(mount_pos[2]) + bottom
+    if lift <= 1e-4 or abs(x) > half or abs(y) > half:
+        return
+    column = scene_spec.worldbody.add_body(name=PEDESTAL, pos=[x, y, lift / 2])
+    column.add_geom(name=PEDESTAL, type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=[PEDESTAL_RADIUS, lift / 2, 0.0],
+                    material="wall_mat", contype=0, conaffinity=0)
+
+
 def build_scene(xml_path: Path, tool: Tool | str = "tip", mount_pos=(0.0, 0.0, 0.0),
                 mount_yaw: float = 0.0, cell: float = DEFAULT_CELL, *, layout: Layout,
                 wall_height: float = WALL_HEIGHT) -> ArmScene:
@@ -307,6 +353,7 @@ def build_scene(xml_path: Path, tool: Tool | str = "tip", mount_pos=(0.0, 0.0, 0
     arm_name = spec.modelname or path.stem
     scene_spec = build_workspace(layout, cell, wall_height)
     _copy_options(scene_spec, spec)
+    _pedestal(scene_spec, model, q_all, mount_pos, mount_yaw, layout.width * cell / 2)
     frame = scene_spec.worldbody.add_frame(pos=[float(v) for v in mount_pos],
                                            quat=[math.cos(mount_yaw / 2), 0.0, 0.0, math.sin(mount_yaw / 2)])
     try:

@@ -102,3 +102,34 @@ def test_a_tool_without_offset_says_its_axis_is_the_frames_z_axis():
     assert "site's z axis" in Tool(site="tcp").axis_hint() and "--tip-offset" in Tool(site="tcp").axis_hint()
     assert "body's z axis" in Tool(site=None, body="jaw").axis_hint()
     assert Tool(site="tcp", offset=(0.0, 0.0, 0.1)).axis_hint() == ""
+
+
+def test_a_base_on_a_pedestal_stands_on_a_drawn_column_that_touches_nothing(files):
+    import mujoco
+
+    from armtransfer.ik.scene import PEDESTAL, PEDESTAL_RADIUS, base_footing
+
+    place = _Placer(arm_scene(xml_path=files["so100"], **SO100))
+    standing = place(0.1, 0.0, None, None)  # on the tabletop, its base's axis at (0.1, 0) m
+    lifted = standing.lifted(0.05)
+    beside = place(0.1 + 1.0, 0.0, None, None).lifted(0.05)  # off the table: nothing to stand on
+    low, high, off = (arm_scene(xml_path=files["so100"], base_pos=p.pos, base_yaw=p.yaw, **SO100)
+                      for p in (standing, lifted, beside))
+    for scene in (low, off):
+        assert mujoco.mj_name2id(scene.model, mujoco.mjtObj.mjOBJ_GEOM, PEDESTAL) == -1
+    g = mujoco.mj_name2id(high.model, mujoco.mjtObj.mjOBJ_GEOM, PEDESTAL)
+    assert g >= 0
+    data = mujoco.MjData(high.model)
+    mujoco.mj_kinematics(high.model, data)
+    centre, half = data.geom_xpos[g], high.model.geom_size[g][1]
+    anchor, bottom = base_footing(high.model, high.home)  # the pedestal itself does not count
+    assert base_footing(low.model, low.home)[1] == pytest.approx(0.0, abs=1e-9)  # standing on the tabletop
+    assert bottom == pytest.approx(0.05, abs=1e-6)
+    assert centre[2] - half == pytest.approx(0.0, abs=1e-9) and centre[2] + half == pytest.approx(bottom)
+    assert np.allclose(centre[:2], anchor[:2]) and np.allclose(anchor[:2], (0.1, 0.0), atol=1e-4)
+    assert high.model.geom_size[g][0] == PEDESTAL_RADIUS
+    assert high.model.geom_contype[g] == 0 and high.model.geom_conaffinity[g] == 0  # drawn only
+    assert not high.env_geoms[g] and not high.arm_geoms[g]
+    assert high.model.geom_matid[g] >= 0  # in the walls' material
+    # the placer finds the same base with the column there
+    assert _Placer(high).bottom == pytest.approx(bottom)
