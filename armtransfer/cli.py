@@ -11,6 +11,8 @@ import importlib
 import os
 import sys
 
+from armtransfer.script import OneLineParser as _Parser  # a usage error is one line
+
 # Subcommand name -> module in armtransfer.commands. Each module has
 # ``add_arguments(parser)``, ``run(args) -> int`` and a one-line ``HELP``.
 COMMANDS = {
@@ -22,13 +24,6 @@ COMMANDS = {
     "arms": "arms",
     "matrix": "matrix",
 }
-
-
-class _Parser(argparse.ArgumentParser):
-    """argparse, but a usage error is one line (the usage is in --help)."""
-
-    def error(self, message: str) -> None:  # type: ignore[override]
-        self.exit(2, f"{self.prog}: error: {message}\n")
 
 
 def build_parser() -> argparse.ArgumentParser:

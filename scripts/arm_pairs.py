@@ -9,9 +9,9 @@ greedy path, as in `armtransfer arms`; controls are skipped here (the demo shows
 
 from __future__ import annotations
 
-import argparse
 import time
 
+from armtransfer import script
 from armtransfer.tasks.specs import resolve
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.learning import experiment
@@ -28,7 +28,7 @@ DEFAULT_METHODS = ("none", "pseudo", "dense")
 
 
 def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = script.parser(__doc__)
     p.add_argument("--trials", type=int, default=20)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", default=None, help="also write the markdown table here")

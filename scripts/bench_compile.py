@@ -10,7 +10,6 @@ interpreter start-up itself).
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import statistics
@@ -18,6 +17,8 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+from armtransfer import script
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
@@ -42,7 +43,7 @@ def _run(spec: str, cache: str) -> dict:
 def main() -> None:
     from armtransfer.tasks.arms import robot_specs
 
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = script.parser(__doc__)
     parser.add_argument("robots", nargs="*", default=robot_specs())
     parser.add_argument("--runs", type=int, default=3)
     args = parser.parse_args()

@@ -9,7 +9,6 @@ Each is run ``--repeats`` times in fresh processes; medians are printed.
 
 from __future__ import annotations
 
-import argparse
 import os
 import statistics
 import subprocess
@@ -17,6 +16,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+from armtransfer import script
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -29,7 +30,7 @@ def run_demo(env: dict, out: Path) -> float:
 
 
 def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = script.parser(__doc__)
     p.add_argument("--repeats", type=int, default=3)
     args = p.parse_args()
     colds, warms = [], []

@@ -15,10 +15,10 @@ the per-round ratios to the first. ``--against REV`` loads ``transfer/sarsa.py``
 
 from __future__ import annotations
 
-import argparse
 import importlib
 import statistics
 import subprocess
+import argparse
 import sys
 import tempfile
 import time
@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from armtransfer import script
 from armtransfer.errors import ArmTransferError
 from armtransfer.learning import sarsa
 from armtransfer.learning.config import LearnerConfig
@@ -80,42 +81,42 @@ def guided_kernel_without_guide(*args, **kwargs):
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = script.parser(__doc__)
     p.add_argument("--rounds", type=int, default=8)
     p.add_argument("--steps", type=int, default=1_000_000, help="steps per contender per round")
     p.add_argument("--against", metavar="REV", help="also time the kernel of this git revision")
     p.add_argument("--fast", action="store_true", help="a smoke run: 2 rounds of 20,000 steps")
     args = p.parse_args(argv)
-    try:
-        if args.rounds < 1 or args.steps < 1:
-            raise ArmTransferError("--rounds and --steps must be >= 1")
-        rounds, steps = (2, 20_000) if args.fast else (args.rounds, args.steps)
-        contenders = {"plain kernel (no guide compiled in)": sarsa.learn,
-                      "guided kernel, run without a guide": guided_kernel_without_guide}
-        with tempfile.TemporaryDirectory() as tmp:
-            if args.against:
-                old = load_revision(args.against, Path(tmp))
-                contenders[f"kernel at {args.against}"] = old.learn
-            for learn in contenders.values():  # compile or load every kernel outside the timing
-                try:
-                    measure(learn, 1_000, 0)
-                except TypeError as e:
-                    raise ArmTransferError(f"that revision's kernel does not run here: {e}") from None
-            rates = {name: [] for name in contenders}
-            for r in range(rounds):
-                for name, learn in contenders.items():
-                    rates[name].append(measure(learn, steps, r))
-        first = next(iter(rates))
-        print(f"{rounds} rounds of {steps:,} steps each (Table I task 1, fine, no transfer)")
-        for name, xs in rates.items():
-            ratio = statistics.median(x / y for x, y in zip(xs, rates[first]))
-            print(f"  {name}: median {statistics.median(xs):,.0f} steps/s, "
-                  f"{ratio:.2f}x the first (per-round ratios {min(x / y for x, y in zip(xs, rates[first])):.2f}-"
-                  f"{max(x / y for x, y in zip(xs, rates[first])):.2f})")
-        return 0
-    except ArmTransferError as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
+    return script.run(_run, args)
+
+
+def _run(args: argparse.Namespace) -> int:
+    if args.rounds < 1 or args.steps < 1:
+        raise ArmTransferError("--rounds and --steps must be >= 1")
+    rounds, steps = (2, 20_000) if args.fast else (args.rounds, args.steps)
+    contenders = {"plain kernel (no guide compiled in)": sarsa.learn,
+                  "guided kernel, run without a guide": guided_kernel_without_guide}
+    with tempfile.TemporaryDirectory() as tmp:
+        if args.against:
+            old = load_revision(args.against, Path(tmp))
+            contenders[f"kernel at {args.against}"] = old.learn
+        for learn in contenders.values():  # compile or load every kernel outside the timing
+            try:
+                measure(learn, 1_000, 0)
+            except TypeError as e:
+                raise ArmTransferError(f"that revision's kernel does not run here: {e}") from None
+        rates = {name: [] for name in contenders}
+        for r in range(rounds):
+            for name, learn in contenders.items():
+                rates[name].append(measure(learn, steps, r))
+    first = next(iter(rates))
+    print(f"{rounds} rounds of {steps:,} steps each (Table I task 1, fine, no transfer)")
+    for name, xs in rates.items():
+        ratio = statistics.median(x / y for x, y in zip(xs, rates[first]))
+        print(f"  {name}: median {statistics.median(xs):,.0f} steps/s, "
+              f"{ratio:.2f}x the first (per-round ratios {min(x / y for x, y in zip(xs, rates[first])):.2f}-"
+              f"{max(x / y for x, y in zip(xs, rates[first])):.2f})")
+    return 0
 
 
 if __name__ == "__main__":

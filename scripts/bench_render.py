@@ -17,7 +17,6 @@ Measured in the same run:
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import statistics
@@ -25,6 +24,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+from armtransfer import script
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 ROOT = Path(__file__).resolve().parent.parent
@@ -49,7 +50,7 @@ def pipeline(rollouts, out: Path, width: int, height: int, shadows: bool = False
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = script.parser(__doc__)
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--task", type=int, default=1)
     parser.add_argument("--source", default="planar2:joint")

@@ -12,7 +12,6 @@ reach the goal, with and without it, over several seeds.
     python scripts/example_wrapper.py --fast          # a few seconds: the smoke test runs this
 """
 
-import argparse
 import os
 
 os.environ.setdefault("MUJOCO_GL", "egl")
@@ -21,12 +20,13 @@ import gymnasium as gym  # noqa: E402
 import numpy as np  # noqa: E402
 
 import armtransfer  # noqa: E402
+from armtransfer import script  # noqa: E402
 from armtransfer.learning import trajectory as trajectories  # noqa: E402
 from armtransfer.tasks.arms import arm_robot  # noqa: E402
 from armtransfer.tasks.catalog import table_task  # noqa: E402
 from armtransfer.wrappers import TransferReward  # noqa: E402
 
-p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+p = script.parser(__doc__)
 p.add_argument("--arm", default="planar2", help="the learning arm (default planar2)")
 p.add_argument("--actions", default="joint", help="its action model (default joint)")
 p.add_argument("--source", default="ur5e_like:cartesian", help="the arm that hands over its path")

@@ -27,7 +27,7 @@ import sys
 import time
 from pathlib import Path
 
-from armtransfer.errors import ArmTransferError
+from armtransfer import script
 from armtransfer.io import check_output_dir, staged_directory, write_json_atomic, write_text_atomic
 from armtransfer.learning import experiment, potentials, sarsa
 from armtransfer.learning.config import LearnerConfig
@@ -151,45 +151,44 @@ def markdown(rows: list[dict], trials: int, seed: int, seconds: float) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = script.parser(__doc__)
     p.add_argument("--trials", type=int, default=20)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", required=True, help="an absent or empty directory for the .md and .json")
     p.add_argument("--fast", action="store_true", help="a smoke run: task 1, the grid robots, 2 trials")
     args = p.parse_args(argv)
-    try:
-        if args.trials < 1 or args.seed < 0:
-            raise ArmTransferError("--trials must be >= 1 and --seed >= 0")
-        check_output_dir(args.out)
-        pairs, tasks, trials, config = PAIRS, (1, 2, 3, 4), args.trials, LearnerConfig()
-        if args.fast:
-            pairs, tasks, trials = PAIRS[:2], (1, 2), 2
-            config = LearnerConfig(max_episodes=60, max_total_steps=400_000)
-        t0 = time.perf_counter()
-        rows = []
-        for src_name, dst_name in pairs:
-            source, target = resolve(src_name), resolve(dst_name)
-            online = None
-            for task in tasks:
-                summary, optimal, src_len, online = run_case(source, target, task, trials, args.seed, config, online)
-                v = verdict(summary[NEW], [summary[f"{NEW} [{k}]"] for k in CONTROLS], optimal)
-                rows.append({"pair": f"{src_name} → {dst_name}", "task": task, "optimal": optimal,
-                             "source_path": src_len, "summary": summary, "verdict": v})
-                print(f"{src_name} -> {dst_name} task {task}: "
-                      + ", ".join(f"{c} {summary[c]['mean'] / optimal:.2f}x" for c in COLUMNS), flush=True)
-        seconds = time.perf_counter() - t0
-        with staged_directory(args.out) as tmp:
-            write_text_atomic(tmp / "first_exposure.md", markdown(rows, trials, args.seed, seconds))
-            write_json_atomic(tmp / "first_exposure.json", {
-                "trials": trials, "seed": args.seed, "config": config.to_dict(), "fast": args.fast,
-                "seconds": seconds,
-                "targets": {"first_exposure": TARGET_RATIO, "greedy": TARGET_GREEDY, "controls": TARGET_CONTROL},
-                "rows": rows})
-        print(f"wrote {Path(args.out) / 'first_exposure.md'} ({seconds:.0f} s)")
-        return 0
-    except ArmTransferError as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
+    return script.run(_run, args)
+
+
+def _run(args: argparse.Namespace) -> int:
+    script.check_trials_seed(args.trials, args.seed)
+    check_output_dir(args.out)
+    pairs, tasks, trials, config = PAIRS, (1, 2, 3, 4), args.trials, LearnerConfig()
+    if args.fast:
+        pairs, tasks, trials = PAIRS[:2], (1, 2), 2
+        config = LearnerConfig(max_episodes=60, max_total_steps=400_000)
+    t0 = time.perf_counter()
+    rows = []
+    for src_name, dst_name in pairs:
+        source, target = resolve(src_name), resolve(dst_name)
+        online = None
+        for task in tasks:
+            summary, optimal, src_len, online = run_case(source, target, task, trials, args.seed, config, online)
+            v = verdict(summary[NEW], [summary[f"{NEW} [{k}]"] for k in CONTROLS], optimal)
+            rows.append({"pair": f"{src_name} → {dst_name}", "task": task, "optimal": optimal,
+                         "source_path": src_len, "summary": summary, "verdict": v})
+            print(f"{src_name} -> {dst_name} task {task}: "
+                  + ", ".join(f"{c} {summary[c]['mean'] / optimal:.2f}x" for c in COLUMNS), flush=True)
+    seconds = time.perf_counter() - t0
+    with staged_directory(args.out) as tmp:
+        write_text_atomic(tmp / "first_exposure.md", markdown(rows, trials, args.seed, seconds))
+        write_json_atomic(tmp / "first_exposure.json", {
+            "trials": trials, "seed": args.seed, "config": config.to_dict(), "fast": args.fast,
+            "seconds": seconds,
+            "targets": {"first_exposure": TARGET_RATIO, "greedy": TARGET_GREEDY, "controls": TARGET_CONTROL},
+            "rows": rows})
+    print(f"wrote {Path(args.out) / 'first_exposure.md'} ({seconds:.0f} s)")
+    return 0
 
 
 if __name__ == "__main__":

@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from armtransfer import script
 from armtransfer.errors import ArmTransferError
 from armtransfer.io import check_output_dir, staged_directory, write_json_atomic, write_text_atomic
 from armtransfer.learning import experiment, metrics
@@ -92,7 +93,7 @@ def markdown(pair: str, rows: list[dict], trials: int, seed: int, seconds: float
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = script.parser(__doc__)
     p.add_argument("--source", default="ur5e_like:cartesian")
     p.add_argument("--target", default="planar2:joint")
     p.add_argument("--tasks", type=int, nargs="+", default=[1, 2, 3, 4])
@@ -101,35 +102,34 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--out", required=True, help="an absent or empty directory for the .md and .json")
     p.add_argument("--fast", action="store_true", help="a smoke run: task 1, 2 trials")
     args = p.parse_args(argv)
-    try:
-        if args.trials < 1 or args.seed < 0:
-            raise ArmTransferError("--trials must be >= 1 and --seed >= 0")
-        bad = [t for t in args.tasks if t not in TABLE_I]
-        if bad:
-            raise ArmTransferError(f"unknown Table I task {bad[0]}; valid: {', '.join(map(str, sorted(TABLE_I)))}")
-        check_output_dir(args.out)
-        source, target = resolve(args.source), resolve(args.target)
-        tasks, trials = (args.tasks[:1], 2) if args.fast else (args.tasks, args.trials)
-        config = LearnerConfig(max_episodes=1)  # the first exposure is the first episode's exploration
-        t0 = time.perf_counter()
-        rows = []
-        for task in tasks:
-            rows.append(run_task(source, target, task, trials, args.seed, config))
-            r = rows[-1]
-            print(f"task {task}: " + ", ".join(f"{v} {r['stats'][v]['mean'] / r['optimal']:.2f}x" for v in VARIANTS),
-                  flush=True)
-        seconds = time.perf_counter() - t0
-        pair = f"{args.source} → {args.target}"
-        with staged_directory(args.out) as tmp:
-            write_text_atomic(tmp / "first_exposure_bounds.md", markdown(pair, rows, trials, args.seed, seconds))
-            write_json_atomic(tmp / "first_exposure_bounds.json", {
-                "pair": pair, "trials": trials, "seed": args.seed, "fast": args.fast, "seconds": seconds,
-                "config": config.to_dict(), "rows": rows})
-        print(f"wrote {Path(args.out) / 'first_exposure_bounds.md'} ({seconds:.0f} s)")
-        return 0
-    except ArmTransferError as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
+    return script.run(_run, args)
+
+
+def _run(args: argparse.Namespace) -> int:
+    script.check_trials_seed(args.trials, args.seed)
+    bad = [t for t in args.tasks if t not in TABLE_I]
+    if bad:
+        raise ArmTransferError(f"unknown Table I task {bad[0]}; valid: {', '.join(map(str, sorted(TABLE_I)))}")
+    check_output_dir(args.out)
+    source, target = resolve(args.source), resolve(args.target)
+    tasks, trials = (args.tasks[:1], 2) if args.fast else (args.tasks, args.trials)
+    config = LearnerConfig(max_episodes=1)  # the first exposure is the first episode's exploration
+    t0 = time.perf_counter()
+    rows = []
+    for task in tasks:
+        rows.append(run_task(source, target, task, trials, args.seed, config))
+        r = rows[-1]
+        print(f"task {task}: " + ", ".join(f"{v} {r['stats'][v]['mean'] / r['optimal']:.2f}x" for v in VARIANTS),
+              flush=True)
+    seconds = time.perf_counter() - t0
+    pair = f"{args.source} → {args.target}"
+    with staged_directory(args.out) as tmp:
+        write_text_atomic(tmp / "first_exposure_bounds.md", markdown(pair, rows, trials, args.seed, seconds))
+        write_json_atomic(tmp / "first_exposure_bounds.json", {
+            "pair": pair, "trials": trials, "seed": args.seed, "fast": args.fast, "seconds": seconds,
+            "config": config.to_dict(), "rows": rows})
+    print(f"wrote {Path(args.out) / 'first_exposure_bounds.md'} ({seconds:.0f} s)")
+    return 0
 
 
 if __name__ == "__main__":

@@ -18,14 +18,14 @@ import sys
 import time
 from pathlib import Path
 
-from armtransfer.errors import ArmTransferError
+from armtransfer import script
 from armtransfer.ik.tool import parse_offset
 from armtransfer.tasks.arms import arm_robot, compile_order, make_tool, mount_search, tasks_solvable
 from armtransfer.tasks.catalog import TABLE_I
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = script.parser(__doc__)
     p.add_argument("xml", help="the arm's MJCF file")
     p.add_argument("--tip-site", default=None)
     p.add_argument("--tip-body", default=None)
@@ -33,6 +33,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--compile", type=int, default=6, metavar="N",
                    help="compile at most the first N of the automatic mount's compiles (default 6)")
     args = p.parse_args(argv)
+    return script.run(_run, args)
+
+
+def _run(args: argparse.Namespace) -> int:
     offset = parse_offset(args.tip_offset) if args.tip_offset else None
     tool = make_tool(args.tip_site, args.tip_body, offset)
     path = Path(args.xml)
@@ -53,8 +57,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    try:
-        sys.exit(main())
-    except ArmTransferError as err:
-        print(f"mount_candidates: error: {err}", file=sys.stderr)
-        sys.exit(2)
+    sys.exit(main())

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from armtransfer.errors import ArmTransferError
+from armtransfer import script
 from armtransfer.io import check_output_dir, staged_directory, write_json_atomic, write_text_atomic
 from armtransfer.learning import experiment
 from armtransfer.learning.config import LearnerConfig
@@ -93,36 +93,35 @@ def markdown(rows: list[dict], trials: int, seed: int, seconds: float) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = script.parser(__doc__)
     p.add_argument("--trials", type=int, default=20)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", required=True, help="an absent or empty directory for the .md and .json")
     p.add_argument("--fast", action="store_true", help="a smoke run: the grid robots, tasks 1-2, 2 trials")
     args = p.parse_args(argv)
-    try:
-        if args.trials < 1 or args.seed < 0:
-            raise ArmTransferError("--trials must be >= 1 and --seed >= 0")
-        check_output_dir(args.out)
-        pairs, tasks, trials = PAIRS, [1, 2, 3, 4], args.trials
-        if args.fast:
-            pairs, tasks, trials = PAIRS[:2], [1, 2], 2
-        t0 = time.perf_counter()
-        rows = []
-        for src_name, dst_name in pairs:
-            for r in run_pair(src_name, dst_name, tasks, trials, args.seed):
-                rows.append(r)
-                print(f"{r['pair']} task {r['task']}: {r['runs']} macro runs, "
-                      f"{pct(r['ends_at_robot1_cell'], r['runs'])} end in robot 1's cell", flush=True)
-        seconds = time.perf_counter() - t0
-        with staged_directory(args.out) as tmp:
-            write_text_atomic(tmp / "online_mapping_check.md", markdown(rows, trials, args.seed, seconds))
-            write_json_atomic(tmp / "online_mapping_check.json", {
-                "trials": trials, "seed": args.seed, "fast": args.fast, "seconds": seconds, "rows": rows})
-        print(f"wrote {Path(args.out) / 'online_mapping_check.md'} ({seconds:.0f} s)")
-        return 0
-    except ArmTransferError as e:
-        print(f"error: {e}", file=sys.stderr)
-        return 2
+    return script.run(_run, args)
+
+
+def _run(args: argparse.Namespace) -> int:
+    script.check_trials_seed(args.trials, args.seed)
+    check_output_dir(args.out)
+    pairs, tasks, trials = PAIRS, [1, 2, 3, 4], args.trials
+    if args.fast:
+        pairs, tasks, trials = PAIRS[:2], [1, 2], 2
+    t0 = time.perf_counter()
+    rows = []
+    for src_name, dst_name in pairs:
+        for r in run_pair(src_name, dst_name, tasks, trials, args.seed):
+            rows.append(r)
+            print(f"{r['pair']} task {r['task']}: {r['runs']} macro runs, "
+                  f"{pct(r['ends_at_robot1_cell'], r['runs'])} end in robot 1's cell", flush=True)
+    seconds = time.perf_counter() - t0
+    with staged_directory(args.out) as tmp:
+        write_text_atomic(tmp / "online_mapping_check.md", markdown(rows, trials, args.seed, seconds))
+        write_json_atomic(tmp / "online_mapping_check.json", {
+            "trials": trials, "seed": args.seed, "fast": args.fast, "seconds": seconds, "rows": rows})
+    print(f"wrote {Path(args.out) / 'online_mapping_check.md'} ({seconds:.0f} s)")
+    return 0
 
 
 if __name__ == "__main__":

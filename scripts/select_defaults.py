@@ -20,11 +20,11 @@ reach 1, knn 8, blocked moves generalised, give up after 100 moves (``transfer.g
 
 from __future__ import annotations
 
-import argparse
 import itertools
 
 import numpy as np
 
+from armtransfer import script
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.tasks.layout import ROOMS
@@ -164,7 +164,7 @@ def select_guided(pairs: int, trials: int, seed: int) -> None:
 
 
 def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = script.parser(__doc__)
     p.add_argument("--pairs", type=int, default=8)
     p.add_argument("--trials", type=int, default=20)
     p.add_argument("--seed", type=int, default=2026)

@@ -1,0 +1,42 @@
+"""What the scripts under ``scripts/`` share with the ``armtransfer`` command: its error contract.
+
+Every error a user can cause (an ``ArmTransferError`` or a bad argument) ends as one line on
+stderr with exit code 2, and nothing is left half-written; anything else is a bug and keeps
+its traceback."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """argparse, but a usage error is one line (the usage is in --help)."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def parser(doc: str | None) -> OneLineParser:
+    """A script's argument parser, described by the first line of its docstring ``doc``."""
+    return OneLineParser(description=doc.strip().splitlines()[0] if doc and doc.strip() else None)
+
+
+def run(body: Callable[..., int | None], *args) -> int:
+    """``body(*args)``'s exit code, or 2 after one line on stderr for an ``ArmTransferError``."""
+    from armtransfer.errors import ArmTransferError
+
+    try:
+        return int(body(*args) or 0)
+    except ArmTransferError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+
+
+def check_trials_seed(trials: int, seed: int) -> None:
+    """The trial count and seed every experiment script takes."""
+    from armtransfer.errors import ArmTransferError
+
+    if trials < 1 or seed < 0:
+        raise ArmTransferError("--trials must be >= 1 and --seed >= 0")
