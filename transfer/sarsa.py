@@ -92,16 +92,38 @@ def _egreedy(Q, s, n_actions, eps, rng):
 
 
 @numba.njit(cache=True, inline="always")
-def _choose(Q, s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start, macro_len, macro_actions,
-            guided, g, gm):
-    """The next action at s: the running macro's next step; else a new macro starting at s
-    (one draw, runs when < 1 - epsilon); else epsilon-greedy. Returns (action, in_macro,
-    m_pos, m_end, 1 for a macro step else 0); m_pos/m_end index the flat macro actions."""
+def _macro_step(s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start, macro_len, macro_actions):
+    """(True, the running macro's next step, in_macro, m_pos, m_end); else a new macro starting
+    at s (one draw, runs when < 1 - epsilon); else (False, -1, ...). m_pos/m_end index the flat
+    macro actions."""
     if in_macro:
-        return macro_actions[m_pos], True, m_pos + 1, m_end, 1
+        return True, macro_actions[m_pos], True, m_pos + 1, m_end
     if may_start and macro_len[s] > 0 and rng.random() < 1.0 - eps:
         m_pos = macro_start[s]
-        return macro_actions[m_pos], True, m_pos + 1, m_pos + macro_len[s], 1
+        return True, macro_actions[m_pos], True, m_pos + 1, m_pos + macro_len[s]
+    return False, -1, False, m_pos, m_end
+
+
+@numba.njit(cache=True, inline="always")
+def _choose(Q, s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start, macro_len, macro_actions):
+    """The next action at s: a macro's step (``_macro_step``), else epsilon-greedy. Returns
+    (action, in_macro, m_pos, m_end, 1 for a macro step else 0)."""
+    found, a, in_macro, m_pos, m_end = _macro_step(s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start,
+                                                   macro_len, macro_actions)
+    if found:
+        return a, in_macro, m_pos, m_end, 1
+    return _egreedy(Q, s, Q.shape[1], eps, rng), False, m_pos, m_end, 0
+
+
+@numba.njit(cache=True, inline="always")
+def _choose_guided(Q, s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start, macro_len, macro_actions,
+                   guided, g, gm):
+    """``_choose`` with the guide's epsilon-greedy (``transfer.guide.egreedy``) in its
+    exploration phase (``guided``)."""
+    found, a, in_macro, m_pos, m_end = _macro_step(s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start,
+                                                   macro_len, macro_actions)
+    if found:
+        return a, in_macro, m_pos, m_end, 1
     if guided:
         return _guide.egreedy(Q, s, eps, rng, g, gm), False, m_pos, m_end, 0
     return _egreedy(Q, s, Q.shape[1], eps, rng), False, m_pos, m_end, 0
@@ -157,10 +179,11 @@ def _shaping(mode, s, s2, terminal, bonus, traj_index, phi, gamma, paid_stamp, e
 def _make_run_trial(with_guide: bool):
     """The trial kernel, compiled with or without the guide (``with_guide``, a constant to numba).
 
-    Why two: the guide's arrays and per-step calls in the loop cost the plain methods about a
-    quarter of their speed even where a run has no guide (``armtransfer bench``, BENCHMARKS.md);
-    compiled without it, the loop is the plain Algorithm 1 alone. Both come from this one body,
-    so they cannot drift apart; numba caches each (the constant is part of its cache key)."""
+    Why two: handed the guide's 21 arrays, even empty and unused, the plain methods ran about
+    a third slower (``scripts/bench_kernels.py``, BENCHMARKS.md). Compiled without the guide,
+    every guide branch (``if with_guide``) is dropped before typing and ``g``/``gm`` are
+    None. Both come from this one body, so they cannot drift apart; numba caches each (the
+    constant is part of its cache key)."""
 
     @numba.njit(cache=True)
     def _run_trial(
@@ -222,9 +245,15 @@ def _make_run_trial(with_guide: bool):
         converged_episode = -1
         episodes = 0
         has_macros = macro_actions.shape[0] > 0
-        has_guide = with_guide and g[5].shape[0] > 1  # the guide has at least one trajectory (transfer.guide)
-        guide_episodes = int(g[6][5])
-        plan = g[6][8] > 0.0
+        # Every use of the guide sits under ``if with_guide``, a constant: compiled without the
+        # guide, numba drops those branches before typing, and g and gm may be None.
+        has_guide = False
+        guide_episodes = 0
+        plan = False
+        if with_guide:
+            has_guide = g[5].shape[0] > 1  # the guide has at least one trajectory (transfer.guide)
+            guide_episodes = int(g[6][5])
+            plan = g[6][8] > 0.0
         for ep in range(max_episodes):
             guided = has_guide and ep < guide_episodes  # the model chooses in the exploration phase
             use_macros = has_macros and ep < macro_episodes
@@ -234,12 +263,17 @@ def _make_run_trial(with_guide: bool):
             n_tr = 0
             s = start
             best = 0.0
-            if has_guide:
+            if with_guide and has_guide:
                 _guide.reset_progress(g, gm, s)
             # choose the first action (m_pos: position in the running macro, m_end: its end)
-            a, in_macro, m_pos, m_end, macro_used = _choose(
-                Q, s, eps, rng, False, 0, 0, use_macros, macro_start, macro_len, macro_actions, guided, g, gm
-            )
+            if with_guide:
+                a, in_macro, m_pos, m_end, macro_used = _choose_guided(
+                    Q, s, eps, rng, False, 0, 0, use_macros, macro_start, macro_len, macro_actions, guided, g, gm
+                )
+            else:
+                a, in_macro, m_pos, m_end, macro_used = _choose(
+                    Q, s, eps, rng, False, 0, 0, use_macros, macro_start, macro_len, macro_actions
+                )
             if ep == 0:
                 fp_states[0] = s
                 fp_pos[s] = 0
@@ -266,7 +300,7 @@ def _make_run_trial(with_guide: bool):
                         fp_states[fp_n] = s2
                         fp_pos[s2] = fp_n
                         fp_n += 1
-                if has_guide:  # robot 2 records what its move did to the label it perceives
+                if with_guide and has_guide:  # robot 2 records what its move did to the label it perceives
                     _guide.observe(g, gm, s, a, s2)
                     _guide.update_progress(g, gm, s2)
                 terminal = label[s2] == goal
@@ -287,10 +321,16 @@ def _make_run_trial(with_guide: bool):
                         abandoned = blocked
                         in_macro = False
                     # right after an abandoned macro, Algorithm 1 chooses (no immediate retry)
-                    a2, in_macro, m_pos, m_end, used = _choose(
-                        Q, s2, eps, rng, in_macro, m_pos, m_end, use_macros and not abandoned,
-                        macro_start, macro_len, macro_actions, guided, g, gm,
-                    )
+                    if with_guide:
+                        a2, in_macro, m_pos, m_end, used = _choose_guided(
+                            Q, s2, eps, rng, in_macro, m_pos, m_end, use_macros and not abandoned,
+                            macro_start, macro_len, macro_actions, guided, g, gm,
+                        )
+                    else:
+                        a2, in_macro, m_pos, m_end, used = _choose(
+                            Q, s2, eps, rng, in_macro, m_pos, m_end, use_macros and not abandoned,
+                            macro_start, macro_len, macro_actions,
+                        )
                     macro_used += used
                     q_next = Q[s2, a2]
                 sa = s * n_actions + a
@@ -326,7 +366,7 @@ def _make_run_trial(with_guide: bool):
                 s = s2
                 a = a2
             total += steps
-            if has_guide and plan:  # robot 2 plans over the moves it has tried (transfer.guide.plan)
+            if with_guide and has_guide and plan:  # robot 2 plans over the moves it has tried (transfer.guide.plan)
                 _guide.plan(g, gm, Q, label, goal, gamma, r_step, r_goal)
             episode_steps[ep] = steps if reached else -steps
             macro_steps_out[ep] = macro_used
@@ -416,7 +456,10 @@ def learn(
     sh = shaping if shaping is not None else Shaping.none(n)
     m_episodes = None
     guide = getattr(sh, "guide", None)
-    if guide is None:
+    kernel = _run_trial if guide is None else _run_trial_guided
+    if guide is None and kernel is not _run_trial_guided:  # the plain kernel never reads them
+        g, gm = None, None
+    elif guide is None:  # the guided kernel run without a guide (scripts/bench_kernels.py, a test)
         g, gm = _guide.inactive(robot.n_actions)
     else:
         g = _guide.as_tuple(guide)
@@ -437,7 +480,6 @@ def learn(
     prev_path = np.zeros(n + 1, np.int64)
     fp_states = np.zeros(n + 1, np.int64)
     fp_actions = np.zeros(n + 1, np.int64)
-    kernel = _run_trial if guide is None else _run_trial_guided
     episodes, conv_ep, path_n, fp_n = kernel(
         robot.next_state, robot.wind_state, robot.label, int(start_state), int(goal_cell),
         sh.mode, sh.bonus, sh.traj_index, sh.phi,
@@ -484,4 +526,4 @@ def _greedy_action(Q: np.ndarray, s: int) -> int:
 
 # The kernels above call the guide's jitted functions; numba's cache does not notice an edit to
 # guide.py alone (``jitcache``), so their cache is emptied when that file changes.
-_jitcache.invalidate_stale(__name__, [_egreedy, _choose, _greedy_path, _shaping, _run_trial, _run_trial_guided], [_guide.__file__])
+_jitcache.invalidate_stale(__name__, [_egreedy, _macro_step, _choose, _choose_guided, _greedy_path, _shaping, _run_trial, _run_trial_guided], [_guide.__file__])
