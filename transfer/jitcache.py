@@ -15,6 +15,9 @@ import hashlib
 from collections.abc import Iterable
 from pathlib import Path
 
+from armtransfer.errors import OutputError
+from armtransfer.io import write_text_atomic
+
 STAMP = "{module}.deps"
 """The digest's file name in the kernels' cache directory."""
 
@@ -51,10 +54,7 @@ def invalidate_stale(module: str, kernels: Iterable, deps: Iterable[str | Path])
         except OSError:
             pass
     try:
-        stamp.parent.mkdir(parents=True, exist_ok=True)
-        tmp = stamp.with_name(stamp.name + ".tmp")
-        tmp.write_text(new)
-        tmp.replace(stamp)
-    except OSError:
+        write_text_atomic(stamp, new)
+    except OutputError:
         pass
     return True
