@@ -310,18 +310,16 @@ def _copy_options(src: mujoco.MjSpec, dst: mujoco.MjSpec) -> None:
             pass
 
 
-def _pedestal(scene_spec: mujoco.MjSpec, model: mujoco.MjModel, q: np.ndarray, mount_pos, mount_yaw: float,
+def _pedestal(scene_spec: mujoco.MjSpec, model: mujoco.MjModel, q: np.ndarray, mount_pos, mount_quat,
               half: float) -> None:
     """Draw a column from the tabletop up to a base mounted above it, so that the arm does not
     float in a video. Only a base over the table gets one; it collides with nothing."""
     anchor, bottom = base_footing(model, q)
-    c, s = math.cos(mount_yaw), math.sin(mount_yaw)
-    x = float(mount_pos[0]) + c * anchor[0] - s * anchor[1]
-    y = float(mount_pos[1]) + s * anchor[0] + c * anchor[1]
+    x, y = np.asarray(mount_pos[:2], dtype=float) + _rotate(mount_quat, anchor)[:2]
     lift = float(mount_pos[2]) + bottom
     if lift <= 1e-4 or abs(x) > half or abs(y) > half:
         return
-    column = scene_spec.worldbody.add_body(name=PEDESTAL, pos=[x, y, lift / 2])
+    column = scene_spec.worldbody.add_body(name=PEDESTAL, pos=[float(x), float(y), lift / 2])
     column.add_geom(name=PEDESTAL, type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=[PEDESTAL_RADIUS, lift / 2, 0.0],
                     material="wall_mat", contype=0, conaffinity=0)
 
@@ -353,9 +351,9 @@ def build_scene(xml_path: Path, tool: Tool | str = "tip", mount_pos=(0.0, 0.0, 0
     arm_name = spec.modelname or path.stem
     scene_spec = build_workspace(layout, cell, wall_height)
     _copy_options(scene_spec, spec)
-    _pedestal(scene_spec, model, q_all, mount_pos, mount_yaw, layout.width * cell / 2)
-    frame = scene_spec.worldbody.add_frame(pos=[float(v) for v in mount_pos],
-                                           quat=[math.cos(mount_yaw / 2), 0.0, 0.0, math.sin(mount_yaw / 2)])
+    mount_quat = [math.cos(mount_yaw / 2), 0.0, 0.0, math.sin(mount_yaw / 2)]
+    _pedestal(scene_spec, model, q_all, mount_pos, mount_quat, layout.width * cell / 2)
+    frame = scene_spec.worldbody.add_frame(pos=[float(v) for v in mount_pos], quat=mount_quat)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
