@@ -457,13 +457,13 @@ def learn(
     m_episodes = None
     guide = getattr(sh, "guide", None)
     kernel = _run_trial if guide is None else _run_trial_guided
-    if guide is None and kernel is not _run_trial_guided:  # the plain kernel never reads them
-        g, gm = None, None
-    elif guide is None:  # the guided kernel run without a guide (scripts/bench_kernels.py, a test)
-        g, gm = _guide.inactive(robot.n_actions)
-    else:
+    if guide is not None:
         g = _guide.as_tuple(guide)
         gm = _guide.model_arrays(n, robot.n_actions, guide.memory, len(guide.tstart) - 1)
+    elif kernel is _run_trial_guided:  # run without a guide (scripts/bench_kernels.py, a test)
+        g, gm = _guide.inactive(robot.n_actions)
+    else:  # the plain kernel never reads them
+        g, gm = None, None
     if macros is None:
         m_start = np.zeros(n, np.int64)
         m_len = np.zeros(n, np.int64)
