@@ -34,6 +34,15 @@ def run(body: Callable[..., int | None], *args) -> int:
         return 2
 
 
+def experiment_options(p: argparse.ArgumentParser, fast: str) -> None:
+    """The options every experiment script takes: --trials (20), --seed (0), --out DIR for its
+    .md and .json, and --fast (``fast`` says what its smoke run is)."""
+    p.add_argument("--trials", type=int, default=20)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--out", required=True, help="an absent or empty directory for the .md and .json")
+    p.add_argument("--fast", action="store_true", help=fast)
+
+
 def check_trials_seed(trials: int, seed: int) -> None:
     """The trial count and seed every experiment script takes."""
     from armtransfer.errors import ArmTransferError

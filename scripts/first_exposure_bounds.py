@@ -97,10 +97,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--source", default="ur5e_like:cartesian")
     p.add_argument("--target", default="planar2:joint")
     p.add_argument("--tasks", type=int, nargs="+", default=[1, 2, 3, 4])
-    p.add_argument("--trials", type=int, default=20)
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--out", required=True, help="an absent or empty directory for the .md and .json")
-    p.add_argument("--fast", action="store_true", help="a smoke run: task 1, 2 trials")
+    script.experiment_options(p, fast="a smoke run: task 1, 2 trials")
     args = p.parse_args(argv)
     return script.run(_run, args)
 

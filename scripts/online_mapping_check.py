@@ -94,10 +94,7 @@ def markdown(rows: list[dict], trials: int, seed: int, seconds: float) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     p = script.parser(__doc__)
-    p.add_argument("--trials", type=int, default=20)
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--out", required=True, help="an absent or empty directory for the .md and .json")
-    p.add_argument("--fast", action="store_true", help="a smoke run: the grid robots, tasks 1-2, 2 trials")
+    script.experiment_options(p, fast="a smoke run: the grid robots, tasks 1-2, 2 trials")
     args = p.parse_args(argv)
     return script.run(_run, args)
 
