@@ -11,6 +11,7 @@ import importlib
 import os
 import sys
 
+from armtransfer import script as _script
 from armtransfer.script import OneLineParser as _Parser  # a usage error is one line
 
 # Subcommand name -> module in armtransfer.commands. Each module has
@@ -80,18 +81,9 @@ def _main(argv: list[str]) -> int:
 
 
 def run() -> None:
-    """The console script and ``python -m armtransfer.cli``: ``main``, then exit with its code.
-
-    After Ctrl-C the exit is ``os._exit(130)``: a KeyboardInterrupt raised while a C extension
-    runs Python code marks the interpreter, which then ends itself with SIGINT at shutdown
-    even though ``main`` caught it, and the shell would see a signal instead of code 130.
-    """
-    code = main()
-    if code == 130:
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(130)
-    sys.exit(code)
+    """The console script and ``python -m armtransfer.cli``: ``main``, then exit with its code
+    (``script.exit_with``: quiet when stdout's reader goes away; 130 after Ctrl-C)."""
+    _script.exit_with(main)
 
 
 if __name__ == "__main__":

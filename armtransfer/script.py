@@ -7,8 +7,10 @@ its traceback."""
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections.abc import Callable
+from typing import NoReturn
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -32,6 +34,38 @@ def run(body: Callable[..., int | None], *args) -> int:
     except ArmTransferError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
+
+
+def stdout_closed() -> int:
+    """The reader of stdout went away (``... | head``): nothing more can be shown, and that is
+    not the program's error. Later writes, and the interpreter's last flush, go to /dev/null so
+    that no traceback follows; the exit code is a shell's for a write to a closed pipe, 141."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+    os.close(devnull)
+    return 141
+
+
+def exit_with(main: Callable[[], int | None]) -> NoReturn:
+    """A script's (and the command's) ``__main__``: ``sys.exit(main())``, quiet when its
+    reader stops reading.
+
+    After Ctrl-C (``main`` returned 130) the exit is ``os._exit(130)``: a KeyboardInterrupt
+    raised while a C extension runs Python code marks the interpreter, which then ends itself
+    with SIGINT at shutdown even though ``main`` caught it, and the shell would see a signal
+    instead of code 130."""
+    try:
+        try:
+            code = main()
+        except SystemExit as e:  # --help, a usage error
+            code = e.code
+        sys.stdout.flush()  # inside the try: a closed pipe shows here, not at shutdown
+    except BrokenPipeError:
+        code = stdout_closed()
+    if code == 130:
+        sys.stderr.flush()
+        os._exit(130)
+    sys.exit(code)
 
 
 def experiment_options(p: argparse.ArgumentParser, fast: str) -> None:

@@ -23,7 +23,6 @@ Writes ``DIR/first_exposure.md`` and ``DIR/first_exposure.json``.
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 
@@ -189,4 +188,4 @@ def _run(args: argparse.Namespace) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    script.exit_with(main)

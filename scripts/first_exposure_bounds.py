@@ -21,7 +21,6 @@ lower bound (≥). Writes ``DIR/first_exposure_bounds.md`` and ``.json``.
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 
@@ -130,4 +129,4 @@ def _run(args: argparse.Namespace) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    script.exit_with(main)

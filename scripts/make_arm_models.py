@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from armtransfer import script
 from armtransfer.models.mjcf import BUILT_IN
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
@@ -30,4 +31,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    script.exit_with(main)

@@ -14,7 +14,6 @@ chosen, or to pick one by hand for ``--base-pos``/``--base-yaw``.
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 
@@ -57,4 +56,4 @@ def _run(args: argparse.Namespace) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    script.exit_with(main)

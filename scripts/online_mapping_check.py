@@ -19,7 +19,6 @@ Writes ``DIR/online_mapping_check.md`` and ``.json``.
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 
@@ -122,4 +121,4 @@ def _run(args: argparse.Namespace) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    script.exit_with(main)

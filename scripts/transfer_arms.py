@@ -15,7 +15,8 @@ Every option of `armtransfer arms` works here (see --help).
 
 import sys
 
+from armtransfer import script
 from armtransfer.cli import main
 
 if __name__ == "__main__":
-    sys.exit(main(["arms", *sys.argv[1:]]))
+    script.exit_with(lambda: main(["arms", *sys.argv[1:]]))
