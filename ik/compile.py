@@ -5,19 +5,23 @@ breadth-first sweep over cells from the home cell (each IK warm-started from the
 neighbour it was reached from). A move of k cells is a table lookup, blocked when the
 target or a cell passed over is a wall or off the table, when IK found no configuration
 for the target, or when the straight joint-space move between the two configurations
-(checked at 3k interpolated points) touches the table or a wall in MuJoCo, or strays
-more than 0.75 cell from the straight line between the cells.
+(checked at 3k interpolated points) touches the table, a wall or the arm itself in MuJoCo, or
+strays more than 0.75 cell from the straight line between the cells. (A self-contact is
+one between two arm bodies that MuJoCo reports and that is not there at home already; see
+``ik.scene.ContactChecker``.)
 
 ``joint`` (planar arms): states are the points of a joint lattice (home + n * delta,
 inside the joint limits) reachable from home by +-delta moves, whose tip is over a free
-cell and not touching a wall. The lattice's forward kinematics is vectorised with numpy
+cell and not touching a wall or itself. The lattice's forward kinematics is vectorised with numpy
 (vertical joint axes: the tip is a sum of rotated link vectors taken from MuJoCo at
 q = 0; the tests check it against mink). A move is blocked when it leaves the limits,
 the tip passes over a wall cell or off the table at any of the interpolated points
-(spaced at most half a cell apart), or MuJoCo reports contact with the table or a wall
-at up to 3 points along the move; MuJoCo is asked only near walls (tip within one cell
-of a wall cell), since a planar arm's links ride above the walls and only the stylus can
-touch them.
+(spaced at most half a cell apart), or MuJoCo reports contact with the table, a wall or
+the arm itself at up to 3 points along the move; MuJoCo is asked only near walls (tip
+within one cell of a wall cell), since a planar arm's links ride above the walls and only
+the stylus can touch them, unless the arm's own geoms may collide with each other
+(``ContactChecker.can_self_collide``; the built-in arms' may not), when it is asked at
+every lattice point and move.
 
 Wind pushes the tip one cell towards +x: for cartesian robots it is the 1-cell +x move;
 for joint robots it is the lattice state labelled with the cell to the right that is
@@ -346,7 +350,8 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
     Q = home + (grids + n_lo) * step
     cells = cells_of_xy(fk.tip(Q), cell, layout)
     valid = (cells >= 0) & free[np.maximum(cells, 0)]
-    check = np.flatnonzero(valid & near[np.maximum(cells, 0)])
+    ask = np.ones(total, dtype=bool) if contact.can_self_collide else near[np.maximum(cells, 0)]
+    check = np.flatnonzero(valid & ask)
     for i in check:
         if contact.touches(Q[i]):
             valid[i] = False
@@ -370,7 +375,7 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
             ok &= inside & free[np.maximum(c, 0)]
             near_any |= inside & near[np.maximum(c, 0)]
         probe = ts[np.unique(np.linspace(0, m - 1, min(m, 3)).round().astype(int))]
-        for e in np.flatnonzero(ok & near_any):
+        for e in np.flatnonzero(ok & (near_any | contact.can_self_collide)):
             for t in probe:
                 q = Q[idx[e]].copy()
                 q[j] += t * step

@@ -392,7 +392,12 @@ def build_scene(xml_path: Path, tool: Tool | str = "tip", mount_pos=(0.0, 0.0, 0
 
 
 class ContactChecker:
-    """Does the arm touch the table or a wall at configuration q? (MuJoCo collision.)"""
+    """Does the arm touch the table, a wall or itself at configuration q? (MuJoCo collision.)
+
+    A self-contact is one between two of the arm's geoms, at least one of them moved by a
+    joint, that MuJoCo reports (it already skips a body and its parent, and the file's
+    ``<exclude>`` pairs). Pairs already in contact at the home configuration are the file's
+    own design (a wrist flange seated in its link) and are allowed."""
 
     def __init__(self, scene: ArmScene) -> None:
         self.scene = scene
@@ -400,21 +405,61 @@ class ContactChecker:
         self.data = mujoco.MjData(scene.model)
         self._env = scene.env_geoms
         self._moving = scene.arm_geoms
+        self._arm = ~scene.env_geoms & (scene.model.geom_bodyid != 0)
         self._walls = np.array([(mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_GEOM, g) or "").startswith("wall_")
                                 for g in range(self.model.ngeom)], dtype=bool) & scene.env_geoms
         self._tip = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, scene.tip)
+        self._allowed = np.zeros((self.model.ngeom, self.model.ngeom), dtype=bool)
+        g1, g2 = self._self_contacts(scene.home)
+        self._allowed[g1, g2] = self._allowed[g2, g1] = True
+        m = self.model
+        arm = np.flatnonzero(self._arm)
+        ct, ca = m.geom_contype[arm], m.geom_conaffinity[arm]
+        pairs = ((ct[:, None] & ca[None, :]) | (ca[:, None] & ct[None, :])) != 0
+        pairs &= m.geom_bodyid[arm][:, None] != m.geom_bodyid[arm][None, :]
+        pairs &= self._moving[arm][:, None] | self._moving[arm][None, :]
+        self.can_self_collide = bool(pairs.any())
+        """Whether any two of the arm's geoms on different bodies, one of them moving, may
+        collide by their contype/conaffinity (the built-in arms' may not)."""
 
-    def touches(self, q: np.ndarray) -> bool:
+    def _contacts(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         d = self.data
         d.qpos[:] = q
         mujoco.mj_kinematics(self.model, d)
         mujoco.mj_collision(self.model, d)
         n = d.ncon
-        if n == 0:
+        return d.contact.geom1[:n], d.contact.geom2[:n]
+
+    def _mine(self, g1: np.ndarray, g2: np.ndarray) -> np.ndarray:
+        """Which contacts are between two arm geoms, one of them moving."""
+        return self._arm[g1] & self._arm[g2] & (self._moving[g1] | self._moving[g2])
+
+    def _own(self, g1: np.ndarray, g2: np.ndarray) -> np.ndarray:
+        """Which contacts are self-contacts that count (not there at home)."""
+        return self._mine(g1, g2) & ~self._allowed[g1, g2]
+
+    def _self_contacts(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        g1, g2 = self._contacts(q)
+        mine = self._mine(g1, g2)
+        return g1[mine], g2[mine]
+
+    def touches(self, q: np.ndarray) -> bool:
+        g1, g2 = self._contacts(q)
+        if len(g1) == 0:
             return False
-        g1 = d.contact.geom1[:n]
-        g2 = d.contact.geom2[:n]
-        return bool(np.any((self._env[g1] & self._moving[g2]) | (self._env[g2] & self._moving[g1])))
+        env = (self._env[g1] & self._moving[g2]) | (self._env[g2] & self._moving[g1])
+        return bool(np.any(env | self._own(g1, g2)))
+
+    def self_contacts(self, q: np.ndarray) -> list[tuple[str, str]]:
+        """The arm's bodies in contact with each other at q (pairs allowed at home left out)."""
+        g1, g2 = self._contacts(q)
+        names = set()
+        for a, b in zip(g1, g2):
+            if self._own(np.array([a]), np.array([b]))[0]:
+                bodies = (int(self.model.geom_bodyid[g]) for g in (a, b))
+                pair = sorted(_name(self.model, mujoco.mjtObj.mjOBJ_BODY, i) or f"body {i}" for i in bodies)
+                names.add((pair[0], pair[1]))
+        return sorted(names)
 
     def base_on_wall(self) -> bool:
         """Does the arm's fixed base (collision geoms that no joint moves) stand in a wall?

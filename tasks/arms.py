@@ -174,7 +174,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
         kind, tip_down = info.kind, info.tip_down
         step = joint_step or info.joint_step
     parts = {
-        "version": 4, "arm_xml": _sha(xml_bytes), "assets": _assets_sha(path), "tool": tool.key(),
+        "version": 5, "arm_xml": _sha(xml_bytes), "assets": _assets_sha(path), "tool": tool.key(),
         "mount": mount, "yaw": yaw, "actions": model.name, "cells": model.cells, "tip_down": tip_down,
         "joint_step": step if model.kind == "joint" else None, "cell": cell_size,
         "wall_height": WALL_HEIGHT, "layout": _layout_data(layout),
@@ -310,7 +310,7 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
     from armtransfer.ik import mount as _mount
     from armtransfer.tasks.catalog import TABLE_I as _TABLE_I
 
-    parts = {"version": 8, "what": "mount", "covers": COVERS, "arm_xml": _sha(path.read_bytes()),
+    parts = {"version": 9, "what": "mount", "covers": COVERS, "arm_xml": _sha(path.read_bytes()),
              "assets": _assets_sha(path), "tool": tool.key(), "cell": cell_size, "yaw": yaw,
              "layout": _layout_data(layout), "stride": _mount.STRIDE, "gaps": _mount.GAPS,
              "grid": _mount.PLANAR_GRID, "lifts": _mount.LIFTS}
