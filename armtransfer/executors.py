@@ -27,9 +27,16 @@ class ExecutorError(ArmTransferError):
 
 def _worker_init() -> None:
     # one thread per worker process: the workers are the parallelism
-    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
+    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS",
+                "ARMTRANSFER_TRIAL_THREADS"):
         os.environ.setdefault(var, "1")
     _die_with_parent()
+
+
+def _execute_in_ray(run: dict, robots):
+    """``execute`` in a Ray worker, its trials on one thread: Ray's tasks are the parallelism."""
+    os.environ.setdefault("ARMTRANSFER_TRIAL_THREADS", "1")
+    return execute(run, robots)
 
 
 def _die_with_parent() -> None:
@@ -182,7 +189,7 @@ def run_ray(
             raise ExecutorError(f"cannot start or reach Ray ({address or 'local'}): {err}".splitlines()[0]) from None
         started_here = True
     try:
-        remote_execute = ray.remote(max_retries=retries, retry_exceptions=False)(execute)
+        remote_execute = ray.remote(max_retries=retries, retry_exceptions=False)(_execute_in_ray)
         refs = {spec: ray.put(robot) for spec, robot in robots.items()}
         futures = {}
         for run in runs:

@@ -53,9 +53,8 @@ def run_oracle(target, start, goal, trials, seed, config) -> experiment.MethodRe
     """The oracle bound on the same trial streams: Phi = -2 x the true shortest-path distance."""
     shaping = Shaping.potential(potentials.oracle(target, goal), 2.0)
     out = experiment.MethodResult("oracle")
-    for k in range(trials):
-        out.trials.append(sarsa.learn(target, target.start_state(start), goal, config,
-                                      experiment.trial_rng(seed, k), shaping=shaping))
+    out.trials = experiment.map_trials(lambda k: sarsa.learn(target, target.start_state(start), goal, config,
+                                                             experiment.trial_rng(seed, k), shaping=shaping), trials)
     return out
 
 

@@ -31,7 +31,7 @@ from armtransfer.tasks.layout import ROOMS
 from armtransfer.learning import potentials, methods, sarsa
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.learning.experiment import trial_rng
+from armtransfer.learning.experiment import map_trials, trial_rng
 from armtransfer.learning.shaping import Shaping
 
 CANDIDATES = {
@@ -71,10 +71,9 @@ def score(method: str, params: dict, pairs, trials: int) -> float:
         else:
             shaping = methods.build_shaping(method, fine, traj, params["K"], config.step_reward)
         optimal = len(fine.shortest_path(fine.start_state(s), g)) - 1
-        for t in range(trials):
-            res = sarsa.learn(fine, fine.start_state(s), g, config, trial_rng(12345, t), shaping=shaping)
-            steps = res.exploration_steps or config.max_total_steps
-            ratios.append(steps / optimal)
+        runs = map_trials(lambda t: sarsa.learn(fine, fine.start_state(s), g, config, trial_rng(12345, t),
+                                                shaping=shaping), trials)
+        ratios += [(res.exploration_steps or config.max_total_steps) / optimal for res in runs]
     return float(np.exp(np.mean(np.log(ratios))))
 
 
@@ -134,9 +133,9 @@ def score_guided(params: dict, held: dict, trials: int, cap: int = 50_000) -> di
             gd = guide.build(dst, [traj], **{"give_up": 0, **params})  # give_up is chosen afterwards
             n = dst.n_states
             shaping = Shaping(MODE_NONE, np.zeros(n), np.full(n, -1, np.int64), np.zeros(n), 0.0, guide=gd)
-            for t in range(trials):
-                res = sarsa.learn(dst, dst.start_state(s), g, config, trial_rng(12345, t), shaping=shaping)
-                ratios.append((res.exploration_steps or cap) / optimal)
+            runs = map_trials(lambda t: sarsa.learn(dst, dst.start_state(s), g, config, trial_rng(12345, t),
+                                                    shaping=shaping), trials)
+            ratios += [(res.exploration_steps or cap) / optimal for res in runs]
         per[key] = float(np.mean(ratios))
     per["all"] = max(per.values())
     return per

@@ -202,11 +202,10 @@ def oracle_markdown(coarse: DiscreteRobot, fine: DiscreteRobot, trials: int, see
     for t in TASKS:
         start, goal = TABLE_I[t].cells()
         shaping = Shaping.potential(potentials.oracle(fine, goal), 2.0)
-        steps = [
-            sarsa.learn(fine, fine.start_state(start), goal, replace(config, max_episodes=1),
-                        experiment.trial_rng(seed, k), shaping=shaping).exploration_steps
-            for k in range(trials)
-        ]
+        steps = experiment.map_trials(
+            lambda k: sarsa.learn(fine, fine.start_state(start), goal, replace(config, max_episodes=1),
+                                  experiment.trial_rng(seed, k), shaping=shaping).exploration_steps,
+            trials)
         st = metrics.exploration_stats(steps, config.max_total_steps)
         mean, ci = st["mean"], st["ci95"]
         d = len(fine.shortest_path(fine.start_state(start), goal)) - 1

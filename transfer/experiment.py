@@ -2,13 +2,16 @@
 
 Every trial of every method gets its own generator from ``SeedSequence([seed, trial])``,
 so the methods meet the same random streams trial by trial (paired comparison) and the
-same seed gives the same result, bit for bit.
+same seed gives the same result, bit for bit, however many threads run the trials.
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 import numpy as np
 
@@ -21,9 +24,61 @@ from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import DEFAULT_MAX_SPAN, ActionMapping, MacroTable
 from armtransfer.learning.trajectory import Trajectory
 
+T = TypeVar("T")
 SHAPING_METHODS = methods.SHAPED
 METHODS = tuple(methods.METHODS)
 """Every method's name, from the registry ``armtransfer.learning.methods``."""
+
+
+THREADS_ENV = "ARMTRANSFER_TRIAL_THREADS"
+"""The environment variable that sets :func:`trial_threads` (a sweep's worker processes set 1:
+the workers are the parallelism there)."""
+
+
+def trial_threads() -> int:
+    """Threads the trials of one method run on: ``$ARMTRANSFER_TRIAL_THREADS``, else the CPUs
+    this process may use. The learner's kernel releases the GIL, and every trial has its own
+    generator and arrays, so the results are the same, bit for bit, for any number."""
+    value = os.environ.get(THREADS_ENV, "").strip()
+    if value:
+        try:
+            n = int(value)
+        except ValueError:
+            n = 0
+        if n < 1:
+            raise InvalidParameterError(f"{THREADS_ENV} must be a positive integer, got {value!r}")
+        return n
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+
+
+def map_trials(one: Callable[[int], T], trials: int, threads: int | None = None,
+               on_trial: Callable[[], None] | None = None) -> list[T]:
+    """``[one(0), ..., one(trials - 1)]``, computed on ``threads`` threads (None:
+    :func:`trial_threads`). ``one(k)`` must depend on k alone (its own generator, its own
+    arrays), so that the list is the same for any number of threads. ``on_trial`` is called
+    once per finished trial, on this thread. The first error, in trial order, is raised, and
+    no trial starts after an error or Ctrl-C."""
+    threads = min(trial_threads() if threads is None else int(threads), trials)
+    if trials < 1 or threads < 1:
+        raise InvalidParameterError(f"trials and threads must be positive integers, got {trials} and {threads}")
+    if threads == 1:
+        out = []
+        for trial in range(trials):
+            out.append(one(trial))
+            if on_trial is not None:
+                on_trial()
+        return out
+    with ThreadPoolExecutor(max_workers=threads, thread_name_prefix="trial") as pool:
+        futures = [pool.submit(one, trial) for trial in range(trials)]
+        try:
+            for _ in as_completed(futures):
+                if on_trial is not None:
+                    on_trial()
+            return [f.result() for f in futures]
+        except BaseException:
+            for f in futures:
+                f.cancel()
+            raise
 
 
 def trial_rng(seed: int, trial: int, stream: int = 0) -> np.random.Generator:
@@ -88,8 +143,10 @@ def run_method(
     on_trial: Callable[[], None] | None = None,
     beta: float = potentials.DENSE_BETA,
     control: str | None = None,
+    threads: int | None = None,
 ) -> MethodResult:
-    """``trials`` independent trials of one method on the target robot."""
+    """``trials`` independent trials of one method on the target robot, on ``threads``
+    threads (None: :func:`trial_threads`); the results do not depend on how many."""
     if trials < 1:
         raise InvalidParameterError(f"trials must be a positive integer, got {trials}")
     shaping = None
@@ -102,14 +159,9 @@ def run_method(
             K = farming.check_k(method, target, start_state, goal_cell, traj, K, config, wind)
         shaping = methods.build_shaping(method, target, traj, K, config.step_reward, beta=beta)
     out = MethodResult(method, control=control)
-    for trial in range(trials):
-        res = sarsa.learn(
-            target, start_state, goal_cell, config, trial_rng(seed, trial),
-            shaping=shaping, wind=wind, macros=macros,
-        )
-        out.trials.append(res)
-        if on_trial is not None:
-            on_trial()
+    out.trials = map_trials(lambda trial: sarsa.learn(target, start_state, goal_cell, config, trial_rng(seed, trial),
+                                                      shaping=shaping, wind=wind, macros=macros),
+                            trials, threads, on_trial)
     if shaping is not None:
         out.extra["K"] = shaping.K
     return out

@@ -185,7 +185,7 @@ def _make_run_trial(with_guide: bool):
     None. Both come from this one body, so they cannot drift apart; numba caches each (the
     constant is part of its cache key)."""
 
-    @numba.njit(cache=True)
+    @numba.njit(cache=True, nogil=True)  # nogil: trials run on threads (experiment.trial_threads)
     def _run_trial(
         next_state,
         wind_state,
