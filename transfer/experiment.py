@@ -57,7 +57,7 @@ def map_trials(one: Callable[[int], T], trials: int, threads: int | None = None,
     :func:`trial_threads`). ``one(k)`` must depend on k alone (its own generator, its own
     arrays), so that the list is the same for any number of threads. ``on_trial`` is called
     once per finished trial, on this thread. The first error, in trial order, is raised, and
-    no trial starts after an error or Ctrl-C."""
+    no trial starts after an error or Ctrl-C (those running finish first)."""
     threads = min(trial_threads() if threads is None else int(threads), trials)
     if trials < 1 or threads < 1:
         raise InvalidParameterError(f"trials and threads must be positive integers, got {trials} and {threads}")
