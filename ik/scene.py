@@ -453,12 +453,12 @@ class ContactChecker:
     def self_contacts(self, q: np.ndarray) -> list[tuple[str, str]]:
         """The arm's bodies in contact with each other at q (pairs allowed at home left out)."""
         g1, g2 = self._contacts(q)
+        own = self._own(g1, g2)
         names = set()
-        for a, b in zip(g1, g2):
-            if self._own(np.array([a]), np.array([b]))[0]:
-                bodies = (int(self.model.geom_bodyid[g]) for g in (a, b))
-                pair = sorted(_name(self.model, mujoco.mjtObj.mjOBJ_BODY, i) or f"body {i}" for i in bodies)
-                names.add((pair[0], pair[1]))
+        for a, b in zip(g1[own], g2[own]):
+            bodies = (int(self.model.geom_bodyid[g]) for g in (a, b))
+            pair = sorted(_name(self.model, mujoco.mjtObj.mjOBJ_BODY, i) or f"body {i}" for i in bodies)
+            names.add((pair[0], pair[1]))
         return sorted(names)
 
     def base_on_wall(self) -> bool:
