@@ -15,7 +15,7 @@ from concurrent.futures.process import BrokenProcessPool
 
 from armtransfer.execute import execute
 from armtransfer.errors import ArmTransferError
-from armtransfer.learning.experiment import THREADS_ENV
+from armtransfer.cpus import ENV as CPUS_ENV
 from armtransfer.tasks.robot import DiscreteRobot
 
 Done = Callable[[dict, dict, float], None]  # (run, result, seconds)
@@ -28,14 +28,14 @@ class ExecutorError(ArmTransferError):
 
 def _worker_init() -> None:
     # one thread per worker process: the workers are the parallelism
-    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS", THREADS_ENV):
+    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS", CPUS_ENV):
         os.environ.setdefault(var, "1")
     _die_with_parent()
 
 
 def _execute_in_ray(run: dict, robots):
     """``execute`` in a Ray worker, its trials on one thread: Ray's tasks are the parallelism."""
-    os.environ.setdefault(THREADS_ENV, "1")
+    os.environ.setdefault(CPUS_ENV, "1")
     return execute(run, robots)
 
 

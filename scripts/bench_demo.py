@@ -35,7 +35,7 @@ def main() -> None:
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--threads", default="",
                    help="comma-separated trial thread counts to compare, taking turns in each repeat "
-                        "(ARMTRANSFER_TRIAL_THREADS; default: unset, all CPUs); the first is the baseline")
+                        "(ARMTRANSFER_CPUS; default: unset, all CPUs); the first is the baseline")
     args = p.parse_args()
     try:
         settings = [int(t) for t in args.threads.split(",")] if args.threads else [None]
@@ -51,7 +51,7 @@ def main() -> None:
                 env = dict(os.environ, ARMTRANSFER_CACHE=f"{tmp}/arms", NUMBA_CACHE_DIR=f"{tmp}/numba",
                            MUJOCO_GL=os.environ.get("MUJOCO_GL", "egl"))
                 if t is not None:
-                    env["ARMTRANSFER_TRIAL_THREADS"] = str(t)
+                    env["ARMTRANSFER_CPUS"] = str(t)
                 colds[t].append(run_demo(env, Path(tmp) / "cold"))
                 warms[t].append(run_demo(env, Path(tmp) / "warm"))
             name = "" if t is None else f" ({t} trial threads)"

@@ -24,7 +24,7 @@ ROOT = Path(__file__).resolve().parents[1]
 # folder -> installed package, in the order data flows
 PACKAGES = {"models": "armtransfer.models", "ik": "armtransfer.ik", "tasks": "armtransfer.tasks",
             "transfer": "armtransfer.learning", "armtransfer": "armtransfer"}
-FOUNDATION = ("armtransfer.errors", "armtransfer.io")
+FOUNDATION = ("armtransfer.errors", "armtransfer.io", "armtransfer.cpus")
 LAYERS = ["foundation", "armtransfer.models", "armtransfer.ik", "armtransfer.tasks",
           "armtransfer.learning", "armtransfer"]
 MUJOCO = ("mujoco", "dm_control", "mink")

@@ -4,6 +4,7 @@ results are the same, bit for bit, for any number of threads."""
 import numpy as np
 import pytest
 
+from armtransfer import cpus
 from armtransfer.errors import InvalidParameterError
 from armtransfer.learning import experiment
 from armtransfer.learning.config import LearnerConfig
@@ -43,14 +44,14 @@ def test_every_trial_is_reported_once_whatever_the_threads():
 
 
 def test_the_thread_count_comes_from_the_environment(monkeypatch):
-    monkeypatch.setenv(experiment.THREADS_ENV, "3")
-    assert experiment.trial_threads() == 3
-    monkeypatch.delenv(experiment.THREADS_ENV)
-    assert experiment.trial_threads() >= 1
+    monkeypatch.setenv(cpus.ENV, "3")
+    assert experiment.trial_threads() == cpus.cpus() == 3
+    monkeypatch.delenv(cpus.ENV)
+    assert cpus.cpus() >= 1
     for bad in ("0", "-2", "two"):
-        monkeypatch.setenv(experiment.THREADS_ENV, bad)
-        with pytest.raises(InvalidParameterError, match=experiment.THREADS_ENV) as err:
-            experiment.trial_threads()
+        monkeypatch.setenv(cpus.ENV, bad)
+        with pytest.raises(InvalidParameterError, match=cpus.ENV) as err:
+            cpus.cpus()
         assert "\n" not in str(err.value)
 
 
@@ -72,10 +73,10 @@ def test_a_bad_thread_count_is_one_line_and_exit_2(tmp_path):
     import subprocess
     import sys
 
-    env = {**os.environ, experiment.THREADS_ENV: "zero"}
+    env = {**os.environ, cpus.ENV: "zero"}
     proc = subprocess.run([sys.executable, "-m", "armtransfer.cli", "rooms", "--trials", "2", "--no-controls",
                            "--method", "none", "--max-episodes", "2", "--json", str(tmp_path / "r.json")],
                           capture_output=True, text=True, env=env, timeout=120, cwd=tmp_path)
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
-    assert experiment.THREADS_ENV in proc.stderr and "Traceback" not in proc.stderr
+    assert cpus.ENV in proc.stderr and "Traceback" not in proc.stderr
     assert list(tmp_path.iterdir()) == []

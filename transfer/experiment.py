@@ -7,7 +7,6 @@ same seed gives the same result, bit for bit, however many threads run the trial
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field
@@ -15,6 +14,7 @@ from typing import TypeVar
 
 import numpy as np
 
+from armtransfer.cpus import cpus as _cpus
 from armtransfer.errors import InvalidParameterError
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.learning import controls, farming, methods, metrics, potentials, sarsa
@@ -30,25 +30,12 @@ METHODS = tuple(methods.METHODS)
 """Every method's name, from the registry ``armtransfer.learning.methods``."""
 
 
-THREADS_ENV = "ARMTRANSFER_TRIAL_THREADS"
-"""The environment variable that sets :func:`trial_threads` (a sweep's worker processes set 1:
-the workers are the parallelism there)."""
-
-
 def trial_threads() -> int:
-    """Threads the trials of one method run on: ``$ARMTRANSFER_TRIAL_THREADS``, else the CPUs
-    this process may use. The learner's kernel releases the GIL, and every trial has its own
-    generator and arrays, so the results are the same, bit for bit, for any number."""
-    value = os.environ.get(THREADS_ENV, "").strip()
-    if value:
-        try:
-            n = int(value)
-        except ValueError:
-            n = 0
-        if n < 1:
-            raise InvalidParameterError(f"{THREADS_ENV} must be a positive integer, got {value!r}")
-        return n
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    """Threads the trials of one method run on: ``armtransfer.cpus.cpus()``
+    (``$ARMTRANSFER_CPUS``, else the CPUs this process may use). The learner's kernel releases
+    the GIL, and every trial has its own generator and arrays, so the results are the same,
+    bit for bit, for any number."""
+    return _cpus()
 
 
 def map_trials(one: Callable[[int], T], trials: int, threads: int | None = None,

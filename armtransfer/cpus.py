@@ -1,0 +1,31 @@
+"""How many CPUs one armtransfer process may use for its own parallel work: the trials of a
+method, on threads (``transfer.experiment.map_trials``). A sweep's workers set 1: there the
+workers are the parallelism. Results never depend on it.
+
+Threads, not processes: with the ``spawn`` start method a process pool re-imports the
+caller's ``__main__``, and a user's script without an ``if __name__ == "__main__":`` guard
+would then run again in every worker (only a sweep, whose workers are the point, starts
+processes)."""
+
+from __future__ import annotations
+
+import os
+
+from armtransfer.errors import InvalidParameterError
+
+ENV = "ARMTRANSFER_CPUS"
+"""The environment variable that sets :func:`cpus` (default: the CPUs this process may use)."""
+
+
+def cpus() -> int:
+    """``$ARMTRANSFER_CPUS``, else the CPUs this process may use."""
+    value = os.environ.get(ENV, "").strip()
+    if value:
+        try:
+            n = int(value)
+        except ValueError:
+            n = 0
+        if n < 1:
+            raise InvalidParameterError(f"{ENV} must be a positive integer, got {value!r}")
+        return n
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
