@@ -50,7 +50,8 @@ def test_bad_guide_parameters_are_one_line_errors():
 
 @pytest.mark.parametrize("wind", [0.0, 0.2])
 @pytest.mark.parametrize("several", [False, True])
-def test_kernel_is_bit_identical_to_the_dense_reference_with_the_guide(wind, several):
+@pytest.mark.parametrize("tip", [False, True])
+def test_kernel_is_bit_identical_to_the_dense_reference_with_the_guide(wind, several, tip):
     fine, coarse, start, goal = small_task()
     trajs = [trajectories.shortest(coarse, start, goal)]
     if several:  # a second, longer trajectory through the top of the rooms
@@ -58,8 +59,9 @@ def test_kernel_is_bit_identical_to_the_dense_reference_with_the_guide(wind, sev
         a, b = trajectories.shortest(coarse, start, mid), trajectories.shortest(coarse, mid, goal)
         trajs.append(trajectories.Trajectory(cells=[*a.cells, *b.cells], actions=[*a.actions, *b.actions],
                                              goal=goal, source=coarse.name))
-    # the model chooses in the first 3 episodes, then Algorithm 1 alone
-    sh = guided_shaping(fine, trajs, episodes=3)
+    # the model chooses in the first 3 episodes, then Algorithm 1 alone; tip: the tip model on a
+    # grid robot (its configuration is its cell), so that wind and several trajectories meet it too
+    sh = guided_shaping(fine, trajs, episodes=3, tip=tip)
     config = LearnerConfig(trace_cutoff=0.0, max_episodes=8, patience=1000)
     s0 = fine.start_state(start)
     fast = sarsa.learn(fine, s0, goal, config, np.random.default_rng(7), shaping=sh, wind=wind, keep_q=True)
@@ -67,6 +69,71 @@ def test_kernel_is_bit_identical_to_the_dense_reference_with_the_guide(wind, sev
                                wind=wind)
     assert fast.episode_steps.tolist() == steps
     assert np.array_equal(fast.Q, Q)
+
+
+@pytest.mark.parametrize("anchor", [False, True])
+def test_kernel_is_bit_identical_to_the_dense_reference_with_the_tip_model_on_a_joint_arm(anchor):
+    """planar2:joint, whose actions move a joint: the tip model is on by default, and the kernel's
+    recursive least squares, predictions and choices are the reference's, bit for bit."""
+    from armtransfer.tasks.specs import resolve
+
+    arm, coarse = resolve("planar2:joint"), grid_robot("coarse")
+    start, goal = TABLE_I[4].cells()
+    trajs = [trajectories.shortest(coarse, start, goal)]
+    sh = guided_shaping(arm, trajs, tip_anchor=anchor)
+    assert sh.guide.tip and sh.guide.fj.shape == (9, guide.TIP_ORDER)  # 2 joints: 1 + 4 + 4 features
+    config = LearnerConfig(trace_cutoff=0.0, max_episodes=2, patience=1000)
+    s0 = arm.start_state(start)
+    fast = sarsa.learn(arm, s0, goal, config, np.random.default_rng(5), shaping=sh, keep_q=True)
+    Q, steps = reference.learn(arm, s0, goal, config, np.random.default_rng(5), episodes=2, guide=sh.guide)
+    assert fast.episode_steps.tolist() == steps
+    assert np.array_equal(fast.Q, Q)
+
+
+def test_the_tip_model_is_on_for_joint_moves_only():
+    from armtransfer.tasks.specs import resolve
+
+    coarse = grid_robot("coarse")
+    start, goal = TABLE_I[1].cells()
+    traj = trajectories.shortest(coarse, start, goal)
+    assert guide.build(resolve("planar2:joint"), [traj]).tip
+    for name in ("fine", "ur5e_like:cartesian"):  # a cell a move: the label shows every move
+        robot = resolve(name) if ":" in name else grid_robot(name)
+        g = guide.build(robot, [traj])
+        assert not g.tip and g.fj.shape[0] == 0
+    assert guide.build(grid_robot("fine"), [traj], tip=True).tip  # asked for
+
+
+def test_tip_features_fit_a_planar_chain_exactly():
+    """Products of cos and sin of up to 3 joints span the tip of any planar chain of up to 3
+    revolute joints: least squares on them reproduces its forward kinematics to rounding."""
+    rng = np.random.default_rng(0)
+    links = np.array([0.9, 0.7, 0.4])
+    q = rng.uniform(-3, 3, (200, 3))
+    angles = np.cumsum(q, axis=1)
+    tip = np.stack([(links * np.cos(angles)).sum(1), (links * np.sin(angles)).sum(1)], axis=1)
+    fj, fk = guide.tip_features(3)
+    assert len(fj) == 27
+    F = np.ones((len(q), len(fj)))
+    for i in range(len(fj)):
+        for j, k in zip(fj[i], fk[i]):
+            if j >= 0:
+                F[:, i] *= np.cos(q[:, j]) if k == 0 else np.sin(q[:, j])
+    W, *_ = np.linalg.lstsq(F, tip, rcond=None)
+    assert np.abs(F @ W - tip).max() < 1e-9
+    # two joints are not enough for a 3-joint chain
+    F2 = F[:, [i for i in range(len(fj)) if (fj[i] < 2).all()]]
+    W2, *_ = np.linalg.lstsq(F2, tip, rcond=None)
+    assert np.abs(F2 @ W2 - tip).max() > 1e-2
+
+
+def test_bad_tip_parameters_are_one_line_errors():
+    fine, coarse, start, goal = small_task()
+    traj = trajectories.shortest(coarse, start, goal)
+    for bad in (dict(tip_ridge=0.0), dict(tip_ridge=float("inf")), dict(tip_nearest=0)):
+        with pytest.raises(InvalidParameterError) as err:
+            guide.build(fine, [traj], **bad)
+        assert "\n" not in str(err.value) and "tip_" in str(err.value)
 
 
 def test_same_seed_gives_bit_identical_results():

@@ -15,6 +15,19 @@ The model (all of it from what robot 2 observes):
     a was tried (for an arm its joint configuration ``arm.qpos``; for a grid robot its cell):
     the same action moves the tip by about the same cells in neighbouring configurations, and
     for a joint-space arm the effect changes smoothly with the configuration.
+  * The tip model, for a robot whose actions move a joint (``joint`` action model; ``tip``): one
+    move shifts the tip by a fraction of a cell, so the label rarely changes and a move tried
+    at a state mostly records "no effect". Robot 2 therefore also learns *where its tip is* as a
+    smooth function of its own joint configuration q: ridge least squares of the label's xy on
+    products of cos and sin of up to ``TIP_ORDER`` of its moving joints (exact for any planar
+    chain of up to 3 joints; learned one recursive step per newly visited state, in the
+    exploration phase). A move not yet tried at s is predicted as tip(q_s + the mean joint
+    displacement robot 2 observed for that action) - tip(q_s): a sub-cell displacement; it is
+    predicted blocked (no displacement) when it was blocked at each of the ``TIP_NEAREST``
+    remembered states nearest to s where it was tried (a joint limit, a wall). With
+    ``TIP_ANCHOR`` the score starts from the model's estimate of the tip inside the current cell
+    (clamped to the cell) instead of the cell's centre. A move tried at s keeps its own
+    observed displacement, as above.
   * Progress along a trajectory: the furthest index whose cell the label came within
     ``reach`` cells of in this episode; after ``give_up`` moves without progress the next
     cell is given up on (it may be out of reach). The score of a predicted label position q is
@@ -49,6 +62,7 @@ greedy path through the table as for every method)."""
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numba
@@ -88,7 +102,15 @@ WEIGHT, WINDOW, REACH, KNN and BLOCKED were chosen together on held-out start/go
 coarse <-> fine and planar2:joint <-> ur5e_like:cartesian (``scripts/select_defaults.py
 --method guided``: the smallest mean first exposure of the worst robot pair, 1.96x the optimal
 distance), never on Table I; EPISODES is the exploration phase, as for the mapping's macros;
-MEMORY was not tuned."""
+MEMORY was not tuned. Re-run with the tip model in place the same grid picks the same values
+(knn 3 and 8 within 0.1% of each other).
+
+TIP_ANCHOR, TIP_RIDGE and TIP_NEAREST were chosen after them (``scripts/select_defaults.py
+--method guided-tip``) on the held-out start/goal pairs of ur5e_like:cartesian ->
+planar2:joint, the robot pair of that grid whose target moves its joints, and on 8 more held-out
+pairs of it whose trajectory has cells the arm cannot reach (at most a quarter of them):
+the smallest worse of the two means, 1.70x the optimal distance on both (without the tip model
+1.79x and 3.23x); never on Table I. TIP_ORDER was not tuned."""
 PLAN = True
 """Whether robot 2 plans over the moves it has tried, after every episode (see :func:`plan`)."""
 PLAN_TOL = 1e-12
@@ -111,6 +133,21 @@ planar2:joint one trial in 40 never converged and one converged 1 step long (47 
 below any real difference: routes of L and L + 1 steps differ by gamma^L (0.0067 at L = 500)."""
 SUCCESSORS = 4
 """Distinct observed successors kept per pair (a move and its wind push are at most 2)."""
+TIP = None
+"""Whether robot 2 also learns where its tip is from its joint configuration (the tip model,
+see the module docstring): None chooses it for robots whose actions move a joint (the ``joint``
+action model), where one move shifts the tip by a fraction of a cell."""
+TIP_ANCHOR = True
+"""Whether the score starts from the tip model's estimate of where the tip is inside the current
+cell (clamped to the cell) instead of the cell's centre."""
+TIP_ORDER = 3
+"""The tip model's features are products of cos and sin of at most this many of the moving
+joints (3: exact for the tip of any planar chain of up to 3 joints and any 2-joint arm)."""
+TIP_RIDGE = 1e-3
+"""Ridge penalty of the tip model's least squares (the prior: the tip stays where it started)."""
+TIP_NEAREST = 8
+"""A move not yet tried at a state is predicted blocked when it was blocked at each of this many
+states nearest in configuration space where it was tried (a joint limit, a wall)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -123,18 +160,46 @@ class Guide:
     ty: np.ndarray  # float64 [T]
     trem: np.ndarray  # float64 [T]: trajectory length (cells) from this cell to its end
     tstart: np.ndarray  # int64 [n_traj + 1]: where each trajectory starts in tx/ty/trem
-    params: np.ndarray  # float64 [10]: window, reach, knn, memory, weight, episodes, blocked (0/1), give_up,
-    #                    plan (0/1), plan tolerance
+    params: np.ndarray  # float64 [14]: window, reach, knn, memory, weight, episodes, blocked (0/1), give_up,
+    #                    plan (0/1), plan tolerance, tip model (0/1), tip ridge, tip nearest, tip anchor (0/1)
+    tq: np.ndarray  # float64 [S, C]: the moving joints of each state (the tip model's input; [0, 1] without it)
+    fj: np.ndarray  # int64 [F, TIP_ORDER]: the joints (columns of tq) each feature multiplies, -1 past its last
+    fk: np.ndarray  # int64 [F, TIP_ORDER]: 0 for the cosine of that joint, 1 for its sine
 
     @property
     def memory(self) -> int:
         return int(self.params[3])
 
+    @property
+    def tip(self) -> bool:
+        return bool(self.params[10] > 0.0)
+
+
+def tip_features(n_joints: int, order: int = TIP_ORDER) -> tuple[np.ndarray, np.ndarray]:
+    """(fj, fk) of the tip model: the constant 1, then for k = 1 .. order every set of k joints
+    (in index order) times every choice of cos or sin for each of them. Any serial chain of
+    revolute joints has a tip whose coordinates are sums of such products of all its joints; up to
+    ``order`` joints at a time this is exact for up to ``order`` joints and a smooth basis beyond."""
+    fj, fk = [[-1] * order], [[0] * order]
+    for k in range(1, min(order, n_joints) + 1):
+        for joints in itertools.combinations(range(n_joints), k):
+            for kinds in itertools.product((0, 1), repeat=k):
+                fj.append(list(joints) + [-1] * (order - k))
+                fk.append(list(kinds) + [0] * (order - k))
+    return np.array(fj, np.int64), np.array(fk, np.int64)
+
+
+def uses_tip(robot: DiscreteRobot) -> bool:
+    """Whether the tip model is on by default: robots whose actions move a joint."""
+    return robot.arm is not None and robot.arm.joint_step is not None
+
 
 def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW, reach: float = REACH,
           knn: int = KNN, memory: int = MEMORY, weight: float = WEIGHT, episodes: int = EPISODES,
-          blocked: bool = BLOCKED, give_up: int = GIVE_UP, plan: bool = PLAN) -> Guide:
-    """The guide for ``robot`` following ``trajs`` (one or several)."""
+          blocked: bool = BLOCKED, give_up: int = GIVE_UP, plan: bool = PLAN, tip: bool | None = TIP,
+          tip_ridge: float = TIP_RIDGE, tip_nearest: int = TIP_NEAREST, tip_anchor: bool = TIP_ANCHOR) -> Guide:
+    """The guide for ``robot`` following ``trajs`` (one or several). ``tip`` None: the tip
+    model for robots whose actions move a joint (:func:`uses_tip`)."""
     for name, v in (("window", window), ("reach", reach), ("weight", weight)):
         if not (np.isfinite(v) and v >= 0):
             raise InvalidParameterError(f"{name} must be a non-negative number, got {v}")
@@ -142,6 +207,10 @@ def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW,
         raise InvalidParameterError(f"give_up must be a non-negative number of moves, got {give_up}")
     if int(knn) < 1 or int(memory) < 1 or int(episodes) < 1:
         raise InvalidParameterError(f"knn, memory and episodes must be positive integers, got {knn}, {memory}, {episodes}")
+    if not (np.isfinite(tip_ridge) and tip_ridge > 0):
+        raise InvalidParameterError(f"tip_ridge must be a positive number, got {tip_ridge}")
+    if int(tip_nearest) < 1:
+        raise InvalidParameterError(f"tip_nearest must be a positive integer, got {tip_nearest}")
     layout = robot.layout
     lxy = layout.xy_of(robot.label).astype(np.float64).reshape(-1, 2)
     if robot.arm is not None:
@@ -158,28 +227,38 @@ def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW,
         ys.append(c[:, 1])
         rem.append(r)
         starts.append(starts[-1] + len(c))
+    tip = uses_tip(robot) if tip is None else bool(tip)
+    if tip:  # the joints that move (a held finger is constant over the states)
+        tq = feat[:, np.ptp(feat, axis=0) > 0] if len(feat) else feat
+        fj, fk = tip_features(tq.shape[1])
+    else:
+        tq, fj, fk = np.zeros((0, 1)), np.zeros((0, TIP_ORDER), np.int64), np.zeros((0, TIP_ORDER), np.int64)
     return Guide(
         feat=np.ascontiguousarray(feat), lxy=np.ascontiguousarray(lxy),
         tx=np.concatenate(xs), ty=np.concatenate(ys), trem=np.concatenate(rem),
         tstart=np.array(starts, np.int64),
         params=np.array([float(window), float(reach), float(int(knn)), float(int(memory)), float(weight),
                          float(int(episodes)), 1.0 if blocked else 0.0, float(int(give_up)),
-                         1.0 if plan else 0.0, PLAN_TOL]),
+                         1.0 if plan else 0.0, PLAN_TOL, 1.0 if tip else 0.0, float(tip_ridge),
+                         float(int(tip_nearest)), 1.0 if tip_anchor else 0.0]),
+        tq=np.ascontiguousarray(tq, dtype=np.float64), fj=fj, fk=fk,
     )
 
 
 def inactive(n_actions: int) -> tuple:
     """(guide tuple, model tuple) for a trial without a guide: empty arrays of the right types."""
     g = (np.zeros((0, 1)), np.zeros((0, 2)), np.zeros(0), np.zeros(0), np.zeros(0),
-         np.zeros(1, np.int64), np.array([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]))
+         np.zeros(1, np.int64), np.array([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0]),
+         np.zeros((0, 1)), np.zeros((0, TIP_ORDER), np.int64), np.zeros((0, TIP_ORDER), np.int64))
     return g, model_arrays(0, n_actions, 1, 1)
 
 
 def as_tuple(g: Guide) -> tuple:
-    return (g.feat, g.lxy, g.tx, g.ty, g.trem, g.tstart, g.params)
+    return (g.feat, g.lxy, g.tx, g.ty, g.trem, g.tstart, g.params, g.tq, g.fj, g.fk)
 
 
-def model_arrays(n_states: int, n_actions: int, memory: int, n_traj: int) -> tuple:
+def model_arrays(n_states: int, n_actions: int, memory: int, n_traj: int, n_features: int = 0,
+                 n_joints: int = 0) -> tuple:
     """What the model learns during a trial: (displacement sums [S, A, 2], counts [S, A],
     remembered states [A, memory], pushes per action [A], progress index per trajectory,
     generalised [S, A], moved [S, A], moves without progress per trajectory), then what
@@ -187,7 +266,11 @@ def model_arrays(n_states: int, n_actions: int, memory: int, n_traj: int) -> tup
     [S*A, M], how many [S*A]), the observed predecessors of each state as a linked list in the
     order first seen (head [S], tail [S], next [S*A*M], pair [S*A*M], edges used [1]), and
     planning scratch (values [S], queue [S], queued [S], has a tried pair [S]) and its counts
-    (plannings, most backups in one, plannings that hit the cap)."""
+    (plannings, most backups in one, plannings that hit the cap); then the tip model's (empty
+    without it): P [F, F] (the inverse of the ridge normal matrix), W [F, 2] (its weights), the
+    first label seen [2] and whether it was [1], states already learned from [S], summed joint
+    displacement per action [A, C] and moves summed [A], and scratch (features [F] twice, P times
+    features [F], a configuration [C])."""
     pairs = n_states * n_actions
     return (np.zeros((n_states, n_actions, 2)), np.zeros((n_states, n_actions), np.int64),
             np.zeros((n_actions, memory), np.int64), np.zeros(n_actions, np.int64),
@@ -197,18 +280,99 @@ def model_arrays(n_states: int, n_actions: int, memory: int, n_traj: int) -> tup
             np.zeros(pairs, np.int64), np.full(n_states, -1, np.int64), np.full(n_states, -1, np.int64),
             np.full(pairs * SUCCESSORS, -1, np.int64), np.zeros(pairs * SUCCESSORS, np.int64),
             np.zeros(1, np.int64), np.zeros(n_states), np.zeros(n_states, np.int64),
-            np.zeros(n_states, np.bool_), np.zeros(n_states, np.bool_), np.zeros(3, np.int64))
+            np.zeros(n_states, np.bool_), np.zeros(n_states, np.bool_), np.zeros(3, np.int64),
+            np.eye(n_features), np.zeros((n_features, 2)), np.zeros(2), np.zeros(1, np.bool_),
+            np.zeros(n_states if n_features else 0, np.bool_), np.zeros((n_actions, n_joints)),
+            np.zeros(n_actions, np.int64), np.zeros(n_features), np.zeros(n_features), np.zeros(n_features),
+            np.zeros(n_joints))
+
+
+def model_arrays_for(g: Guide, n_states: int, n_actions: int) -> tuple:
+    """:func:`model_arrays` sized for guide ``g`` (P starts as the identity over the ridge)."""
+    f = g.fj.shape[0]
+    gm = model_arrays(n_states, n_actions, g.memory, len(g.tstart) - 1, f, g.tq.shape[1] if f else 0)
+    gm[21][...] /= g.params[11] if f else 1.0
+    return gm
 
 
 @numba.njit(cache=True)
-def reset_progress(g, gm, s):
-    """At an episode's start: progress at each trajectory's first cell, then what s reaches."""
+def reset_progress(g, gm, s, guided):
+    """At an episode's start: progress at each trajectory's first cell, then what s reaches;
+    in the exploration phase (``guided``) the tip model learns from s."""
     tstart = g[5]
     prog, wait = gm[4], gm[7]
     for t in range(tstart.shape[0] - 1):
         prog[t] = tstart[t]
         wait[t] = 0
+    if guided and g[6][10] > 0.0:
+        tip_learn(g, gm, s)
     update_progress(g, gm, s)
+
+
+@numba.njit(cache=True)
+def features(g, q, out):
+    """The tip model's features of joint configuration q (``tip_features``) into out."""
+    fj, fk = g[8], g[9]
+    for i in range(fj.shape[0]):
+        v = 1.0
+        for k in range(fj.shape[1]):
+            j = fj[i, k]
+            if j < 0:
+                break
+            if fk[i, k] == 0:
+                v *= np.cos(q[j])
+            else:
+                v *= np.sin(q[j])
+        out[i] = v
+
+
+@numba.njit(cache=True)
+def tip_learn(g, gm, s):
+    """The tip model learns from state s, once per state: one recursive least-squares step
+    (Sherman-Morrison) towards label xy(s) - (the first label it learned from), on the
+    features of s's moving joints. P stays the inverse of (ridge I + sum of f f^T)."""
+    lxy, tq = g[1], g[7]
+    P, W, y0, has0, seen, f, px = gm[21], gm[22], gm[23], gm[24], gm[25], gm[28], gm[30]
+    if seen[s]:
+        return
+    seen[s] = True
+    if not has0[0]:
+        y0[0] = lxy[s, 0]
+        y0[1] = lxy[s, 1]
+        has0[0] = True
+    features(g, tq[s], f)
+    n = f.shape[0]
+    denom = 1.0
+    for i in range(n):
+        acc = 0.0
+        for j in range(n):
+            acc += P[i, j] * f[j]
+        px[i] = acc
+    for i in range(n):
+        denom += f[i] * px[i]
+    for c in range(2):
+        fit = 0.0
+        for i in range(n):
+            fit += f[i] * W[i, c]
+        err = (lxy[s, c] - y0[c]) - fit
+        for i in range(n):
+            W[i, c] += px[i] / denom * err
+    for i in range(n):
+        k = px[i] / denom
+        for j in range(n):
+            P[i, j] -= k * px[j]
+
+
+@numba.njit(cache=True)
+def tip_at(g, gm, f):
+    """(x, y) the tip model predicts (relative to the first label) for features f."""
+    W = gm[22]
+    x = 0.0
+    y = 0.0
+    for i in range(f.shape[0]):
+        x += f[i] * W[i, 0]
+        y += f[i] * W[i, 1]
+    return x, y
 
 
 @numba.njit(cache=True)
@@ -243,12 +407,21 @@ def update_progress(g, gm, s):
 
 
 @numba.njit(cache=True)
-def observe(g, gm, s, a, s2):
-    """Record the move s --a--> s2 (s2: the state whose label robot 2 perceives after it)."""
+def observe(g, gm, s, a, s2, guided):
+    """Record the move s --a--> s2 (s2: the state whose label robot 2 perceives after it); in
+    the exploration phase (``guided``) the tip model learns the move's joint displacement and
+    where s2 is."""
     lxy, params = g[1], g[6]
     dsum, dcnt, buf, bufn, inbuf, moved = gm[0], gm[1], gm[2], gm[3], gm[5], gm[6]
     if s2 != s:
         moved[s, a] = True
+    if guided and params[10] > 0.0:
+        tq, dq, dqn = g[7], gm[26], gm[27]
+        if s2 != s:
+            for c in range(tq.shape[1]):
+                dq[a, c] += tq[s2, c] - tq[s, c]
+            dqn[a] += 1
+        tip_learn(g, gm, s2)
     dsum[s, a, 0] += lxy[s2, 0] - lxy[s, 0]
     dsum[s, a, 1] += lxy[s2, 1] - lxy[s, 1]
     dcnt[s, a] += 1
@@ -411,6 +584,52 @@ def predict(g, gm, s, a):
 
 
 @numba.njit(cache=True)
+def near_blocked(g, gm, s, a):
+    """Whether a was blocked at each of the ``tip nearest`` remembered states nearest to s in
+    configuration space where it was tried (ties: the earlier slot), i.e. a joint limit or a
+    wall is predicted; False when a was tried nowhere."""
+    feat, params = g[0], g[6]
+    buf, bufn, moved = gm[2], gm[3], gm[6]
+    memory = int(params[3])
+    n = min(bufn[a], memory)
+    if n == 0:
+        return False
+    k = min(int(params[12]), n)
+    dist = np.empty(n)
+    for i in range(n):
+        u = buf[a, i]
+        d = 0.0
+        for c in range(feat.shape[1]):
+            diff = feat[u, c] - feat[s, c]
+            d += diff * diff
+        dist[i] = d
+    taken = np.zeros(n, np.bool_)
+    for _ in range(k):
+        best = -1
+        for i in range(n):
+            if not taken[i] and (best < 0 or dist[i] < dist[best]):
+                best = i
+        taken[best] = True
+        if moved[buf[a, best], a]:
+            return False
+    return True
+
+
+@numba.njit(cache=True)
+def tip_move(g, gm, s, a, x0, y0):
+    """(dx, dy): the tip model's displacement for a at s: the tip at s's joints plus a's mean
+    observed joint displacement, minus (x0, y0), the tip at s; (0, 0) when a never moved."""
+    tq, dq, dqn, f, q = g[7], gm[26], gm[27], gm[29], gm[31]
+    if dqn[a] == 0:
+        return 0.0, 0.0
+    for c in range(tq.shape[1]):
+        q[c] = tq[s, c] + dq[a, c] / dqn[a]
+    features(g, q, f)
+    x1, y1 = tip_at(g, gm, f)
+    return x1 - x0, y1 - y0
+
+
+@numba.njit(cache=True)
 def score(g, gm, x, y):
     """How far (cells) a label at (x, y) is from the goal along the trajectories ahead."""
     tx, ty, trem, tstart, params = g[2], g[3], g[4], g[5], g[6]
@@ -449,15 +668,34 @@ def egreedy(Q, s, eps, rng, g, gm):
     y = lxy[s, 1]
     val = np.empty(n_actions)
     best = -np.inf
-    dcnt, moved = gm[1], gm[6]
+    dcnt, moved, bufn = gm[1], gm[6], gm[3]
+    tip = params[10] > 0.0
+    x0 = 0.0
+    y0 = 0.0
+    if tip:
+        features(g, g[7][s], gm[28])
+        x0, y0 = tip_at(g, gm, gm[28])
+        if params[13] > 0.0:
+            first = gm[23]
+            x = min(max(first[0] + x0, lxy[s, 0] - 0.5), lxy[s, 0] + 0.5)
+            y = min(max(first[1] + y0, lxy[s, 1] - 0.5), lxy[s, 1] + 0.5)
     for a in range(n_actions):
-        known, dx, dy = predict(g, gm, s, a)
         if dcnt[s, a] > 0 and not moved[s, a]:
             v = -np.inf  # tried here and blocked every time: a wasted step, never the model's choice
-        elif known:
-            v = Q[s, a] - w * score(g, gm, x + dx, y + dy)
+        elif tip and dcnt[s, a] == 0:  # the tip model predicts a pair not tried here
+            if bufn[a] == 0:
+                v = np.inf  # tried nowhere yet
+            elif near_blocked(g, gm, s, a):
+                v = Q[s, a] - w * score(g, gm, x, y)
+            else:
+                dx, dy = tip_move(g, gm, s, a, x0, y0)
+                v = Q[s, a] - w * score(g, gm, x + dx, y + dy)
         else:
-            v = np.inf
+            known, dx, dy = predict(g, gm, s, a)
+            if known:
+                v = Q[s, a] - w * score(g, gm, x + dx, y + dy)
+            else:
+                v = np.inf
         val[a] = v
         if v > best:
             best = v

@@ -7,6 +7,7 @@ same generator and ``trace_cutoff=0`` the two give bit-identical Q tables.
 
 from __future__ import annotations
 
+import math
 from collections import deque
 
 import numpy as np
@@ -46,14 +47,110 @@ class GuideModel:
         self.plans = guide.params[8] > 0
         self.successors: dict[tuple[int, int], list[list[int]]] = {}  # (s, a) -> [[s2, count], ...] first seen first
         self.preds: dict[int, list[int]] = {}  # s2 -> the states of the pairs it followed, first seen first
+        # the tip model (transfer.guide.tip_learn): ridge least squares, one recursive step per new state
+        self.tip = guide.params[10] > 0
+        n_f = guide.fj.shape[0]
+        ridge = float(guide.params[11])
+        self.P = [[(1.0 if i == j else 0.0) / ridge for j in range(n_f)] for i in range(n_f)]
+        self.W = [[0.0, 0.0] for _ in range(n_f)]
+        self.first: tuple[float, float] | None = None  # the first label the tip model learned from
+        self.tip_seen: set[int] = set()
+        n_j = guide.tq.shape[1] if n_f else 0
+        self.dq = [[0.0] * n_j for _ in range(n_actions)]  # summed joint displacement of each action's moves
+        self.dqn = [0] * n_actions
 
     def cells(self, t: int) -> range:
         return range(int(self.g.tstart[t]), int(self.g.tstart[t + 1]))
 
-    def start_episode(self, s: int) -> None:
+    def start_episode(self, s: int, guided: bool) -> None:
         self.prog = [int(self.g.tstart[t]) for t in range(self.n_traj)]
         self.wait = [0] * self.n_traj
+        if guided and self.tip:
+            self.tip_learn(s)
         self.reached(s)
+
+    def features(self, q) -> list[float]:
+        g = self.g
+        out = []
+        for i in range(g.fj.shape[0]):
+            v = 1.0
+            for k in range(g.fj.shape[1]):
+                j = int(g.fj[i, k])
+                if j < 0:
+                    break
+                v *= math.cos(float(q[j])) if g.fk[i, k] == 0 else math.sin(float(q[j]))
+            out.append(v)
+        return out
+
+    def tip_learn(self, s: int) -> None:
+        """One recursive least-squares step towards s's label (relative to the first one)."""
+        if s in self.tip_seen:
+            return
+        self.tip_seen.add(s)
+        lx, ly = float(self.g.lxy[s][0]), float(self.g.lxy[s][1])
+        if self.first is None:
+            self.first = (lx, ly)
+        f = self.features(self.g.tq[s])
+        n = len(f)
+        px = []
+        for i in range(n):
+            acc = 0.0
+            for j in range(n):
+                acc += self.P[i][j] * f[j]
+            px.append(acc)
+        denom = 1.0
+        for i in range(n):
+            denom += f[i] * px[i]
+        for c, target in enumerate((lx - self.first[0], ly - self.first[1])):
+            fit = 0.0
+            for i in range(n):
+                fit += f[i] * self.W[i][c]
+            err = target - fit
+            for i in range(n):
+                self.W[i][c] += px[i] / denom * err
+        for i in range(n):
+            k = px[i] / denom
+            for j in range(n):
+                self.P[i][j] -= k * px[j]
+
+    def tip_at(self, f: list[float]) -> tuple[float, float]:
+        x = y = 0.0
+        for i in range(len(f)):
+            x += f[i] * self.W[i][0]
+            y += f[i] * self.W[i][1]
+        return x, y
+
+    def tip_move(self, s: int, a: int, x0: float, y0: float) -> tuple[float, float]:
+        if self.dqn[a] == 0:
+            return 0.0, 0.0
+        q = [float(self.g.tq[s, c]) + self.dq[a][c] / self.dqn[a] for c in range(self.g.tq.shape[1])]
+        x1, y1 = self.tip_at(self.features(q))
+        return x1 - x0, y1 - y0
+
+    def recent(self, a: int) -> list[int]:
+        """The most recent ``memory`` states a was tried at, in the kernel's ring-buffer slot order."""
+        slots: dict[int, int] = {}
+        for i, u in enumerate(self.tried_at[a]):
+            slots[i % self.memory] = u
+        return [slots[k] for k in sorted(slots)]
+
+    def nearest(self, s: int, a: int, k: int) -> list[int]:
+        """The k of those states nearest to s in configuration space (ties: the earlier slot)."""
+        recent = self.recent(a)
+        f = self.g.feat
+
+        def dist(u: int) -> float:
+            d = 0.0
+            for c in range(f.shape[1]):
+                d += (f[u, c] - f[s, c]) * (f[u, c] - f[s, c])
+            return d
+
+        order = sorted(range(len(recent)), key=lambda i: (dist(recent[i]), i))
+        return [recent[i] for i in order[: min(k, len(recent))]]
+
+    def near_blocked(self, s: int, a: int) -> bool:
+        near = self.nearest(s, a, int(self.g.params[12]))
+        return bool(near) and all((u, a) not in self.moved for u in near)
 
     def reached(self, s: int) -> None:
         g = self.g
@@ -76,13 +173,19 @@ class GuideModel:
                     self.prog[t] += 1
                     self.wait[t] = 0
 
-    def observe(self, s: int, a: int, s2: int) -> None:
+    def observe(self, s: int, a: int, s2: int, guided: bool) -> None:
         g = self.g
         entry = self.sums.get((s, a))
         if entry is None:
             entry = self.sums[(s, a)] = [0.0, 0.0, 0]
         if s2 != s:
             self.moved.add((s, a))
+        if guided and self.tip:
+            if s2 != s:
+                for c in range(g.tq.shape[1]):
+                    self.dq[a][c] += g.tq[s2, c] - g.tq[s, c]
+                self.dqn[a] += 1
+            self.tip_learn(s2)
         if (s2 != s or g.params[6] > 0) and (s, a) not in self.generalised:  # blocked: only if asked
             self.generalised.add((s, a))
             self.tried_at[a].append(s)
@@ -143,27 +246,12 @@ class GuideModel:
         if (s, a) in self.sums:
             sx, sy, n = self.sums[(s, a)]
             return sx / n, sy / n
-        tried = self.tried_at[a]
-        if not tried:
+        near = self.nearest(s, a, self.knn)
+        if not near:
             return None
-        # the most recent `memory` states, in the kernel's ring-buffer slot order
-        slots: dict[int, int] = {}
-        for i, u in enumerate(tried):
-            slots[i % self.memory] = u
-        recent = [slots[k] for k in sorted(slots)]
-        f = self.g.feat
-
-        def dist(u: int) -> float:
-            d = 0.0
-            for c in range(f.shape[1]):
-                d += (f[u, c] - f[s, c]) * (f[u, c] - f[s, c])
-            return d
-
-        order = sorted(range(len(recent)), key=lambda i: (dist(recent[i]), i))
-        near = order[: min(self.knn, len(recent))]
         sx = sy = 0.0
-        for i in near:
-            ex, ey, n = self.sums[(recent[i], a)]
+        for u in near:
+            ex, ey, n = self.sums[(u, a)]
             sx += ex / n
             sy += ey / n
         return sx / len(near), sy / len(near)
@@ -188,12 +276,27 @@ class GuideModel:
             return int(rng.random() * n_actions)
         x, y = self.g.lxy[s]
         w = self.g.params[4]
+        x0 = y0 = 0.0
+        if self.tip:
+            x0, y0 = self.tip_at(self.features(self.g.tq[s]))
+            if self.g.params[13] > 0:  # anchored: the tip model's estimate, kept inside the cell
+                lx, ly = self.g.lxy[s]
+                x = min(max(self.first[0] + x0, lx - 0.5), lx + 0.5)
+                y = min(max(self.first[1] + y0, ly - 0.5), ly + 0.5)
         val = []
         for a in range(n_actions):
-            p = self.predict(s, a)
             if (s, a) in self.sums and (s, a) not in self.moved:
                 val.append(-np.inf)  # blocked at every try here
+            elif self.tip and (s, a) not in self.sums:  # the tip model predicts a pair not tried here
+                if not self.tried_at[a]:
+                    val.append(np.inf)
+                elif self.near_blocked(s, a):
+                    val.append(q_row[a] - w * self.score(x, y))
+                else:
+                    dx, dy = self.tip_move(s, a, x0, y0)
+                    val.append(q_row[a] - w * self.score(x + dx, y + dy))
             else:
+                p = self.predict(s, a)
                 val.append(np.inf if p is None else q_row[a] - w * self.score(x + p[0], y + p[1]))
         best = max(val)
         keep = [a for a in range(n_actions) if val[a] == best]
@@ -266,7 +369,7 @@ def learn(
         e = np.zeros_like(Q)  # Initialize e(s, a) = 0 for all s, a
         s = start_state  # Initialize s, a
         if model is not None:
-            model.start_episode(s)
+            model.start_episode(s, episode < model.episodes)
         if trace is not None:
             trace.append(s)
         a, pending, from_macro = choose(s, [], True)
@@ -279,7 +382,7 @@ def learn(
             blocked = s2 == s  # observed: the robot did not move (after wind)
             steps += 1
             if model is not None:
-                model.observe(s, a, s2)
+                model.observe(s, a, s2, episode < model.episodes)
                 model.reached(s2)
             if trace is not None:
                 trace.append(s2)

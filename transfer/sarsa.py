@@ -264,7 +264,7 @@ def _make_run_trial(with_guide: bool):
             s = start
             best = 0.0
             if with_guide and has_guide:
-                _guide.reset_progress(g, gm, s)
+                _guide.reset_progress(g, gm, s, guided)
             # choose the first action (m_pos: position in the running macro, m_end: its end)
             if with_guide:
                 a, in_macro, m_pos, m_end, macro_used = _choose_guided(
@@ -301,7 +301,7 @@ def _make_run_trial(with_guide: bool):
                         fp_pos[s2] = fp_n
                         fp_n += 1
                 if with_guide and has_guide:  # robot 2 records what its move did to the label it perceives
-                    _guide.observe(g, gm, s, a, s2)
+                    _guide.observe(g, gm, s, a, s2, guided)
                     _guide.update_progress(g, gm, s2)
                 terminal = label[s2] == goal
                 r = r_step
@@ -459,7 +459,7 @@ def learn(
     kernel = _run_trial if guide is None else _run_trial_guided
     if guide is not None:
         g = _guide.as_tuple(guide)
-        gm = _guide.model_arrays(n, robot.n_actions, guide.memory, len(guide.tstart) - 1)
+        gm = _guide.model_arrays_for(guide, n, robot.n_actions)
     elif kernel is _run_trial_guided:  # run without a guide (scripts/bench_kernels.py, a test)
         g, gm = _guide.inactive(robot.n_actions)
     else:  # the plain kernel never reads them
