@@ -8,6 +8,7 @@ pairs of exploration steps / optimal distance (first episode only, 20 trials per
 
     python scripts/select_defaults.py            # about two minutes on 2 cores
     python scripts/select_defaults.py --method guided --pairs 6 --trials 10
+    python scripts/select_defaults.py --method guided-tip       # the tip model's, about a minute
 
 For ``guided`` the held-out pairs are drawn for each of coarse -> fine, fine -> coarse and
 planar2:joint <-> ur5e_like:cartesian, with the source's shortest path as the trajectory. A
@@ -16,6 +17,8 @@ issue's target is on the mean, which a rare long trial dominates). The grid GUID
 searched first; then GIVE_UP with the best of it, taking the smallest value within 2% of
 never giving up. Chosen this way (8 pairs, 20 trials, seed 2026): weight 2, window 2,
 reach 1, knn 8, blocked moves generalised, give up after 100 moves (``transfer.guide``).
+They were chosen without the tip model and the grid runs without it, as then; ``guided-tip``
+then chooses the tip model's parameters with those in place (``select_tip``).
 """
 
 from __future__ import annotations
@@ -146,20 +149,76 @@ def select_guided(pairs: int, trials: int, seed: int) -> None:
     for key, (_, tasks) in held.items():
         print(f"guided held-out {key[0]} -> {key[1]}:", [(ROOMS.xy(s), ROOMS.xy(g)) for s, g, _, _ in tasks])
     results = []
-    for c in GUIDED:
-        per = score_guided(c, held, trials)
+    for c in GUIDED:  # without the tip model, as they were chosen before it (select_tip comes after)
+        per = score_guided({"tip": False, **c}, held, trials)
         results.append((per["all"], c))
         print(f"guided       {c}: " + ", ".join(f"{k if k == 'all' else '->'.join(k)} {v:.2f}x"
                                             for k, v in per.items()), flush=True)
     best = min(results, key=lambda x: x[0])
     print(f"-> guided: best {best[1]} ({best[0]:.2f} x optimal, mean over the worst pair's trials)", flush=True)
-    never = score_guided({**best[1], "give_up": 0}, held, trials)["all"]
+    never = score_guided({"tip": False, **best[1], "give_up": 0}, held, trials)["all"]
     for g in GIVE_UP:
-        sc = score_guided({**best[1], "give_up": g}, held, trials)["all"]
+        sc = score_guided({"tip": False, **best[1], "give_up": g}, held, trials)["all"]
         print(f"guided       give_up {g}: {sc:.2f}x (never: {never:.2f}x)", flush=True)
         if sc <= 1.02 * never:
             print(f"-> guided: give_up {g}, the smallest within 2% of never giving up", flush=True)
             break
+
+
+TIP = [{"tip": False}] + [{"tip_anchor": an, "tip_ridge": r, "tip_nearest": k}
+                          for an, r, k in itertools.product((False, True), (1e-3, 1e-2, 1e-1, 1.0), (1, 3, 8))]
+"""Candidates for the tip model of method ``guided`` (transfer.guide: TIP_ANCHOR, TIP_RIDGE,
+TIP_NEAREST), chosen after the grid GUIDED; the first is the tip model off, the baseline."""
+
+
+def unreachable_held_out(src_name: str, dst_name: str, n: int, seed: int) -> tuple:
+    """n held-out start/goal pairs (none a Table I task, at least 20 target steps apart) whose
+    source shortest path has cells the target cannot reach: at least one, at most a quarter."""
+    src, dst = _robot(src_name), _robot(dst_name)
+    labels = set(np.unique(dst.label).tolist())
+    table = {(t.start, t.goal) for t in TABLE_I.values()}
+    rng = np.random.default_rng(seed)
+    cells = np.intersect1d(np.unique(src.label), np.unique(dst.label))
+    cells = [int(c) for c in cells if all(v % 2 == 0 for v in ROOMS.xy(int(c)))]
+    tasks = []
+    tries = 0
+    while len(tasks) < n and tries < 10_000:
+        tries += 1
+        s, g = (int(c) for c in rng.choice(cells, 2, replace=False))
+        if (ROOMS.xy(s), ROOMS.xy(g)) in table:
+            continue
+        path = dst.shortest_path(dst.start_state(s), g)
+        if path is None or len(path) - 1 < 20:
+            continue
+        traj = trajectories.shortest(src, s, g)
+        out = sum(int(c) not in labels for c in traj.cells)
+        if out < 1 or out > len(traj.cells) // 4:
+            continue
+        tasks.append((s, g, traj, len(path) - 1))
+    return dst, tasks
+
+
+def select_tip(pairs: int, trials: int, seed: int) -> None:
+    """The tip model's parameters, the other guided parameters at their defaults, on two held-out
+    sets of each robot pair of GUIDED_PAIRS whose target moves its joints: its tasks of
+    ``guided_held_out`` and those of ``unreachable_held_out``. A candidate's score is the worse
+    of its two means (transfer.guide: chosen this way, 8 pairs each, 20 trials, seed 2026)."""
+    from armtransfer.learning import guide
+
+    held = {k: v for k, v in guided_held_out(pairs, seed).items() if guide.uses_tip(v[0])}
+    far = {k: unreachable_held_out(*k, pairs, seed) for k in held}
+    for name, sets in (("held-out", held), ("held-out with unreachable cells", far)):
+        for key, (_, tasks) in sets.items():
+            print(f"tip {name} {key[0]} -> {key[1]}:", [(ROOMS.xy(s), ROOMS.xy(g)) for s, g, _, _ in tasks])
+    results = []
+    for c in TIP:
+        a = score_guided({"give_up": guide.GIVE_UP, **c}, held, trials)["all"]
+        b = score_guided({"give_up": guide.GIVE_UP, **c}, far, trials)["all"]
+        results.append((max(a, b), c))
+        print(f"guided tip   {c}: held-out {a:.2f}x, with unreachable cells {b:.2f}x", flush=True)
+    best = min(results[1:], key=lambda x: x[0])
+    print(f"-> guided tip: best {best[1]} ({best[0]:.2f} x optimal, the worse of the two; "
+          f"off: {results[0][0]:.2f}x)", flush=True)
 
 
 def main() -> None:
@@ -171,8 +230,10 @@ def main() -> None:
     args = p.parse_args()
     if args.method and "guided" in args.method:
         select_guided(args.pairs, args.trials, args.seed)
-        if args.method == ["guided"]:
-            return
+    if args.method and {"guided", "guided-tip"} & set(args.method):
+        select_tip(args.pairs, args.trials, args.seed)
+    if args.method and set(args.method) <= {"guided", "guided-tip"}:
+        return
     pairs = held_out_pairs(args.pairs, args.seed)
     print("held-out pairs:", [(ROOMS.xy(s), ROOMS.xy(g)) for s, g in pairs])
     for method, cands in CANDIDATES.items():
