@@ -8,7 +8,8 @@ pairs of exploration steps / optimal distance (first episode only, 20 trials per
 
     python scripts/select_defaults.py            # about two minutes on 2 cores
     python scripts/select_defaults.py --method guided --pairs 6 --trials 10
-    python scripts/select_defaults.py --method guided-tip       # the tip model's, about a minute
+    python scripts/select_defaults.py --method guided-tip       # the tip model's, then the fill's
+    python scripts/select_defaults.py --method guided-fill      # the fill's alone, about 20 s
 
 For ``guided`` the held-out pairs are drawn for each of coarse -> fine, fine -> coarse and
 planar2:joint <-> ur5e_like:cartesian, with the source's shortest path as the trajectory. A
@@ -212,13 +213,35 @@ def select_tip(pairs: int, trials: int, seed: int) -> None:
             print(f"tip {name} {key[0]} -> {key[1]}:", [(ROOMS.xy(s), ROOMS.xy(g)) for s, g, _, _ in tasks])
     results = []
     for c in TIP:
-        a = score_guided({"give_up": guide.GIVE_UP, **c}, held, trials)["all"]
-        b = score_guided({"give_up": guide.GIVE_UP, **c}, far, trials)["all"]
+        # without the fill, as they were chosen before it (select_fill comes after)
+        a = score_guided({"give_up": guide.GIVE_UP, "fill": 0.0, **c}, held, trials)["all"]
+        b = score_guided({"give_up": guide.GIVE_UP, "fill": 0.0, **c}, far, trials)["all"]
         results.append((max(a, b), c))
         print(f"guided tip   {c}: held-out {a:.2f}x, with unreachable cells {b:.2f}x", flush=True)
     best = min(results[1:], key=lambda x: x[0])
     print(f"-> guided tip: best {best[1]} ({best[0]:.2f} x optimal, the worse of the two; "
           f"off: {results[0][0]:.2f}x)", flush=True)
+
+
+FILL = (0.0, 0.1, 0.25, 0.5, 1.0, 2.0)
+"""Candidates for the fill of method ``guided`` (transfer.guide.FILL_COST), 0 first (off), chosen
+after the tip model's parameters on the same two held-out sets."""
+
+
+def select_fill(pairs: int, trials: int, seed: int) -> None:
+    """The fill's cost per move, the tip model at its defaults, scored as in ``select_tip``."""
+    from armtransfer.learning import guide
+
+    held = {k: v for k, v in guided_held_out(pairs, seed).items() if guide.uses_tip(v[0])}
+    far = {k: unreachable_held_out(*k, pairs, seed) for k in held}
+    results = []
+    for f in FILL:
+        a = score_guided({"give_up": guide.GIVE_UP, "fill": f}, held, trials)["all"]
+        b = score_guided({"give_up": guide.GIVE_UP, "fill": f}, far, trials)["all"]
+        results.append((max(a, b), f))
+        print(f"guided fill  {f}: held-out {a:.2f}x, with unreachable cells {b:.2f}x", flush=True)
+    best = min(results, key=lambda x: x[0])
+    print(f"-> guided fill: best {best[1]} ({best[0]:.2f} x optimal, the worse of the two)", flush=True)
 
 
 def main() -> None:
@@ -232,7 +255,9 @@ def main() -> None:
         select_guided(args.pairs, args.trials, args.seed)
     if args.method and {"guided", "guided-tip"} & set(args.method):
         select_tip(args.pairs, args.trials, args.seed)
-    if args.method and set(args.method) <= {"guided", "guided-tip"}:
+    if args.method and {"guided", "guided-tip", "guided-fill"} & set(args.method):
+        select_fill(args.pairs, args.trials, args.seed)
+    if args.method and set(args.method) <= {"guided", "guided-tip", "guided-fill"}:
         return
     pairs = held_out_pairs(args.pairs, args.seed)
     print("held-out pairs:", [(ROOMS.xy(s), ROOMS.xy(g)) for s, g in pairs])

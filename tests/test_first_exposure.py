@@ -130,10 +130,33 @@ def test_tip_features_fit_a_planar_chain_exactly():
 def test_bad_tip_parameters_are_one_line_errors():
     fine, coarse, start, goal = small_task()
     traj = trajectories.shortest(coarse, start, goal)
-    for bad in (dict(tip_ridge=0.0), dict(tip_ridge=float("inf")), dict(tip_nearest=0)):
+    for bad in (dict(tip_ridge=0.0), dict(tip_ridge=float("inf")), dict(tip_nearest=0), dict(fill=-0.5),
+                dict(fill=float("nan"))):
         with pytest.raises(InvalidParameterError) as err:
             guide.build(fine, [traj], **bad)
-        assert "\n" not in str(err.value) and "tip_" in str(err.value)
+        assert "\n" not in str(err.value) and next(iter(bad)) in str(err.value)
+
+
+def test_the_fill_is_on_with_the_tip_model_and_raises_h_where_robot_2_waited():
+    """With the tip model the fill defaults to FILL_COST; after a first exposure some visited
+    state has h > 0 (a basin was filled) and no state robot 2 never visited has."""
+    from armtransfer.tasks.specs import resolve
+
+    arm, source = resolve("planar2:joint"), resolve("ur5e_like:cartesian")
+    start, goal = TABLE_I[1].cells()
+    traj = experiment.source_trajectory("optimal", source, start, goal, LearnerConfig(), 0)
+    g = guide.build(arm, [traj])
+    assert g.params[14] == guide.FILL_COST > 0
+    assert guide.build(grid_robot("fine"), [traj]).params[14] == 0.0
+    gm = guide.model_arrays_for(g, arm.n_states, arm.n_actions)
+    shaping = replace(guided_shaping(arm, [traj]), guide=g)
+    config = LearnerConfig(max_episodes=1)
+    res = sarsa.learn(arm, arm.start_state(start), goal, config, np.random.default_rng(3), shaping=shaping,
+                      guide_arrays=gm)
+    assert res.exploration_steps is not None
+    h, seen = gm[32], gm[33] >= 0
+    assert (h[seen] > 0).any()
+    assert not h[~seen].any()
 
 
 def test_same_seed_gives_bit_identical_results():

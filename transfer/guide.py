@@ -28,6 +28,14 @@ The model (all of it from what robot 2 observes):
     ``TIP_ANCHOR`` the score starts from the model's estimate of the tip inside the current cell
     (clamped to the cell) instead of the cell's centre. A move tried at s keeps its own
     observed displacement, as above.
+  * The fill (with the tip model; ``FILL``), learning real-time search (Korf's LRTA*) on the
+    score: a joint-space robot has many states per cell, so where the trajectory's next cells
+    cannot be reached straight on (the arm must first move away from them) the score has wide
+    local minima. Robot 2 keeps, per state and only until a trajectory's progress next moves,
+    an increment h(s) in cells: a move's score is its predicted score plus h of the state that
+    move led to when tried at s; choosing at s raises h(s) to (the smallest of its moves'
+    scores) + the fill - (the score at s), so a basin fills as it is visited, a fill per visit at
+    most, instead of one SARSA(lambda) update at a time.
   * Progress along a trajectory: the furthest index whose cell the label came within
     ``reach`` cells of in this episode; after ``give_up`` moves without progress the next
     cell is given up on (it may be out of reach). The score of a predicted label position q is
@@ -140,6 +148,12 @@ action model), where one move shifts the tip by a fraction of a cell."""
 TIP_ANCHOR = True
 """Whether the score starts from the tip model's estimate of where the tip is inside the current
 cell (clamped to the cell) instead of the cell's centre."""
+FILL = None
+"""The fill's cost per move, in cells (see the module docstring); None: ``FILL_COST`` with the tip
+model, 0 (off) without it."""
+FILL_COST = 0.25
+"""Chosen on the held-out pairs of the tip model (``scripts/select_defaults.py --method
+guided-fill``) from 0 (off), 0.1, 0.25, 0.5, 1 and 2, never on Table I."""
 TIP_ORDER = 3
 """The tip model's features are products of cos and sin of at most this many of the moving
 joints (3: exact for the tip of any planar chain of up to 3 joints and any 2-joint arm)."""
@@ -197,7 +211,8 @@ def uses_tip(robot: DiscreteRobot) -> bool:
 def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW, reach: float = REACH,
           knn: int = KNN, memory: int = MEMORY, weight: float = WEIGHT, episodes: int = EPISODES,
           blocked: bool = BLOCKED, give_up: int = GIVE_UP, plan: bool = PLAN, tip: bool | None = TIP,
-          tip_ridge: float = TIP_RIDGE, tip_nearest: int = TIP_NEAREST, tip_anchor: bool = TIP_ANCHOR) -> Guide:
+          tip_ridge: float = TIP_RIDGE, tip_nearest: int = TIP_NEAREST, tip_anchor: bool = TIP_ANCHOR,
+          fill: float | None = FILL) -> Guide:
     """The guide for ``robot`` following ``trajs`` (one or several). ``tip`` None: the tip
     model for robots whose actions move a joint (:func:`uses_tip`)."""
     for name, v in (("window", window), ("reach", reach), ("weight", weight)):
@@ -211,6 +226,8 @@ def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW,
         raise InvalidParameterError(f"tip_ridge must be a positive number, got {tip_ridge}")
     if int(tip_nearest) < 1:
         raise InvalidParameterError(f"tip_nearest must be a positive integer, got {tip_nearest}")
+    if fill is not None and not (np.isfinite(fill) and fill >= 0):
+        raise InvalidParameterError(f"fill must be a non-negative number of cells, got {fill}")
     layout = robot.layout
     lxy = layout.xy_of(robot.label).astype(np.float64).reshape(-1, 2)
     if robot.arm is not None:
@@ -240,7 +257,8 @@ def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW,
         params=np.array([float(window), float(reach), float(int(knn)), float(int(memory)), float(weight),
                          float(int(episodes)), 1.0 if blocked else 0.0, float(int(give_up)),
                          1.0 if plan else 0.0, PLAN_TOL, 1.0 if tip else 0.0, float(tip_ridge),
-                         float(int(tip_nearest)), 1.0 if tip_anchor else 0.0]),
+                         float(int(tip_nearest)), 1.0 if tip_anchor else 0.0,
+                         (FILL_COST if tip else 0.0) if fill is None else float(fill)]),
         tq=np.ascontiguousarray(tq, dtype=np.float64), fj=fj, fk=fk,
     )
 
@@ -248,7 +266,7 @@ def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW,
 def inactive(n_actions: int) -> tuple:
     """(guide tuple, model tuple) for a trial without a guide: empty arrays of the right types."""
     g = (np.zeros((0, 1)), np.zeros((0, 2)), np.zeros(0), np.zeros(0), np.zeros(0),
-         np.zeros(1, np.int64), np.array([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0]),
+         np.zeros(1, np.int64), np.array([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0]),
          np.zeros((0, 1)), np.zeros((0, TIP_ORDER), np.int64), np.zeros((0, TIP_ORDER), np.int64))
     return g, model_arrays(0, n_actions, 1, 1)
 
@@ -270,7 +288,9 @@ def model_arrays(n_states: int, n_actions: int, memory: int, n_traj: int, n_feat
     without it): P [F, F] (the inverse of the ridge normal matrix), W [F, 2] (its weights), the
     first label seen [2] and whether it was [1], states already learned from [S], summed joint
     displacement per action [A, C] and moves summed [A], and scratch (features [F] twice, P times
-    features [F], a configuration [C])."""
+    features [F], a configuration [C]); then the fill's: h [S], the epoch each h was set in [S],
+    the epoch [1] (+1 at an episode's start and whenever a trajectory's progress moves), and the
+    state last observed after each pair [S, A] (-1: none)."""
     pairs = n_states * n_actions
     return (np.zeros((n_states, n_actions, 2)), np.zeros((n_states, n_actions), np.int64),
             np.zeros((n_actions, memory), np.int64), np.zeros(n_actions, np.int64),
@@ -284,7 +304,9 @@ def model_arrays(n_states: int, n_actions: int, memory: int, n_traj: int, n_feat
             np.eye(n_features), np.zeros((n_features, 2)), np.zeros(2), np.zeros(1, np.bool_),
             np.zeros(n_states if n_features else 0, np.bool_), np.zeros((n_actions, n_joints)),
             np.zeros(n_actions, np.int64), np.zeros(n_features), np.zeros(n_features), np.zeros(n_features),
-            np.zeros(n_joints))
+            np.zeros(n_joints),
+            np.zeros(n_states), np.full(n_states, -1, np.int64), np.zeros(1, np.int64),
+            np.full((n_states, n_actions), -1, np.int64))
 
 
 def model_arrays_for(g: Guide, n_states: int, n_actions: int) -> tuple:
@@ -304,6 +326,7 @@ def reset_progress(g, gm, s, guided):
     for t in range(tstart.shape[0] - 1):
         prog[t] = tstart[t]
         wait[t] = 0
+    gm[34][0] += 1
     if guided and g[6][10] > 0.0:
         tip_learn(g, gm, s)
     update_progress(g, gm, s)
@@ -399,11 +422,13 @@ def update_progress(g, gm, s):
                 prog[t] = j
         if prog[t] != i0:
             wait[t] = 0
+            gm[34][0] += 1
         else:
             wait[t] += 1
             if give_up > 0.0 and wait[t] >= give_up and prog[t] < tstart[t + 1] - 1:
                 prog[t] += 1
                 wait[t] = 0
+                gm[34][0] += 1
 
 
 @numba.njit(cache=True)
@@ -415,6 +440,8 @@ def observe(g, gm, s, a, s2, guided):
     dsum, dcnt, buf, bufn, inbuf, moved = gm[0], gm[1], gm[2], gm[3], gm[5], gm[6]
     if s2 != s:
         moved[s, a] = True
+    if params[14] > 0.0:
+        gm[35][s, a] = s2
     if guided and params[10] > 0.0:
         tq, dq, dqn = g[7], gm[26], gm[27]
         if s2 != s:
@@ -679,26 +706,49 @@ def egreedy(Q, s, eps, rng, g, gm):
             first = gm[23]
             x = min(max(first[0] + x0, lxy[s, 0] - 0.5), lxy[s, 0] + 0.5)
             y = min(max(first[1] + y0, lxy[s, 1] - 0.5), lxy[s, 1] + 0.5)
+    fill = params[14]
+    h, hst, epoch, last = gm[32], gm[33], gm[34], gm[35]
+    here = 0.0
+    if fill > 0.0:
+        if hst[s] != epoch[0]:
+            hst[s] = epoch[0]
+            h[s] = 0.0
+        here = score(g, gm, x, y)
+    low = np.inf
     for a in range(n_actions):
+        ha = np.nan
         if dcnt[s, a] > 0 and not moved[s, a]:
             v = -np.inf  # tried here and blocked every time: a wasted step, never the model's choice
         elif tip and dcnt[s, a] == 0:  # the tip model predicts a pair not tried here
             if bufn[a] == 0:
                 v = np.inf  # tried nowhere yet
             elif near_blocked(g, gm, s, a):
-                v = Q[s, a] - w * score(g, gm, x, y)
+                ha = here + h[s] if fill > 0.0 else score(g, gm, x, y)
+                v = Q[s, a] - w * ha
             else:
                 dx, dy = tip_move(g, gm, s, a, x0, y0)
-                v = Q[s, a] - w * score(g, gm, x + dx, y + dy)
+                ha = score(g, gm, x + dx, y + dy)
+                v = Q[s, a] - w * ha
         else:
             known, dx, dy = predict(g, gm, s, a)
             if known:
-                v = Q[s, a] - w * score(g, gm, x + dx, y + dy)
+                ha = score(g, gm, x + dx, y + dy)
+                if fill > 0.0 and dcnt[s, a] > 0:
+                    u = last[s, a]
+                    if hst[u] == epoch[0]:
+                        ha += h[u]
+                v = Q[s, a] - w * ha
             else:
                 v = np.inf
+        if fill > 0.0 and not np.isnan(ha) and ha < low:
+            low = ha
         val[a] = v
         if v > best:
             best = v
+    if fill > 0.0 and low < np.inf:  # learning real-time search: the basin fills as it is visited
+        raise_to = low + fill - here
+        if raise_to > h[s]:
+            h[s] = raise_to
     m = 0
     first = -1
     for a in range(n_actions):

@@ -58,6 +58,12 @@ class GuideModel:
         n_j = guide.tq.shape[1] if n_f else 0
         self.dq = [[0.0] * n_j for _ in range(n_actions)]  # summed joint displacement of each action's moves
         self.dqn = [0] * n_actions
+        # the fill (transfer.guide: learning real-time search): h per state, valid in one epoch
+        self.fill = float(guide.params[14])
+        self.h: dict[int, float] = {}
+        self.h_epoch: dict[int, int] = {}
+        self.epoch = 0  # +1 at an episode's start and whenever a trajectory's progress moves
+        self.last: dict[tuple[int, int], int] = {}  # (s, a) -> the state observed after it last
 
     def cells(self, t: int) -> range:
         return range(int(self.g.tstart[t]), int(self.g.tstart[t + 1]))
@@ -65,6 +71,7 @@ class GuideModel:
     def start_episode(self, s: int, guided: bool) -> None:
         self.prog = [int(self.g.tstart[t]) for t in range(self.n_traj)]
         self.wait = [0] * self.n_traj
+        self.epoch += 1
         if guided and self.tip:
             self.tip_learn(s)
         self.reached(s)
@@ -166,12 +173,14 @@ class GuideModel:
                     self.prog[t] = j
             if self.prog[t] != i0:
                 self.wait[t] = 0
+                self.epoch += 1
             else:
                 self.wait[t] += 1
                 last = int(g.tstart[t + 1]) - 1
                 if g.params[7] > 0 and self.wait[t] >= g.params[7] and self.prog[t] < last:
                     self.prog[t] += 1
                     self.wait[t] = 0
+                    self.epoch += 1
 
     def observe(self, s: int, a: int, s2: int, guided: bool) -> None:
         g = self.g
@@ -180,6 +189,8 @@ class GuideModel:
             entry = self.sums[(s, a)] = [0.0, 0.0, 0]
         if s2 != s:
             self.moved.add((s, a))
+        if self.fill > 0:
+            self.last[(s, a)] = s2
         if guided and self.tip:
             if s2 != s:
                 for c in range(g.tq.shape[1]):
@@ -283,21 +294,47 @@ class GuideModel:
                 lx, ly = self.g.lxy[s]
                 x = min(max(self.first[0] + x0, lx - 0.5), lx + 0.5)
                 y = min(max(self.first[1] + y0, ly - 0.5), ly + 0.5)
+        fill = self.fill > 0
+        here = 0.0
+        if fill:
+            if self.h_epoch.get(s) != self.epoch:
+                self.h_epoch[s] = self.epoch
+                self.h[s] = 0.0
+            here = self.score(x, y)
         val = []
+        heads = []  # each action's predicted score (plus h of its known successor), None when unknown
         for a in range(n_actions):
+            ha = None
             if (s, a) in self.sums and (s, a) not in self.moved:
-                val.append(-np.inf)  # blocked at every try here
+                v = -np.inf  # blocked at every try here
             elif self.tip and (s, a) not in self.sums:  # the tip model predicts a pair not tried here
                 if not self.tried_at[a]:
-                    val.append(np.inf)
+                    v = np.inf
                 elif self.near_blocked(s, a):
-                    val.append(q_row[a] - w * self.score(x, y))
+                    ha = here + self.h[s] if fill else self.score(x, y)
+                    v = q_row[a] - w * ha
                 else:
                     dx, dy = self.tip_move(s, a, x0, y0)
-                    val.append(q_row[a] - w * self.score(x + dx, y + dy))
+                    ha = self.score(x + dx, y + dy)
+                    v = q_row[a] - w * ha
             else:
                 p = self.predict(s, a)
-                val.append(np.inf if p is None else q_row[a] - w * self.score(x + p[0], y + p[1]))
+                if p is None:
+                    v = np.inf
+                else:
+                    ha = self.score(x + p[0], y + p[1])
+                    if fill and (s, a) in self.sums:
+                        u = self.last[(s, a)]
+                        if self.h_epoch.get(u) == self.epoch:
+                            ha += self.h[u]
+                    v = q_row[a] - w * ha
+            val.append(v)
+            heads.append(ha)
+        known = [ha for ha in heads if ha is not None]
+        if fill and known:  # learning real-time search: raise h(s) to the best neighbour's + the fill
+            raise_to = min(known) + self.fill - here
+            if raise_to > self.h[s]:
+                self.h[s] = raise_to
         best = max(val)
         keep = [a for a in range(n_actions) if val[a] == best]
         if len(keep) == 1:

@@ -444,13 +444,15 @@ def learn(
     macros=None,
     q_init: np.ndarray | None = None,
     keep_q: bool = False,
+    guide_arrays: tuple | None = None,
 ) -> TrialResult:
     """Run one trial of SARSA(lambda) on ``robot`` from ``start_state`` to ``goal_cell``.
 
     ``shaping`` is a :class:`armtransfer.learning.shaping.Shaping` (None: no transfer); ``macros`` a
     :class:`transfer.mapping.MacroTable` (None: no action sequence mapping); its attribute
     ``episodes`` (None: all) says in how many first episodes macros are offered. ``rng`` is
-    the only source of randomness.
+    the only source of randomness. ``guide_arrays``: the guide's model arrays to learn into
+    (``transfer.guide.model_arrays_for``), to read what robot 2 learned afterwards; None: new ones.
     """
     n = robot.n_states
     sh = shaping if shaping is not None else Shaping.none(n)
@@ -459,7 +461,7 @@ def learn(
     kernel = _run_trial if guide is None else _run_trial_guided
     if guide is not None:
         g = _guide.as_tuple(guide)
-        gm = _guide.model_arrays_for(guide, n, robot.n_actions)
+        gm = _guide.model_arrays_for(guide, n, robot.n_actions) if guide_arrays is None else guide_arrays
     elif kernel is _run_trial_guided:  # run without a guide (scripts/bench_kernels.py, a test)
         g, gm = _guide.inactive(robot.n_actions)
     else:  # the plain kernel never reads them
