@@ -110,15 +110,15 @@ WEIGHT, WINDOW, REACH, KNN and BLOCKED were chosen together on held-out start/go
 coarse <-> fine and planar2:joint <-> ur5e_like:cartesian (``scripts/select_defaults.py
 --method guided``: the smallest mean first exposure of the worst robot pair, 1.96x the optimal
 distance), never on Table I; EPISODES is the exploration phase, as for the mapping's macros;
-MEMORY was not tuned. Re-run with the tip model in place the same grid picks the same values
-(knn 3 and 8 within 0.1% of each other).
+MEMORY was not tuned.
 
 TIP_ANCHOR, TIP_RIDGE and TIP_NEAREST were chosen after them (``scripts/select_defaults.py
 --method guided-tip``) on the held-out start/goal pairs of ur5e_like:cartesian ->
 planar2:joint, the robot pair of that grid whose target moves its joints, and on 8 more held-out
 pairs of it whose trajectory has cells the arm cannot reach (at most a quarter of them):
 the smallest worse of the two means, 1.70x the optimal distance on both (without the tip model
-1.79x and 3.23x); never on Table I. TIP_ORDER was not tuned."""
+1.79x and 3.23x); never on Table I. TIP_ORDER was not tuned. FILL_COST was chosen after them on
+the same two sets (``--method guided-fill``): 1.65x (1.70x without the fill)."""
 PLAN = True
 """Whether robot 2 plans over the moves it has tried, after every episode (see :func:`plan`)."""
 PLAN_TOL = 1e-12
