@@ -97,28 +97,41 @@ def _robot(spec: str):
     return grid_robot(spec)
 
 
+def draw_tasks(src, dst, n: int, seed: int, keep) -> list[tuple]:
+    """n start/goal pairs on even cells both robots label (a fixed seed), none a Table I task, at
+    least 20 target steps apart, and that ``keep(s, g)`` takes: it returns the trajectory, or
+    None to draw again. Each task is (start, goal, trajectory, the target's optimal distance)."""
+    table = {(t.start, t.goal) for t in TABLE_I.values()}
+    rng = np.random.default_rng(seed)
+    cells = np.intersect1d(np.unique(src.label), np.unique(dst.label))
+    cells = [int(c) for c in cells if all(v % 2 == 0 for v in ROOMS.xy(int(c)))]
+    tasks = []
+    tries = 0
+    while len(tasks) < n and tries < 10_000:
+        tries += 1
+        s, g = (int(c) for c in rng.choice(cells, 2, replace=False))
+        if (ROOMS.xy(s), ROOMS.xy(g)) in table:
+            continue
+        path = dst.shortest_path(dst.start_state(s), g)
+        if path is None or len(path) - 1 < 20:
+            continue
+        traj = keep(s, g)
+        if traj is not None:
+            tasks.append((s, g, traj, len(path) - 1))
+    return tasks
+
+
 def guided_held_out(n: int, seed: int) -> dict:
     """For each robot pair of GUIDED_PAIRS: n held-out start/goal pairs that both robots can
     do, at least 20 target steps apart, none a Table I task; with the source's shortest path."""
-    table = {(t.start, t.goal) for t in TABLE_I.values()}
     out = {}
     for src_name, dst_name in GUIDED_PAIRS:
         src, dst = _robot(src_name), _robot(dst_name)
-        rng = np.random.default_rng(seed)
-        cells = np.intersect1d(np.unique(src.label), np.unique(dst.label))
-        cells = [int(c) for c in cells if all(v % 2 == 0 for v in ROOMS.xy(int(c)))]
-        tasks = []
-        tries = 0
-        while len(tasks) < n and tries < 10_000:
-            tries += 1
-            s, g = (int(c) for c in rng.choice(cells, 2, replace=False))
-            if (ROOMS.xy(s), ROOMS.xy(g)) in table:
-                continue
-            path = dst.shortest_path(dst.start_state(s), g)
-            if path is None or len(path) - 1 < 20 or src.shortest_path(src.start_state(s), g) is None:
-                continue
-            tasks.append((s, g, trajectories.shortest(src, s, g), len(path) - 1))
-        out[(src_name, dst_name)] = (dst, tasks)
+
+        def keep(s, g, src=src):
+            return None if src.shortest_path(src.start_state(s), g) is None else trajectories.shortest(src, s, g)
+
+        out[(src_name, dst_name)] = (dst, draw_tasks(src, dst, n, seed, keep))
     return out
 
 
@@ -177,26 +190,13 @@ def unreachable_held_out(src_name: str, dst_name: str, n: int, seed: int) -> tup
     source shortest path has cells the target cannot reach: at least one, at most a quarter."""
     src, dst = _robot(src_name), _robot(dst_name)
     labels = set(np.unique(dst.label).tolist())
-    table = {(t.start, t.goal) for t in TABLE_I.values()}
-    rng = np.random.default_rng(seed)
-    cells = np.intersect1d(np.unique(src.label), np.unique(dst.label))
-    cells = [int(c) for c in cells if all(v % 2 == 0 for v in ROOMS.xy(int(c)))]
-    tasks = []
-    tries = 0
-    while len(tasks) < n and tries < 10_000:
-        tries += 1
-        s, g = (int(c) for c in rng.choice(cells, 2, replace=False))
-        if (ROOMS.xy(s), ROOMS.xy(g)) in table:
-            continue
-        path = dst.shortest_path(dst.start_state(s), g)
-        if path is None or len(path) - 1 < 20:
-            continue
+
+    def keep(s, g):
         traj = trajectories.shortest(src, s, g)
         out = sum(int(c) not in labels for c in traj.cells)
-        if out < 1 or out > len(traj.cells) // 4:
-            continue
-        tasks.append((s, g, traj, len(path) - 1))
-    return dst, tasks
+        return traj if 1 <= out <= len(traj.cells) // 4 else None
+
+    return dst, draw_tasks(src, dst, n, seed, keep)
 
 
 def select_tip(pairs: int, trials: int, seed: int) -> None:

@@ -578,15 +578,29 @@ def plan(g, gm, Q, label, goal, gamma, r_step, r_goal):
 def predict(g, gm, s, a):
     """(known, dx, dy): the predicted label displacement of a at s; known is False when a
     was never tried anywhere."""
-    feat, params = g[0], g[6]
-    dsum, dcnt, buf, bufn = gm[0], gm[1], gm[2], gm[3]
+    dsum, dcnt = gm[0], gm[1]
     if dcnt[s, a] > 0:
         return True, dsum[s, a, 0] / dcnt[s, a], dsum[s, a, 1] / dcnt[s, a]
-    memory = int(params[3])
-    n = min(bufn[a], memory)
-    if n == 0:
+    near = nearest(g, gm, s, a, int(g[6][2]))
+    k = near.shape[0]
+    if k == 0:
         return False, 0.0, 0.0
-    k = min(int(params[2]), n)
+    sx = 0.0
+    sy = 0.0
+    for u in near:
+        sx += dsum[u, a, 0] / dcnt[u, a]
+        sy += dsum[u, a, 1] / dcnt[u, a]
+    return True, sx / k, sy / k
+
+
+@numba.njit(cache=True)
+def nearest(g, gm, s, a, k):
+    """The (at most) k remembered states where a was tried that are nearest to s in robot 2's
+    configuration space, nearest first (ties: the earlier ring-buffer slot)."""
+    feat, params = g[0], g[6]
+    buf, bufn = gm[2], gm[3]
+    n = min(bufn[a], int(params[3]))
+    k = min(k, n)
     dist = np.empty(n)
     for i in range(n):
         u = buf[a, i]
@@ -596,18 +610,15 @@ def predict(g, gm, s, a):
             d += diff * diff
         dist[i] = d
     taken = np.zeros(n, np.bool_)
-    sx = 0.0
-    sy = 0.0
-    for _ in range(k):
+    out = np.empty(k, np.int64)
+    for j in range(k):
         best = -1
         for i in range(n):
             if not taken[i] and (best < 0 or dist[i] < dist[best]):
                 best = i
         taken[best] = True
-        u = buf[a, best]
-        sx += dsum[u, a, 0] / dcnt[u, a]
-        sy += dsum[u, a, 1] / dcnt[u, a]
-    return True, sx / k, sy / k
+        out[j] = buf[a, best]
+    return out
 
 
 @numba.njit(cache=True)
@@ -615,29 +626,12 @@ def near_blocked(g, gm, s, a):
     """Whether a was blocked at each of the ``tip nearest`` remembered states nearest to s in
     configuration space where it was tried (ties: the earlier slot), i.e. a joint limit or a
     wall is predicted; False when a was tried nowhere."""
-    feat, params = g[0], g[6]
-    buf, bufn, moved = gm[2], gm[3], gm[6]
-    memory = int(params[3])
-    n = min(bufn[a], memory)
-    if n == 0:
+    near = nearest(g, gm, s, a, int(g[6][12]))
+    if near.shape[0] == 0:
         return False
-    k = min(int(params[12]), n)
-    dist = np.empty(n)
-    for i in range(n):
-        u = buf[a, i]
-        d = 0.0
-        for c in range(feat.shape[1]):
-            diff = feat[u, c] - feat[s, c]
-            d += diff * diff
-        dist[i] = d
-    taken = np.zeros(n, np.bool_)
-    for _ in range(k):
-        best = -1
-        for i in range(n):
-            if not taken[i] and (best < 0 or dist[i] < dist[best]):
-                best = i
-        taken[best] = True
-        if moved[buf[a, best], a]:
+    moved = gm[6]
+    for u in near:
+        if moved[u, a]:
             return False
     return True
 
