@@ -491,3 +491,47 @@ def test_the_mapping_check_counts_what_macros_do(tmp_path):
     proc = subprocess.run([sys.executable, str(CHECK), "--trials", "0", "--out", str(tmp_path / "n")],
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1 and not (tmp_path / "n").exists()
+
+
+def test_the_tip_model_learns_where_the_tip_is():
+    """After a first exposure on planar2:joint, the tip model's estimate at the states robot 2
+    visited matches the arm's true tip (MuJoCo's, in cell units) to well under a cell, where the
+    label alone is off by up to half a cell in each axis; and it predicts a joint move's
+    displacement, a fraction of a cell, to within a small part of one."""
+    from armtransfer.tasks.specs import resolve
+
+    arm, coarse = resolve("planar2:joint"), grid_robot("coarse")
+    start, goal = TABLE_I[4].cells()
+    traj = trajectories.shortest(coarse, start, goal)
+    g = guide.build(arm, [traj])
+    gm = guide.model_arrays_for(g, arm.n_states, arm.n_actions)
+    res = sarsa.learn(arm, arm.start_state(start), goal, LearnerConfig(max_episodes=1), np.random.default_rng(2),
+                      shaping=replace(guided_shaping(arm, [traj]), guide=g), guide_arrays=gm)
+    assert res.exploration_steps is not None
+    seen = np.flatnonzero(gm[25])
+    assert len(seen) > 50
+    # the true tip in cell units: the affine map from metres that best fits the labels of all states
+    tip = np.asarray(arm.arm.tip)[:, :2]
+    X = np.c_[tip, np.ones(len(tip))]
+    M, *_ = np.linalg.lstsq(X, g.lxy, rcond=None)
+    true = X @ M
+    feats = np.empty((len(seen), g.fj.shape[0]))
+    for i, s in enumerate(seen):
+        guide.features(guide.as_tuple(g), g.tq[s], feats[i])
+    est = feats @ gm[22] + gm[23]
+    err = np.linalg.norm(est - true[seen], axis=1)
+    label_err = np.linalg.norm(g.lxy[seen] - true[seen], axis=1)
+    assert np.median(err) < 0.5 * np.median(label_err)
+    assert np.median(err) < 0.2
+    # a joint move's displacement, true against predicted, at the visited states
+    step = np.zeros(g.tq.shape[1])
+    step[0] = arm.arm.joint_step
+    moved = []
+    for s in seen:
+        t = arm.next_state[s, 0]  # q1+ (one lattice step of the first joint) where it is not blocked
+        if t != s:
+            f1 = np.empty(g.fj.shape[0])
+            guide.features(guide.as_tuple(g), g.tq[s] + step, f1)
+            moved.append(np.linalg.norm((f1 - feats[list(seen).index(s)]) @ gm[22] - (true[t] - true[s])))
+    assert len(moved) > 20
+    assert np.median(moved) < 0.05
