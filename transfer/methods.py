@@ -124,9 +124,9 @@ METHODS: dict[str, Method] = {
                paper=False, build=_progress, auto_k=30.0),
         Method("dense", "potential from the progress along the trajectory and the distance to it",
                paper=False, build=_dense, auto_k=potentials.DENSE_K),
-        Method("guided", "robot 2 learns while it explores what its own actions do to its cell and, until the "
-               "goal is first reached, prefers those predicted to lead on along the trajectory; after every episode it plans "
-               "over the moves it has tried",
+        Method("guided", "robot 2 learns while it explores what its own actions do to its cell (an arm that moves its "
+               "joints: where its tip is) and, until the goal is first reached, prefers those predicted to lead on along "
+               "the trajectory; after every episode it plans over the moves it has tried",
                paper=False, build=_guided, auto_k=0.0, chooses=True),
     )
 }
