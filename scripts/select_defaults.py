@@ -199,23 +199,35 @@ def unreachable_held_out(src_name: str, dst_name: str, n: int, seed: int) -> tup
     return dst, draw_tasks(src, dst, n, seed, keep)
 
 
+def tip_held_out(pairs: int, seed: int) -> tuple[dict, dict]:
+    """The two held-out sets of the robot pairs of GUIDED_PAIRS whose target moves its joints:
+    their tasks of ``guided_held_out``, and those of ``unreachable_held_out``."""
+    from armtransfer.learning import guide
+
+    held = {k: v for k, v in guided_held_out(pairs, seed).items() if guide.uses_tip(v[0])}
+    return held, {k: unreachable_held_out(*k, pairs, seed) for k in held}
+
+
+def score_both(params: dict, sets: tuple[dict, dict], trials: int) -> tuple[float, float]:
+    """``score_guided``'s worst-pair mean on each of the two held-out sets, give_up at its default."""
+    from armtransfer.learning import guide
+
+    return tuple(score_guided({"give_up": guide.GIVE_UP, **params}, s, trials)["all"] for s in sets)
+
+
 def select_tip(pairs: int, trials: int, seed: int) -> None:
     """The tip model's parameters, the other guided parameters at their defaults, on two held-out
     sets of each robot pair of GUIDED_PAIRS whose target moves its joints: its tasks of
     ``guided_held_out`` and those of ``unreachable_held_out``. A candidate's score is the worse
     of its two means (transfer.guide: chosen this way, 8 pairs each, 20 trials, seed 2026)."""
-    from armtransfer.learning import guide
-
-    held = {k: v for k, v in guided_held_out(pairs, seed).items() if guide.uses_tip(v[0])}
-    far = {k: unreachable_held_out(*k, pairs, seed) for k in held}
-    for name, sets in (("held-out", held), ("held-out with unreachable cells", far)):
-        for key, (_, tasks) in sets.items():
+    sets = tip_held_out(pairs, seed)
+    for name, held in zip(("held-out", "held-out with unreachable cells"), sets):
+        for key, (_, tasks) in held.items():
             print(f"tip {name} {key[0]} -> {key[1]}:", [(ROOMS.xy(s), ROOMS.xy(g)) for s, g, _, _ in tasks])
     results = []
     for c in TIP:
         # without the fill, as they were chosen before it (select_fill comes after)
-        a = score_guided({"give_up": guide.GIVE_UP, "fill": 0.0, **c}, held, trials)["all"]
-        b = score_guided({"give_up": guide.GIVE_UP, "fill": 0.0, **c}, far, trials)["all"]
+        a, b = score_both({"fill": 0.0, **c}, sets, trials)
         results.append((max(a, b), c))
         print(f"guided tip   {c}: held-out {a:.2f}x, with unreachable cells {b:.2f}x", flush=True)
     best = min(results[1:], key=lambda x: x[0])
@@ -230,14 +242,10 @@ after the tip model's parameters on the same two held-out sets."""
 
 def select_fill(pairs: int, trials: int, seed: int) -> None:
     """The fill's cost per move, the tip model at its defaults, scored as in ``select_tip``."""
-    from armtransfer.learning import guide
-
-    held = {k: v for k, v in guided_held_out(pairs, seed).items() if guide.uses_tip(v[0])}
-    far = {k: unreachable_held_out(*k, pairs, seed) for k in held}
+    sets = tip_held_out(pairs, seed)
     results = []
     for f in FILL:
-        a = score_guided({"give_up": guide.GIVE_UP, "fill": f}, held, trials)["all"]
-        b = score_guided({"give_up": guide.GIVE_UP, "fill": f}, far, trials)["all"]
+        a, b = score_both({"fill": f}, sets, trials)
         results.append((max(a, b), f))
         print(f"guided fill  {f}: held-out {a:.2f}x, with unreachable cells {b:.2f}x", flush=True)
     best = min(results, key=lambda x: x[0])

@@ -174,8 +174,9 @@ class Guide:
     ty: np.ndarray  # float64 [T]
     trem: np.ndarray  # float64 [T]: trajectory length (cells) from this cell to its end
     tstart: np.ndarray  # int64 [n_traj + 1]: where each trajectory starts in tx/ty/trem
-    params: np.ndarray  # float64 [14]: window, reach, knn, memory, weight, episodes, blocked (0/1), give_up,
-    #                    plan (0/1), plan tolerance, tip model (0/1), tip ridge, tip nearest, tip anchor (0/1)
+    params: np.ndarray  # float64 [15]: window, reach, knn, memory, weight, episodes, blocked (0/1), give_up,
+    #                    plan (0/1), plan tolerance, tip model (0/1), tip ridge, tip nearest, tip anchor (0/1),
+    #                    fill (cells per move; 0: off)
     tq: np.ndarray  # float64 [S, C]: the moving joints of each state (the tip model's input; [0, 1] without it)
     fj: np.ndarray  # int64 [F, TIP_ORDER]: the joints (columns of tq) each feature multiplies, -1 past its last
     fk: np.ndarray  # int64 [F, TIP_ORDER]: 0 for the cosine of that joint, 1 for its sine
@@ -276,7 +277,7 @@ def as_tuple(g: Guide) -> tuple:
 
 
 def model_arrays(n_states: int, n_actions: int, memory: int, n_traj: int, n_features: int = 0,
-                 n_joints: int = 0) -> tuple:
+                 n_joints: int = 0, fill: bool = False) -> tuple:
     """What the model learns during a trial: (displacement sums [S, A, 2], counts [S, A],
     remembered states [A, memory], pushes per action [A], progress index per trajectory,
     generalised [S, A], moved [S, A], moves without progress per trajectory), then what
@@ -288,9 +289,10 @@ def model_arrays(n_states: int, n_actions: int, memory: int, n_traj: int, n_feat
     without it): P [F, F] (the inverse of the ridge normal matrix), W [F, 2] (its weights), the
     first label seen [2] and whether it was [1], states already learned from [S], summed joint
     displacement per action [A, C] and moves summed [A], and scratch (features [F] twice, P times
-    features [F], a configuration [C]); then the fill's: h [S], the epoch each h was set in [S],
-    the epoch [1] (+1 at an episode's start and whenever a trajectory's progress moves), and the
-    state last observed after each pair [S, A] (-1: none)."""
+    features [F], a configuration [C]); then the fill's (empty without it, but for the epoch): h
+    [S], the epoch each h was set in [S], the epoch [1] (+1 at an episode's start and whenever a
+    trajectory's progress moves), and the state last observed after each pair [S, A] (-1: none)."""
+    n_fill = n_states if fill else 0
     pairs = n_states * n_actions
     return (np.zeros((n_states, n_actions, 2)), np.zeros((n_states, n_actions), np.int64),
             np.zeros((n_actions, memory), np.int64), np.zeros(n_actions, np.int64),
@@ -305,14 +307,15 @@ def model_arrays(n_states: int, n_actions: int, memory: int, n_traj: int, n_feat
             np.zeros(n_states if n_features else 0, np.bool_), np.zeros((n_actions, n_joints)),
             np.zeros(n_actions, np.int64), np.zeros(n_features), np.zeros(n_features), np.zeros(n_features),
             np.zeros(n_joints),
-            np.zeros(n_states), np.full(n_states, -1, np.int64), np.zeros(1, np.int64),
-            np.full((n_states, n_actions), -1, np.int64))
+            np.zeros(n_fill), np.full(n_fill, -1, np.int64), np.zeros(1, np.int64),
+            np.full((n_fill, n_actions), -1, np.int64))
 
 
 def model_arrays_for(g: Guide, n_states: int, n_actions: int) -> tuple:
     """:func:`model_arrays` sized for guide ``g`` (P starts as the identity over the ridge)."""
     f = g.fj.shape[0]
-    gm = model_arrays(n_states, n_actions, g.memory, len(g.tstart) - 1, f, g.tq.shape[1] if f else 0)
+    gm = model_arrays(n_states, n_actions, g.memory, len(g.tstart) - 1, f, g.tq.shape[1] if f else 0,
+                      fill=g.params[14] > 0.0)
     gm[21][...] /= g.params[11] if f else 1.0
     return gm
 
@@ -702,12 +705,12 @@ def egreedy(Q, s, eps, rng, g, gm):
             y = min(max(first[1] + y0, lxy[s, 1] - 0.5), lxy[s, 1] + 0.5)
     fill = params[14]
     h, hst, epoch, last = gm[32], gm[33], gm[34], gm[35]
-    here = 0.0
-    if fill > 0.0:
-        if hst[s] != epoch[0]:
-            hst[s] = epoch[0]
-            h[s] = 0.0
+    here = 0.0  # the score where the tip is now (what a move predicted blocked keeps)
+    if tip or fill > 0.0:
         here = score(g, gm, x, y)
+    if fill > 0.0 and hst[s] != epoch[0]:
+        hst[s] = epoch[0]
+        h[s] = 0.0
     low = np.inf
     for a in range(n_actions):
         ha = np.nan
@@ -717,7 +720,7 @@ def egreedy(Q, s, eps, rng, g, gm):
             if bufn[a] == 0:
                 v = np.inf  # tried nowhere yet
             elif near_blocked(g, gm, s, a):
-                ha = here + h[s] if fill > 0.0 else score(g, gm, x, y)
+                ha = here + h[s] if fill > 0.0 else here
                 v = Q[s, a] - w * ha
             else:
                 dx, dy = tip_move(g, gm, s, a, x0, y0)

@@ -295,12 +295,10 @@ class GuideModel:
                 x = min(max(self.first[0] + x0, lx - 0.5), lx + 0.5)
                 y = min(max(self.first[1] + y0, ly - 0.5), ly + 0.5)
         fill = self.fill > 0
-        here = 0.0
-        if fill:
-            if self.h_epoch.get(s) != self.epoch:
-                self.h_epoch[s] = self.epoch
-                self.h[s] = 0.0
-            here = self.score(x, y)
+        here = self.score(x, y) if self.tip or fill else 0.0  # the score where the tip is now
+        if fill and self.h_epoch.get(s) != self.epoch:
+            self.h_epoch[s] = self.epoch
+            self.h[s] = 0.0
         val = []
         heads = []  # each action's predicted score (plus h of its known successor), None when unknown
         for a in range(n_actions):
@@ -311,7 +309,7 @@ class GuideModel:
                 if not self.tried_at[a]:
                     v = np.inf
                 elif self.near_blocked(s, a):
-                    ha = here + self.h[s] if fill else self.score(x, y)
+                    ha = here + self.h[s] if fill else here
                     v = q_row[a] - w * ha
                 else:
                     dx, dy = self.tip_move(s, a, x0, y0)
