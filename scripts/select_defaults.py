@@ -257,7 +257,8 @@ def main() -> None:
     p.add_argument("--pairs", type=int, default=8)
     p.add_argument("--trials", type=int, default=20)
     p.add_argument("--seed", type=int, default=2026)
-    p.add_argument("--method", nargs="*", default=None, help="only these methods")
+    p.add_argument("--method", nargs="*", default=None, help="only these methods",
+                   choices=[*CANDIDATES, "guided", "guided-tip", "guided-fill"])
     args = p.parse_args()
     if args.method and "guided" in args.method:
         select_guided(args.pairs, args.trials, args.seed)

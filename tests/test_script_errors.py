@@ -28,6 +28,14 @@ def test_a_bad_option_is_one_line_and_exit_2(name, tmp_path):
     assert list(tmp_path.iterdir()) == []  # nothing written
 
 
+def test_an_unknown_method_to_select_defaults_is_one_line_naming_the_valid_ones(tmp_path):
+    proc = subprocess.run([sys.executable, str(SCRIPTS / "select_defaults.py"), "--method", "guided-tips"],
+                          capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr and proc.stdout == ""
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "'guided-tips'" in lines[0] and "'guided-tip'" in lines[0] and "'dense'" in lines[0]
+
+
 def _into_a_closed_pipe(argv, cwd) -> subprocess.CompletedProcess:
     """Run ``argv`` with stdout a pipe whose reader is gone before the first write (as after
     ``| head``: Python starts far slower than the close below)."""
