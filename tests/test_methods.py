@@ -8,6 +8,7 @@ from armtransfer.tasks.layout import Layout
 from armtransfer.learning import controls, experiment, learning_metrics, potentials, methods, rewards, sarsa
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
+from armtransfer.errors import InvalidParameterError
 from armtransfer.learning.shaping import Shaping
 
 # 9 x 9, two rooms joined by one door at (0, 2)
@@ -137,6 +138,57 @@ def test_controls_keep_length_and_cells_and_are_seeded(setup):
     rw = controls.random_walk(coarse, traj, np.random.default_rng(0))
     assert len(rw) == len(traj) and rw.start == traj.start
     assert controls.random_walk(coarse, traj, np.random.default_rng(0)) == rw
+
+
+def test_controls_do_not_carry_the_goal_unless_asked(setup):
+    """s_tg is part of what robot 1 hands over, so a control replaces it: the shuffled one ends
+    at its own last cell, the random walk where the walk ends. keep_goal keeps the task's goal
+    and changes nothing else."""
+    fine, coarse, start, goal, traj = setup
+    sh = controls.shuffled(traj, np.random.default_rng(0))
+    assert sh.goal == sh.cells[-1] != goal
+    rw = controls.random_walk(coarse, traj, np.random.default_rng(0))
+    s = coarse.start_state(start)
+    for a in rw.actions:
+        s = int(coarse.next_state[s, a])
+    assert rw.goal == int(coarse.label[s]) != goal
+    for kind in ("shuffled", "random"):
+        free = experiment.control_trajectories(kind, coarse, [traj], 3)[0]
+        kept = experiment.control_trajectories(kind, coarse, [traj], 3, keep_goal=True)[0]
+        assert kept.goal == goal and (kept.cells, kept.actions) == (free.cells, free.actions)
+
+
+def test_a_control_draws_its_trajectory_per_trial(setup):
+    """run_control gives each trial its own control trajectory, so its mean is over the control's
+    randomness and not over one draw: trial k runs exactly as run_method does on draw k, the
+    draws differ, and the same seed gives the same trials on any number of threads."""
+    fine, coarse, start, goal, traj = setup
+    config = LearnerConfig(max_episodes=1, max_total_steps=100_000)
+    draws = [experiment.control_trajectories("shuffled", coarse, [traj], 0, trial=k)[0] for k in range(3)]
+    assert len({d.cells for d in draws}) > 1
+    ctl = experiment.run_control("pseudo", "shuffled", coarse, fine, start, goal, [traj], 3, 0, config, threads=1)
+    assert ctl.label == "pseudo [shuffled]" and len(ctl.extra["K"]) == 3
+    for k, d in enumerate(draws):
+        one = experiment.run_method("pseudo", fine, start, goal, [d], k + 1, 0, config, threads=1)
+        assert one.trials[k].exploration_steps == ctl.trials[k].exploration_steps
+        assert one.extra["K"] == ctl.extra["K"][k]
+    again = experiment.run_control("pseudo", "shuffled", coarse, fine, start, goal, [traj], 3, 0, config, threads=2)
+    assert [t.exploration_steps for t in again.trials] == [t.exploration_steps for t in ctl.trials]
+    with pytest.raises(InvalidParameterError, match="valid: shuffled, random"):
+        experiment.run_control("pseudo", "reversed", coarse, fine, start, goal, [traj], 1, 0, config)
+
+
+@pytest.mark.parametrize("method", ["pseudo", "dense"])
+def test_the_paper_methods_never_read_the_goal_of_a_control(setup, method):
+    """pseudo and dense pay by the cells s_t1..s_tn only: a control with or without the task's
+    goal gives them the same trials, step for step."""
+    fine, coarse, start, goal, traj = setup
+    config = LearnerConfig(max_episodes=20, max_total_steps=100_000)
+    runs = []
+    for keep in (False, True):
+        r = experiment.run_control(method, "random", coarse, fine, start, goal, [traj], 3, 0, config, keep_goal=keep)
+        runs.append([(t.exploration_steps, t.total_steps, t.greedy_steps) for t in r.trials])
+    assert runs[0] == runs[1]
 
 
 def test_run_transfer_reports_controls_and_transfer_metrics(setup):

@@ -136,22 +136,65 @@ def run_method(
     threads (None: :func:`trial_threads`); the results do not depend on how many."""
     if trials < 1:
         raise InvalidParameterError(f"trials must be a positive integer, got {trials}")
-    shaping = None
     start_state = target.start_state(start_cell)
     m = methods.get(method)
-    if m.shaped:
-        if traj is None:
+
+    def shaping_for(trajs):
+        if not m.shaped:
+            return None
+        if trajs is None:
             raise InvalidParameterError(f"method {method!r} needs a trajectory")
+        k = K
         if m.farmable:  # the exact check: value iteration over this task ('auto' comes out verified)
-            K = farming.check_k(method, target, start_state, goal_cell, traj, K, config, wind)
-        shaping = methods.build_shaping(method, target, traj, K, config.step_reward, beta=beta)
+            k = farming.check_k(method, target, start_state, goal_cell, trajs, K, config, wind)
+        return methods.build_shaping(method, target, trajs, k, config.step_reward, beta=beta)
+
     out = MethodResult(method, control=control)
+    if callable(traj):  # each trial its own trajectories (the controls: one draw per trial)
+        shapings: list = [None] * trials
+
+        def one(trial: int):
+            shapings[trial] = sh = shaping_for(traj(trial))
+            return sarsa.learn(target, start_state, goal_cell, config, trial_rng(seed, trial),
+                               shaping=sh, wind=wind, macros=macros)
+
+        out.trials = map_trials(one, trials, threads, on_trial)
+        if m.shaped:
+            out.extra["K"] = [sh.K for sh in shapings]
+        return out
+    shaping = shaping_for(traj)
     out.trials = map_trials(lambda trial: sarsa.learn(target, start_state, goal_cell, config, trial_rng(seed, trial),
                                                       shaping=shaping, wind=wind, macros=macros),
                             trials, threads, on_trial)
     if shaping is not None:
         out.extra["K"] = shaping.K
     return out
+
+
+def run_control(
+    method: str,
+    kind: str,
+    source: DiscreteRobot,
+    target: DiscreteRobot,
+    start_cell: int,
+    goal_cell: int,
+    trajs: Sequence[Trajectory],
+    trials: int,
+    seed: int,
+    config: LearnerConfig,
+    keep_goal: bool = False,
+    **kw,
+) -> MethodResult:
+    """``trials`` trials of a method given ``kind`` control trajectories in place of ``trajs``:
+    each trial draws its own (:func:`control_trajectories` with ``trial``), so the mean is over
+    the control's randomness too, not over one draw. ``keep_goal``: the ablation that keeps the
+    task's goal (labelled ``kind, goal kept``). ``kw`` goes to :func:`run_method`."""
+    if kind not in CONTROLS:
+        raise InvalidParameterError(f"unknown control {kind!r}; valid: {', '.join(CONTROLS)}")
+    label = f"{kind}, goal kept" if keep_goal else kind
+    return run_method(method, target, start_cell, goal_cell,
+                      lambda trial: control_trajectories(kind, source, trajs, seed, keep_goal, trial),
+                      trials, seed, config, control=label, **kw)
 
 
 def run_mapping(
@@ -297,13 +340,17 @@ def compact(entry: dict) -> dict:
 
 
 def control_trajectories(
-    kind: str, source: DiscreteRobot, trajs: Sequence[Trajectory], seed: int
+    kind: str, source: DiscreteRobot, trajs: Sequence[Trajectory], seed: int, keep_goal: bool = False,
+    trial: int | None = None,
 ) -> list[Trajectory]:
-    """``shuffled`` or ``random`` stand-ins for the real trajectories, seeded by ``seed``."""
-    rng = np.random.default_rng(np.random.SeedSequence([int(seed), 2, CONTROLS.index(kind)]))
+    """``shuffled`` or ``random`` stand-ins for the real trajectories, seeded by ``seed`` (and
+    ``trial``: one draw per trial, see :func:`run_control`); with ``keep_goal`` they keep the
+    task's goal (an ablation, see :mod:`controls`) and are otherwise the same cells and actions."""
+    key = [int(seed), 2, CONTROLS.index(kind)] + ([] if trial is None else [int(trial)])
+    rng = np.random.default_rng(np.random.SeedSequence(key))
     if kind == "shuffled":
-        return [controls.shuffled(t, rng) for t in trajs]
-    return [controls.random_walk(source, t, rng) for t in trajs]
+        return [controls.shuffled(t, rng, keep_goal) for t in trajs]
+    return [controls.random_walk(source, t, rng, keep_goal) for t in trajs]
 
 
 def add_transfer_metrics(summary: dict, optimal: int, baseline: str = "none") -> None:
@@ -374,11 +421,10 @@ def run_all(
                                       trials, seed, config, beta=beta, **kw))
     if controls:
         for kind in CONTROLS:
-            fake = control_trajectories(kind, source, trajs, seed)
             for m in chosen:
                 if m.name in SHAPING_METHODS:  # the same K as the real trajectory's
-                    results.append(run_method(m.name, target, start_cell, goal_cell, fake, trials, seed, config,
-                                              beta=beta, control=kind, wind=wind, K=k_of(m.name), on_trial=tick))
+                    results.append(run_control(m.name, kind, source, target, start_cell, goal_cell, trajs, trials,
+                                               seed, config, beta=beta, wind=wind, K=k_of(m.name), on_trial=tick))
     return results, learned
 
 
