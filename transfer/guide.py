@@ -38,7 +38,9 @@ The model (all of it from what robot 2 observes):
     most, instead of one SARSA(lambda) update at a time.
   * Progress along a trajectory: the furthest index whose cell the label came within
     ``reach`` cells of in this episode; after ``give_up`` moves without progress the next
-    cell is given up on (it may be out of reach). The score of a predicted label position q is
+    cell is given up on (it may be out of reach), and after ``give_up`` moves at the last one,
+    s_tg, without the episode ending, the trajectory is (its goal is not this task's: a control
+    trajectory, or a wrong one), and once every trajectory is, Algorithm 1 chooses alone. The score of a predicted label position q is
     min over the trajectory cells c_j ahead of that index, within ``window`` cells of
     trajectory length, of |q - c_j| + (the trajectory's length from c_j to its end); lower is
     better. With several trajectories the smallest score counts.
@@ -101,7 +103,10 @@ distance), 100 and 200 change nothing (1.79x, 1.80x, against 1.80x never); 100 i
 the smallest harmless value. It matters where a trajectory cell is out of robot 2's reach:
 coarse -> a bring-your-own SCARA (tests/conftest.py, cartesian, Table I task 4's optimal
 trajectory, 6 of its 38 cells unreachable) needs about 3,700x without it and about 260x
-with it, 5 trials."""
+with it, 5 trials. The same count at the last cell, s_tg, gives up on the whole trajectory:
+before that rule a trajectory whose goal was not the task's (a random walk, ending where it
+ended) held robot 2 at its end, and guided ran 2 of 2 trials on coarse -> fine task 4 to the
+20,000,000-step cap."""
 EPISODES = 1
 """The model chooses in this many first episodes (1: until the goal is first reached, the
 exploration phase); afterwards Algorithm 1's epsilon-greedy chooses alone.
@@ -406,7 +411,10 @@ def update_progress(g, gm, s):
     """Advance each trajectory's progress index to the furthest cell within reach of s's
     label, looking up to ``window + reach`` cells of trajectory length ahead. After
     ``give_up`` moves without progress on a trajectory its next cell is given up on (robot 2
-    may be unable to reach it: a wall, a joint limit, a cell out of its reach)."""
+    may be unable to reach it: a wall, a joint limit, a cell out of its reach); after
+    ``give_up`` moves at its last cell, s_tg, the trajectory itself is (its goal is not the
+    task's, or out of reach): its progress goes one past its cells, and once every trajectory
+    is given up on, :func:`egreedy` is Algorithm 1's own."""
     lxy, tx, ty, trem, tstart, params = g[1], g[2], g[3], g[4], g[5], g[6]
     prog, wait = gm[4], gm[7]
     reach = params[1]
@@ -416,6 +424,8 @@ def update_progress(g, gm, s):
     y = lxy[s, 1]
     for t in range(tstart.shape[0] - 1):
         i0 = prog[t]
+        if i0 >= tstart[t + 1]:
+            continue  # given up on
         for j in range(i0 + 1, tstart[t + 1]):
             if trem[i0] - trem[j] > horizon:
                 break
@@ -428,10 +438,20 @@ def update_progress(g, gm, s):
             gm[34][0] += 1
         else:
             wait[t] += 1
-            if give_up > 0.0 and wait[t] >= give_up and prog[t] < tstart[t + 1] - 1:
+            if give_up > 0.0 and wait[t] >= give_up:
                 prog[t] += 1
                 wait[t] = 0
                 gm[34][0] += 1
+
+
+@numba.njit(cache=True)
+def exhausted(g, gm):
+    """Every trajectory given up on (:func:`update_progress`): the model has nothing to say."""
+    tstart, prog = g[5], gm[4]
+    for t in range(tstart.shape[0] - 1):
+        if prog[t] < tstart[t + 1]:
+            return False
+    return True
 
 
 @numba.njit(cache=True)

@@ -164,6 +164,8 @@ class GuideModel:
         x, y = g.lxy[s]
         for t in range(self.n_traj):
             i0 = self.prog[t]
+            if i0 > self.cells(t)[-1]:
+                continue  # the whole trajectory given up on
             for j in self.cells(t):
                 if j <= i0:
                     continue
@@ -176,11 +178,14 @@ class GuideModel:
                 self.epoch += 1
             else:
                 self.wait[t] += 1
-                last = int(g.tstart[t + 1]) - 1
-                if g.params[7] > 0 and self.wait[t] >= g.params[7] and self.prog[t] < last:
+                if g.params[7] > 0 and self.wait[t] >= g.params[7]:  # past the last cell: the trajectory
                     self.prog[t] += 1
                     self.wait[t] = 0
                     self.epoch += 1
+
+    def exhausted(self) -> bool:
+        """Every trajectory given up on, its goal s_tg included: Algorithm 1 chooses alone."""
+        return all(self.prog[t] > self.cells(t)[-1] for t in range(self.n_traj))
 
     def observe(self, s: int, a: int, s2: int, guided: bool) -> None:
         g = self.g
@@ -392,7 +397,7 @@ def learn(
         if may_start and s in seq_at and rng.random() < 1.0 - config.epsilon:
             seq = seq_at[s]
             return seq[0], seq[1:], True
-        if model is not None and episode < model.episodes:
+        if model is not None and episode < model.episodes and not model.exhausted():
             return model.egreedy(Q[s], s, config.epsilon, rng), [], False
         return _egreedy(Q[s], config.epsilon, rng), [], False
 

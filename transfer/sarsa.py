@@ -124,7 +124,7 @@ def _choose_guided(Q, s, eps, rng, in_macro, m_pos, m_end, may_start, macro_star
                                                    macro_len, macro_actions)
     if found:
         return a, in_macro, m_pos, m_end, 1
-    if guided:
+    if guided and not _guide.exhausted(g, gm):  # every trajectory given up on: Algorithm 1's own
         return _guide.egreedy(Q, s, eps, rng, g, gm), False, m_pos, m_end, 0
     return _egreedy(Q, s, Q.shape[1], eps, rng), False, m_pos, m_end, 0
 
