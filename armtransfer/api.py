@@ -67,7 +67,7 @@ def transfer(
     trajectory file names its task, else task 1. ``trajectory`` is one or several of
     :data:`TRAJECTORY_KINDS`, trajectory JSON files or :class:`Trajectory` objects (default
     ``learned``). ``controls`` also runs every reward-only method with a shuffled and a
-    random trajectory. ``mapping`` (for method ``mapping``) is a mapping or its JSON file;
+    random trajectory, each trial with its own draw (``experiment.run_control``). ``mapping`` (for method ``mapping``) is a mapping or its JSON file;
     with ``save_mapping`` the file is updated from this run's converged trials.
     ``learner_options`` are :class:`LearnerConfig` fields (``alpha``, ``epsilon``, ...).
     ``progress`` is called after every trial.

@@ -8,7 +8,10 @@ For each robot pair and Table I task, the source learns the task (SARSA(lambda) 
 transfer) and hands over its converged greedy path, the paper's protocol. The target then
 learns with ``none``, ``pseudo``, ``dense``, ``oracle`` (a bound, not a method: potential
 shaping from the true map distance, which no robot has) and ``guided``, and ``guided`` again
-with the two control trajectories (its cells shuffled; a random walk of the source). Every
+with the two control trajectories (its cells shuffled; a random walk of the source), which
+replace the trajectory's goal s_tg too (``armtransfer.learning.controls``). The same controls
+with the task's goal kept are run as an ablation: they show what the path's order adds to
+knowing the goal, and are not one of the issue's checks. Every
 trial counts: one that never reaches the goal counts at the step cap and its mean is marked
 as a lower bound (≥). Means and 95% CIs are ``experiment.summarize``'s (``metrics``).
 
@@ -23,6 +26,7 @@ Writes ``DIR/first_exposure.md`` and ``DIR/first_exposure.json``.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import time
 from pathlib import Path
 
@@ -41,6 +45,9 @@ PAIRS = [("coarse", "fine"), ("fine", "coarse"),
 METHODS = ("none", "pseudo", "dense", "guided")
 NEW = "guided"
 COLUMNS = ("none", "pseudo", "dense", "oracle", NEW, f"{NEW} [shuffled]", f"{NEW} [random]")
+KEPT = ", goal kept"
+"""The ablation's control names: ``shuffled, goal kept`` and ``random, goal kept``."""
+ABLATION = tuple(f"{NEW} [{k}{KEPT}]" for k in CONTROLS)
 TARGET_RATIO = 3.0
 """Issue 14: first-exposure exploration at most 3x the optimal distance..."""
 TARGET_GREEDY = 1.05
@@ -66,9 +73,11 @@ def run_case(source, target, task: int, trials: int, seed: int, config: LearnerC
     results, _ = experiment.run_all(source, target, start, goal, METHODS, [traj], trials, seed, config,
                                     controls=False)
     results.append(run_oracle(target, start, goal, trials, seed, config))
+    first = dataclasses.replace(config, max_episodes=1)  # only their first exposure is reported
     for kind in CONTROLS:
-        fake = experiment.control_trajectories(kind, source, [traj], seed)
-        results.append(experiment.run_method(NEW, target, start, goal, fake, trials, seed, config, control=kind))
+        for keep in (False, True):
+            results.append(experiment.run_control(NEW, kind, source, target, start, goal, [traj], trials, seed,
+                                                  first, keep_goal=keep))
     if online is not None and len(online):  # the mapping learned during the earlier tasks
         res, _ = experiment.run_mapping(target, start, goal, traj, online, trials, seed, config)
         res.control = "online"
@@ -104,16 +113,19 @@ def total_cell(entry: dict) -> str:
     return "n/a" if entry["total_mean"] is None else f"{entry['total_mean']:,.0f}"
 
 
-def verdict(entry: dict, controls: list[dict], optimal: int) -> dict:
-    """The issue's three checks on one case, from the measured means."""
+def verdict(entry: dict, controls: list[dict], optimal: int, ablation: list[dict]) -> dict:
+    """The issue's three checks on one case, from the measured means; and the same factor for
+    the controls that keep the goal (the ablation, not a check)."""
     ratio = entry["mean"] / optimal
     greedy = None if entry["greedy_mean"] is None else entry["greedy_mean"] / optimal
     factors = [c["mean"] / entry["mean"] for c in controls]
+    kept = [c["mean"] / entry["mean"] for c in ablation]
     return {
         "first_exposure_ratio": ratio, "first_exposure_ok": ratio <= TARGET_RATIO,
         "greedy_ratio": greedy, "greedy_ok": greedy is not None and greedy <= TARGET_GREEDY
         and all(entry["converged"]),
         "control_factors": factors, "controls_ok": all(f >= TARGET_CONTROL for f in factors),
+        "goal_kept_factors": kept, "goal_kept_ok": all(f >= TARGET_CONTROL for f in kept),
     }
 
 
@@ -131,11 +143,15 @@ def markdown(rows: list[dict], trials: int, seed: int, seconds: float) -> str:
              *[f"{c}: steps to converge" for c in conv_cols]]
     t3 = [[r["pair"], str(r["task"]), f"{v['first_exposure_ratio']:.2f}" + ("" if v["first_exposure_ok"] else " ✗"),
            ("n/a" if v["greedy_ratio"] is None else f"{v['greedy_ratio']:.3f}") + ("" if v["greedy_ok"] else " ✗"),
-           ", ".join(f"{f:.1f}" for f in v["control_factors"]) + ("" if v["controls_ok"] else " ✗")]
+           ", ".join(f"{f:.1f}" for f in v["control_factors"]) + ("" if v["controls_ok"] else " ✗"),
+           ", ".join(f"{f:.1f}" for f in v["goal_kept_factors"]) + ("" if v["goal_kept_ok"] else " ✗")]
           for r in rows for v in [r["verdict"]]]
+    t4 = [[r["pair"], str(r["task"]), str(r["optimal"]),
+           *[ratio_cell(r["summary"][c], r["optimal"]) for c in (NEW, *ABLATION)]] for r in rows]
     head3 = ["source → target", "task", f"{NEW} first exposure (≤ {TARGET_RATIO:g}×)",
              f"{NEW} greedy/optimal (≤ {TARGET_GREEDY:g})",
-             f"controls / {NEW}: shuffled, random (≥ {TARGET_CONTROL:g}×)"]
+             f"controls / {NEW}: shuffled, random (≥ {TARGET_CONTROL:g}×)",
+             f"ablation, goal kept / {NEW}: shuffled, random (not a check)"]
     return "\n\n".join([
         f"## First exposure: exploration steps / the target's optimal distance, mean [95% CI], "
         f"{trials} trials, seed {seed}",
@@ -144,6 +160,9 @@ def markdown(rows: list[dict], trials: int, seed: int, seconds: float) -> str:
         markdown_table(head2, t2),
         f"## Issue 14's checks for `{NEW}` (✗: not met)",
         markdown_table(head3, t3),
+        "## Ablation: the controls with the task's goal kept (what the path's order adds to knowing "
+        "the goal), exploration steps / optimal distance",
+        markdown_table(["source → target", "task", "optimal", NEW, *ABLATION], t4),
         f"({seconds:.0f} s)",
     ]) + "\n"
 
@@ -169,11 +188,13 @@ def _run(args: argparse.Namespace) -> int:
         online = None
         for task in tasks:
             summary, optimal, src_len, online = run_case(source, target, task, trials, args.seed, config, online)
-            v = verdict(summary[NEW], [summary[f"{NEW} [{k}]"] for k in CONTROLS], optimal)
+            v = verdict(summary[NEW], [summary[f"{NEW} [{k}]"] for k in CONTROLS], optimal,
+                        [summary[c] for c in ABLATION])
             rows.append({"pair": f"{src_name} → {dst_name}", "task": task, "optimal": optimal,
                          "source_path": src_len, "summary": summary, "verdict": v})
             print(f"{src_name} -> {dst_name} task {task}: "
-                  + ", ".join(f"{c} {summary[c]['mean'] / optimal:.2f}x" for c in COLUMNS), flush=True)
+                  + ", ".join(f"{c} {summary[c]['mean'] / optimal:.2f}x" for c in (*COLUMNS, *ABLATION)),
+                  flush=True)
     seconds = time.perf_counter() - t0
     with staged_directory(args.out) as tmp:
         write_text_atomic(tmp / "first_exposure.md", markdown(rows, trials, args.seed, seconds))

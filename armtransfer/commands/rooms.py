@@ -52,7 +52,8 @@ def print_results(out: dict) -> None:
     print(results_table(out))
     if out.get("controls"):
         print("[shuffled] and [random] are controls: the same method given the trajectory's cells in a "
-              "random order, or a random walk of the source robot of the same length.")
+              "random order, or a random walk of the source robot of the same length, a new draw each "
+              "trial, neither ending at the task's goal.")
     info = out["mapping"]
     if info is not None:
         if info["macro_states"] == 0:
