@@ -122,7 +122,7 @@ TIP_ANCHOR, TIP_RIDGE and TIP_NEAREST were chosen after them (``scripts/select_d
 planar2:joint, the robot pair of that grid whose target moves its joints, and on 8 more held-out
 pairs of it whose trajectory has cells the arm cannot reach (at most a quarter of them):
 the smallest worse of the two means, 1.70x the optimal distance on both (without the tip model
-1.79x and 3.23x); never on Table I. TIP_ORDER was not tuned. FILL_COST was chosen after them on
+1.79x and 3.23x; 1.79x and 5.76x since the give-up at a trajectory's last cell); never on Table I. TIP_ORDER was not tuned. FILL_COST was chosen after them on
 the same two sets (``--method guided-fill``): 1.65x (1.70x without the fill)."""
 PLAN = True
 """Whether robot 2 plans over the moves it has tried, after every episode (see :func:`plan`)."""
