@@ -71,6 +71,30 @@ def test_kernel_is_bit_identical_to_the_dense_reference_with_the_guide(wind, sev
     assert np.array_equal(fast.Q, Q)
 
 
+@pytest.mark.parametrize("several", [False, True])
+def test_kernel_is_bit_identical_to_the_dense_reference_when_it_gives_a_trajectory_up(several):
+    """Control trajectories that do not end at the goal: the give-up at their last cell, and
+    Algorithm 1 choosing alone once every one is given up, are the reference's, bit for bit."""
+    fine, coarse, start, goal = small_task()
+    traj = trajectories.shortest(coarse, start, goal)
+    trajs = [experiment.control_trajectories("random", coarse, [traj], 0, trial=k)[0] for k in range(1 + several)]
+    assert all(t.goal != goal for t in trajs)
+    sh = guided_shaping(fine, trajs, episodes=3, give_up=20)
+    config = LearnerConfig(trace_cutoff=0.0, max_episodes=4, patience=1000)
+    s0 = fine.start_state(start)
+    fast = sarsa.learn(fine, s0, goal, config, np.random.default_rng(3), shaping=sh, keep_q=True)
+    Q, steps = reference.learn(fine, s0, goal, config, np.random.default_rng(3), episodes=4, guide=sh.guide)
+    assert fast.episode_steps.tolist() == steps
+    assert np.array_equal(fast.Q, Q)
+    # the first episode did give every trajectory up: its progress ends one past its cells
+    g = sh.guide
+    gm = guide.model_arrays_for(g, fine.n_states, fine.n_actions)
+    first = sarsa.learn(fine, s0, goal, replace(config, max_episodes=1), np.random.default_rng(3), shaping=sh,
+                        guide_arrays=gm)
+    assert first.episode_steps.tolist() == steps[:1]
+    assert gm[4].tolist() == g.tstart[1:].tolist()
+
+
 @pytest.mark.parametrize("anchor", [False, True])
 def test_kernel_is_bit_identical_to_the_dense_reference_with_the_tip_model_on_a_joint_arm(anchor):
     """planar2:joint, whose actions move a joint: the tip model is on by default, and the kernel's
