@@ -142,7 +142,9 @@ def controls_markdown(res: dict, max_steps: int) -> str:
         "### Controls: the same methods with a shuffled and a random trajectory\n\n"
         + markdown_table(header, rows)
         + "\n\n[shuffled]: the trajectory's cells in a random order (start kept first); [random]: a random "
-        "walk of the coarse robot of the same length. A speed-up that the random walk also gives does not "
+        "walk of the coarse robot of the same length. Each trial draws its own, and neither ends at the "
+        "task's goal (the shuffled one ends at its own last cell, the walk where it ends). A speed-up "
+        "that the random walk also gives does not "
         "come from the transferred knowledge; one that the shuffled cells keep comes from where the cells "
         "are, not from their order. (r/N reached): only r of N trials reached the goal within the "
         f"trial's cap of {max_steps:,} steps; the others count at the cap, so the mean (≥) is a lower bound."
