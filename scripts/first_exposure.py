@@ -32,7 +32,7 @@ from pathlib import Path
 
 from armtransfer import script
 from armtransfer.io import check_output_dir, staged_directory, write_json_atomic, write_text_atomic
-from armtransfer.learning import experiment, potentials, sarsa
+from armtransfer.learning import controls, experiment, potentials, sarsa
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.controls import CONTROLS
 from armtransfer.learning.report import fmt_ci, markdown_table
@@ -45,9 +45,8 @@ PAIRS = [("coarse", "fine"), ("fine", "coarse"),
 METHODS = ("none", "pseudo", "dense", "guided")
 NEW = "guided"
 COLUMNS = ("none", "pseudo", "dense", "oracle", NEW, f"{NEW} [shuffled]", f"{NEW} [random]")
-KEPT = ", goal kept"
-"""The ablation's control names: ``shuffled, goal kept`` and ``random, goal kept``."""
-ABLATION = tuple(f"{NEW} [{k}{KEPT}]" for k in CONTROLS)
+ABLATION = tuple(f"{NEW} [{controls.label(k, keep_goal=True)}]" for k in CONTROLS)
+"""The ablation's columns: the controls with the task's goal kept."""
 TARGET_RATIO = 3.0
 """Issue 14: first-exposure exploration at most 3x the optimal distance..."""
 TARGET_GREEDY = 1.05

@@ -27,6 +27,11 @@ from armtransfer.learning.trajectory import Trajectory
 CONTROLS = ("shuffled", "random")
 
 
+def label(kind: str, keep_goal: bool = False) -> str:
+    """How results name a control: ``shuffled``, or ``shuffled, goal kept`` for the ablation."""
+    return f"{kind}, goal kept" if keep_goal else kind
+
+
 def shuffled(traj: Trajectory, rng: np.random.Generator, keep_goal: bool = False) -> Trajectory:
     """The start stays first (it is where every robot starts); the rest is permuted."""
     order = np.concatenate([[0], 1 + rng.permutation(len(traj) - 1)]).astype(int)

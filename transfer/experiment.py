@@ -191,10 +191,9 @@ def run_control(
     task's goal (labelled ``kind, goal kept``). ``kw`` goes to :func:`run_method`."""
     if kind not in CONTROLS:
         raise InvalidParameterError(f"unknown control {kind!r}; valid: {', '.join(CONTROLS)}")
-    label = f"{kind}, goal kept" if keep_goal else kind
     return run_method(method, target, start_cell, goal_cell,
                       lambda trial: control_trajectories(kind, source, trajs, seed, keep_goal, trial),
-                      trials, seed, config, control=label, **kw)
+                      trials, seed, config, control=controls.label(kind, keep_goal), **kw)
 
 
 def run_mapping(
