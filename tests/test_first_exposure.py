@@ -33,6 +33,18 @@ def guided_shaping(robot, trajs, **params):
     return replace(sh, guide=guide.build(robot, trajs, **params)) if params else sh
 
 
+def assert_kernel_is_reference(robot, start, goal, config, seed, shaping, wind=0.0) -> list[int]:
+    """The numba kernel and the dense reference (Algorithm 1 with the guide, written out plainly)
+    give the same episode lengths and the same Q, bit for bit; returns the episode lengths."""
+    s0 = robot.start_state(start)
+    fast = sarsa.learn(robot, s0, goal, config, np.random.default_rng(seed), shaping=shaping, wind=wind, keep_q=True)
+    Q, steps = reference.learn(robot, s0, goal, config, np.random.default_rng(seed), episodes=config.max_episodes,
+                               guide=shaping.guide, wind=wind)
+    assert fast.episode_steps.tolist() == steps
+    assert np.array_equal(fast.Q, Q)
+    return steps
+
+
 def test_guided_is_registered_and_chooses_actions():
     m = methods.get("guided")
     assert m.chooses and m.shaped and not m.farmable
@@ -63,12 +75,7 @@ def test_kernel_is_bit_identical_to_the_dense_reference_with_the_guide(wind, sev
     # grid robot (its configuration is its cell), so that wind and several trajectories meet it too
     sh = guided_shaping(fine, trajs, episodes=3, tip=tip)
     config = LearnerConfig(trace_cutoff=0.0, max_episodes=8, patience=1000)
-    s0 = fine.start_state(start)
-    fast = sarsa.learn(fine, s0, goal, config, np.random.default_rng(7), shaping=sh, wind=wind, keep_q=True)
-    Q, steps = reference.learn(fine, s0, goal, config, np.random.default_rng(7), episodes=8, guide=sh.guide,
-                               wind=wind)
-    assert fast.episode_steps.tolist() == steps
-    assert np.array_equal(fast.Q, Q)
+    assert_kernel_is_reference(fine, start, goal, config, 7, sh, wind=wind)
 
 
 @pytest.mark.parametrize("several", [False, True])
@@ -81,16 +88,12 @@ def test_kernel_is_bit_identical_to_the_dense_reference_when_it_gives_a_trajecto
     assert all(t.goal != goal for t in trajs)
     sh = guided_shaping(fine, trajs, episodes=3, give_up=20)
     config = LearnerConfig(trace_cutoff=0.0, max_episodes=4, patience=1000)
-    s0 = fine.start_state(start)
-    fast = sarsa.learn(fine, s0, goal, config, np.random.default_rng(3), shaping=sh, keep_q=True)
-    Q, steps = reference.learn(fine, s0, goal, config, np.random.default_rng(3), episodes=4, guide=sh.guide)
-    assert fast.episode_steps.tolist() == steps
-    assert np.array_equal(fast.Q, Q)
+    steps = assert_kernel_is_reference(fine, start, goal, config, 3, sh)
     # the first episode did give every trajectory up: its progress ends one past its cells
     g = sh.guide
     gm = guide.model_arrays_for(g, fine.n_states, fine.n_actions)
-    first = sarsa.learn(fine, s0, goal, replace(config, max_episodes=1), np.random.default_rng(3), shaping=sh,
-                        guide_arrays=gm)
+    first = sarsa.learn(fine, fine.start_state(start), goal, replace(config, max_episodes=1), np.random.default_rng(3),
+                        shaping=sh, guide_arrays=gm)
     assert first.episode_steps.tolist() == steps[:1]
     assert gm[4].tolist() == g.tstart[1:].tolist()
 
@@ -107,11 +110,7 @@ def test_kernel_is_bit_identical_to_the_dense_reference_with_the_tip_model_on_a_
     sh = guided_shaping(arm, trajs, tip_anchor=anchor)
     assert sh.guide.tip and sh.guide.fj.shape == (9, guide.TIP_ORDER)  # 2 joints: 1 + 4 + 4 features
     config = LearnerConfig(trace_cutoff=0.0, max_episodes=2, patience=1000)
-    s0 = arm.start_state(start)
-    fast = sarsa.learn(arm, s0, goal, config, np.random.default_rng(5), shaping=sh, keep_q=True)
-    Q, steps = reference.learn(arm, s0, goal, config, np.random.default_rng(5), episodes=2, guide=sh.guide)
-    assert fast.episode_steps.tolist() == steps
-    assert np.array_equal(fast.Q, Q)
+    assert_kernel_is_reference(arm, start, goal, config, 5, sh)
 
 
 def test_the_tip_model_is_on_for_joint_moves_only():
