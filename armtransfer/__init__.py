@@ -1,15 +1,18 @@
 """armtransfer: transfer learning between robots that cannot imitate each other.
 
-The library, in the one direction its imports follow (``tests/test_architecture.py``):
+The library, in the one direction its imports follow (``tests/test_architecture.py``); each
+file's path is its module's path:
 
-  armtransfer.errors, armtransfer.io   every error a user can cause; atomic writes
-  armtransfer.models    (models/)      MJCF arms, one folder each
-  armtransfer.ik        (ik/)          all MuJoCo code: scenes, mink labels and IK, compile,
-                                       physics replay, offscreen rendering
-  armtransfer.tasks     (tasks/)       the rooms layout, discrete robots, tasks, environments
-  armtransfer.learning  (transfer/)    trajectories, methods, SARSA(lambda), mapping,
-                                       metrics, experiments, sweeps; never imports MuJoCo
-  armtransfer           (armtransfer/) the Python API, Gymnasium wrappers, the command
+  armtransfer.errors, .io, .cpus   every error a user can cause; atomic writes; cores
+  armtransfer.models               MJCF arms, one folder each
+  armtransfer.ik                   all MuJoCo code: scenes, mink labels and IK, compile,
+                                   physics replay, offscreen rendering
+  armtransfer.tasks                the rooms layout, discrete robots, tasks, environments
+  armtransfer.learning             the learner: trajectories, methods, shaping, SARSA(lambda),
+                                   the guide, mapping; never imports MuJoCo
+  armtransfer.experiments          trials, results, sweeps, stores, matrices, statistics,
+                                   reports and figures
+  armtransfer                      the Python API, Gymnasium wrappers, the command
 
 The public names below are loaded on first use, so importing any part stays cheap:
 
@@ -26,8 +29,8 @@ __version__ = "0.1.0"
 
 _LAZY = {
     "transfer": "armtransfer.api",
-    "TransferResult": "armtransfer.learning.results",
-    "MethodResult": "armtransfer.learning.experiment",
+    "TransferResult": "armtransfer.experiments.results",
+    "MethodResult": "armtransfer.experiments.experiment",
     "TrialResult": "armtransfer.learning.sarsa",
     "LearnerConfig": "armtransfer.learning.config",
     "METHODS": "armtransfer.learning.methods",

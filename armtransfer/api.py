@@ -18,13 +18,14 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from armtransfer.errors import InvalidParameterError, InvalidTaskError
-from armtransfer.learning import experiment, farming, potentials
+from armtransfer.learning import farming, potentials
+from armtransfer.experiments import experiment
 from armtransfer.learning import methods as registry
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import DEFAULT_MAX_SPAN, ActionMapping
 from armtransfer.learning.mapping import load_for as load_mapping
-from armtransfer.learning.results import MappingInfo, TransferResult
+from armtransfer.experiments.results import MappingInfo, TransferResult
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.catalog import Task, custom_task, parse_xy, table_task
 from armtransfer.tasks.layout import ROOMS

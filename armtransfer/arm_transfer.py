@@ -23,7 +23,7 @@ from armtransfer.commands.rooms import print_results, results_table
 from armtransfer.errors import InvalidParameterError
 from armtransfer.tasks.layout import ROOMS
 from armtransfer.tasks.robot import DiscreteRobot
-from armtransfer.learning import experiment, figures
+from armtransfer.experiments import experiment, figures
 from armtransfer.tasks.specs import CUSTOM, resolve
 from armtransfer.io import check_writable, copy_atomic, staged_directory, write_json_atomic, write_text_atomic
 

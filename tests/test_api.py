@@ -13,7 +13,7 @@ from armtransfer.cli import main
 from armtransfer.errors import ArmTransferError, InvalidParameterError
 from armtransfer.learning import methods as registry
 from armtransfer.learning import shaping as modes
-from armtransfer.learning.experiment import MethodResult
+from armtransfer.experiments.experiment import MethodResult
 from armtransfer.learning.sarsa import TrialResult
 from armtransfer.learning.shaping import Shaping
 
@@ -76,7 +76,7 @@ def test_bad_input_is_one_line_error_before_learning(kwargs, message):
 
 
 def test_a_farmable_k_is_refused_before_the_first_trial(monkeypatch):
-    import armtransfer.learning.experiment as experiment
+    import armtransfer.experiments.experiment as experiment
 
     calls = []
     monkeypatch.setattr(experiment, "run_method", lambda *a, **k: calls.append(a))
@@ -95,7 +95,7 @@ def test_a_new_method_needs_only_a_registry_entry(monkeypatch):
     new = registry.Method("double", "first-visit paying twice", paper=False, build=double_bonus, auto_k=5.0)
     monkeypatch.setitem(registry.METHODS, "double", new)
     monkeypatch.setattr(registry, "SHAPED", registry.SHAPED + ("double",))
-    import armtransfer.learning.experiment as experiment
+    import armtransfer.experiments.experiment as experiment
 
     monkeypatch.setattr(experiment, "SHAPING_METHODS", registry.SHAPED)
     r = armtransfer.transfer(methods=["none", "double"], trials=2, seed=0)

@@ -1,6 +1,6 @@
 """The project's one-way data flow, as the README draws it, checked on the imports.
 
-    errors/io -> models -> ik -> tasks -> learning -> armtransfer (API, wrappers, command)
+    errors/io -> models -> ik -> tasks -> learning -> experiments -> armtransfer (API, wrappers, command)
 
 A module may import its own layer and the layers before it, never a later one; imports
 inside functions count too (only ``if TYPE_CHECKING:`` blocks are left out, since they never
@@ -21,27 +21,24 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
-# folder -> installed package, in the order data flows
-PACKAGES = {"models": "armtransfer.models", "ik": "armtransfer.ik", "tasks": "armtransfer.tasks",
-            "transfer": "armtransfer.learning", "armtransfer": "armtransfer"}
 FOUNDATION = ("armtransfer.errors", "armtransfer.io", "armtransfer.cpus")
+# the layers in the order data flows; the rest of armtransfer (API, wrappers, command) comes last
 LAYERS = ["foundation", "armtransfer.models", "armtransfer.ik", "armtransfer.tasks",
-          "armtransfer.learning", "armtransfer"]
+          "armtransfer.learning", "armtransfer.experiments", "armtransfer"]
 MUJOCO = ("mujoco", "dm_control", "mink")
 
 
 def _modules() -> dict[str, Path]:
+    """Every module of the package, named by its path: the file path is the module path."""
     out = {}
-    for folder, package in PACKAGES.items():
-        for path in sorted((ROOT / folder).rglob("*.py")):
-            rel = path.relative_to(ROOT / folder).with_suffix("")
-            parts = [p for p in rel.parts if p != "__init__"]
-            out[".".join([package, *parts])] = path
+    for path in sorted((ROOT / "armtransfer").rglob("*.py")):
+        rel = path.relative_to(ROOT).with_suffix("")
+        out[".".join(p for p in rel.parts if p != "__init__")] = path
     return out
 
 
 def _layer(module: str) -> int:
-    """0 for the foundation, then models, ik, tasks, learning; the rest of armtransfer last."""
+    """0 for the foundation, then models, ik, tasks, learning, experiments; the rest of armtransfer last."""
     if module in FOUNDATION:
         return 0
     for i, prefix in enumerate(LAYERS[1:-1], start=1):
@@ -135,16 +132,16 @@ def test_layer_check_catches_an_upward_import(tmp_path):
     assert not any(d.startswith("armtransfer.tasks") for d in _imports(guarded, "armtransfer.ik.guarded"))
 
 
-def test_learning_never_imports_mujoco_statically():
+def test_learning_and_experiments_never_import_mujoco_statically():
     modules = _modules()
     for name, path in modules.items():
-        if name.startswith("armtransfer.learning"):
+        if name.startswith(("armtransfer.learning", "armtransfer.experiments")):
             hits = [m for m in _imports(path, name) if m.split(".")[0] in MUJOCO]
             assert hits == [], f"{name} imports {hits}"
 
 
-def test_learning_and_tasks_import_no_mujoco_at_run_time():
-    names = [n for n in _modules() if n.startswith(("armtransfer.learning", "armtransfer.tasks"))]
+def test_learning_experiments_and_tasks_import_no_mujoco_at_run_time():
+    names = [n for n in _modules() if n.startswith(("armtransfer.learning", "armtransfer.experiments", "armtransfer.tasks"))]
     code = (
         "import importlib, sys\n"
         f"for m in {names!r}: importlib.import_module(m)\n"

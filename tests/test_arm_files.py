@@ -12,7 +12,7 @@ from armtransfer.errors import ArmModelError, ArmTransferError
 from armtransfer.ik.replay import replay
 from armtransfer.ik.scene import ContactChecker, build_scene
 from armtransfer.ik.tool import Tool, parse_offset
-from armtransfer.learning import sweep as sweeps
+from armtransfer.experiments import sweep as sweeps
 from armtransfer.tasks.arms import arm_robot
 from armtransfer.tasks.layout import ROOMS
 
@@ -191,7 +191,7 @@ def test_mount_candidates_script_lists_and_compiles(scara_xml, capsys):
     import importlib.util
     from pathlib import Path
 
-    path = Path(__file__).resolve().parent.parent / "scripts" / "mount_candidates.py"
+    path = Path(__file__).resolve().parent.parent / "research" / "mount_candidates.py"
     spec = importlib.util.spec_from_file_location("mount_candidates", path)
     script = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(script)

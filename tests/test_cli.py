@@ -193,7 +193,7 @@ def test_bench_kernels_fast_mode_times_both_kernels_and_refuses_a_bad_revision()
     import sys
     from pathlib import Path
 
-    script = Path(__file__).resolve().parents[1] / "scripts" / "bench_kernels.py"
+    script = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_kernels.py"
     proc = subprocess.run([sys.executable, str(script), "--fast"], capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert "plain kernel (no guide compiled in): median" in proc.stdout

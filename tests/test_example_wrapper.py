@@ -5,7 +5,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "example_wrapper.py"
+SCRIPT = Path(__file__).resolve().parents[1] / "examples" / "example_wrapper.py"
 
 
 def test_example_wrapper_fast_mode_prints_both_variants_and_the_difference():

@@ -10,7 +10,7 @@ import pytest
 from armtransfer.errors import InvalidParameterError
 from armtransfer.learning import farming, rewards, trajectory
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.learning.experiment import source_trajectory
+from armtransfer.experiments.experiment import source_trajectory
 from armtransfer.tasks.catalog import TABLE_I, custom_task
 from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.tasks.robot import DiscreteRobot

@@ -8,7 +8,8 @@ import pytest
 
 import armtransfer
 from armtransfer.errors import InvalidParameterError
-from armtransfer.learning import experiment, guide, methods, reference, sarsa
+from armtransfer.learning import guide, methods, reference, sarsa
+from armtransfer.experiments import experiment
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import ActionMapping
@@ -413,7 +414,7 @@ def test_the_online_mapping_is_learned_at_first_exposure_and_used_on_the_next_ta
     assert used.extra["macro_states"] > 0 and sum(used.extra["macro_steps_first_episode"]) > 0
 
 
-SCRIPT = __import__("pathlib").Path(__file__).resolve().parents[1] / "scripts" / "first_exposure.py"
+SCRIPT = __import__("pathlib").Path(__file__).resolve().parents[1] / "research" / "first_exposure.py"
 
 
 def test_the_benchmark_script_fast_mode_writes_its_table(tmp_path):

@@ -8,7 +8,7 @@ from armtransfer.cli import main
 from armtransfer.errors import ArmTransferError
 from armtransfer.ik import contract
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.learning.experiment import run_method
+from armtransfer.experiments.experiment import run_method
 from armtransfer.models import ARMS, generate, mjcf
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.generated import generate_arm, read_sidecar

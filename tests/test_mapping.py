@@ -10,7 +10,8 @@ from armtransfer.errors import InvalidMappingError
 from armtransfer.tasks.catalog import table_task
 from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.tasks.layout import ROOMS, Layout
-from armtransfer.learning import experiment, reference, methods, sarsa
+from armtransfer.learning import reference, methods, sarsa
+from armtransfer.experiments import experiment
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import ActionMapping, MacroTable, chain, load_for

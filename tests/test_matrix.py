@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from armtransfer.cli import main
-from armtransfer.learning import matrix
+from armtransfer.experiments import matrix
 
 ARGS = ["--robots", "coarse,fine", "--tasks", "1,2", "--methods", "pseudo", "--trials", "2"]
 

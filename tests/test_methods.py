@@ -5,7 +5,8 @@ import pytest
 
 from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.tasks.layout import Layout
-from armtransfer.learning import controls, experiment, learning_metrics, potentials, methods, rewards, sarsa
+from armtransfer.learning import controls, potentials, methods, rewards, sarsa
+from armtransfer.experiments import experiment, learning_metrics
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.errors import InvalidParameterError

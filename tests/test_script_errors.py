@@ -1,4 +1,4 @@
-"""Every script under scripts/ keeps the command's error contract for bad arguments: one line
+"""Every script (scripts/, examples/, benchmarks/, research/) keeps the command's error contract for bad arguments: one line
 on stderr, exit code 2, no traceback (``armtransfer.script``)."""
 
 import subprocess
@@ -7,12 +7,13 @@ from pathlib import Path
 
 import pytest
 
-SCRIPTS = Path(__file__).resolve().parents[1] / "scripts"
-WITH_OPTIONS = sorted(p.name for p in SCRIPTS.glob("*.py") if "script.parser(" in p.read_text())
+ROOT = Path(__file__).resolve().parents[1]
+ALL = sorted(p for d in ("scripts", "examples", "benchmarks", "research") for p in (ROOT / d).glob("*.py"))
+WITH_OPTIONS = [str(p.relative_to(ROOT)) for p in ALL if "script.parser(" in p.read_text()]
 
 
 def test_every_script_with_options_uses_the_one_line_parser():
-    for path in SCRIPTS.glob("*.py"):
+    for path in ALL:
         text = path.read_text()
         assert "argparse.ArgumentParser(" not in text, f"{path.name} builds its own parser"
     assert len(WITH_OPTIONS) >= 10
@@ -20,16 +21,16 @@ def test_every_script_with_options_uses_the_one_line_parser():
 
 @pytest.mark.parametrize("name", WITH_OPTIONS)
 def test_a_bad_option_is_one_line_and_exit_2(name, tmp_path):
-    proc = subprocess.run([sys.executable, str(SCRIPTS / name), "--no-such-option", "1"], capture_output=True,
+    proc = subprocess.run([sys.executable, str(ROOT / name), "--no-such-option", "1"], capture_output=True,
                           text=True, timeout=120, cwd=tmp_path)
     assert proc.returncode == 2, (proc.stdout[-500:], proc.stderr[-500:])
     lines = proc.stderr.strip().splitlines()
-    assert len(lines) == 1 and f"{name}: error: " in lines[0] and "Traceback" not in proc.stderr
+    assert len(lines) == 1 and f"{Path(name).name}: error: " in lines[0] and "Traceback" not in proc.stderr
     assert list(tmp_path.iterdir()) == []  # nothing written
 
 
 def test_an_unknown_method_to_select_defaults_is_one_line_naming_the_valid_ones(tmp_path):
-    proc = subprocess.run([sys.executable, str(SCRIPTS / "select_defaults.py"), "--method", "guided-tips"],
+    proc = subprocess.run([sys.executable, str(ROOT / "research" / "select_defaults.py"), "--method", "guided-tips"],
                           capture_output=True, text=True, timeout=120, cwd=tmp_path)
     assert proc.returncode == 2 and "Traceback" not in proc.stderr and proc.stdout == ""
     lines = proc.stderr.strip().splitlines()
@@ -62,7 +63,7 @@ def test_a_reader_that_stops_reading_ends_the_command_quietly(tmp_path):
 
 
 def test_every_script_ends_through_the_quiet_exit():
-    for path in SCRIPTS.glob("*.py"):
+    for path in ALL:
         text = path.read_text()
         if '__name__ == "__main__"' in text:
             assert "script.exit_with(" in text.split('__name__ == "__main__"')[1], path.name

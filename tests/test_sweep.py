@@ -11,12 +11,12 @@ from pathlib import Path
 import pytest
 
 from armtransfer.cli import main
-from armtransfer.execute import execute
-from armtransfer.executors import run_local
+from armtransfer.experiments.execute import execute
+from armtransfer.experiments.executors import run_local
 from armtransfer.tasks.grid_robots import grid_robot
-from armtransfer.learning import sweep as sweeps
-from armtransfer.learning.store import ResultStore
-from armtransfer.learning.summary import summarize
+from armtransfer.experiments import sweep as sweeps
+from armtransfer.experiments.store import ResultStore
+from armtransfer.experiments.summary import summarize
 
 SWEEP = """
 [sweep]
@@ -181,7 +181,7 @@ def test_ray_executor_without_ray_says_how_to_install_it(sweep_file, tmp_path, c
     assert not (tmp_path / "o").exists()
 
 
-@pytest.mark.parametrize("path", sorted((Path(__file__).resolve().parents[1] / "scripts" / "sweeps").glob("*.toml")),
+@pytest.mark.parametrize("path", sorted((Path(__file__).resolve().parents[1] / "examples" / "sweeps").glob("*.toml")),
                          ids=lambda p: p.name)
 def test_every_example_sweep_file_is_valid(path):
     sw = sweeps.load(path)

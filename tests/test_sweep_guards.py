@@ -11,8 +11,8 @@ from pathlib import Path
 import pytest
 
 from armtransfer.cli import main
-from armtransfer.learning import sweep as sweeps
-from armtransfer.learning.store import ResultStore
+from armtransfer.experiments import sweep as sweeps
+from armtransfer.experiments.store import ResultStore
 
 GOOD = """[sweep]
 name = "guards"

@@ -6,7 +6,7 @@ import pytest
 
 from armtransfer import cpus
 from armtransfer.errors import InvalidParameterError
-from armtransfer.learning import experiment
+from armtransfer.experiments import experiment
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.grid_robots import grid_robot

@@ -14,8 +14,8 @@ from armtransfer.commands import common
 from armtransfer.commands.sweep import add_executor_arguments, run_sweep
 from armtransfer.errors import InvalidParameterError
 from armtransfer.io import write_bytes_atomic, write_json_atomic, write_text_atomic
-from armtransfer.learning import matrix
-from armtransfer.learning.store import ResultStore
+from armtransfer.experiments import matrix
+from armtransfer.experiments.store import ResultStore
 
 HELP = "Run every ordered source -> target pair of the robots (a robot to itself too) and draw the matrix."
 
@@ -92,6 +92,6 @@ def write_summary(store: ResultStore, out: Path) -> str:
 
 
 def store_runs(spec: dict) -> list[dict]:
-    from armtransfer.learning import sweep as sweeps
+    from armtransfer.experiments import sweep as sweeps
 
     return sweeps.expand(spec)

@@ -13,9 +13,9 @@ from pathlib import Path
 
 from armtransfer.commands import common
 from armtransfer.io import check_output_dir, staged_directory, write_json_atomic, write_text_atomic
-from armtransfer.learning import beyond, figures
-from armtransfer.learning import reproduce as rep
-from armtransfer.learning import reproduce_report as rr
+from armtransfer.experiments import beyond, figures
+from armtransfer.experiments import reproduce as rep
+from armtransfer.experiments import reproduce_report as rr
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import ActionMapping
 from armtransfer.tasks.catalog import TABLE_I

@@ -7,7 +7,7 @@ import argparse
 from armtransfer import api
 from armtransfer.commands import common
 from armtransfer.io import check_writable, write_json_atomic
-from armtransfer.learning import experiment, report
+from armtransfer.experiments import experiment, report
 
 HELP = "Transfer a trajectory from one grid robot to another in the rooms world (Table II style)."
 

@@ -6,8 +6,8 @@ import argparse
 from pathlib import Path
 
 from armtransfer.io import write_json_atomic, write_text_atomic
-from armtransfer.learning.store import ResultStore
-from armtransfer.learning.summary import plot, summarize, summary_markdown
+from armtransfer.experiments.store import ResultStore
+from armtransfer.experiments.summary import plot, summarize, summary_markdown
 
 HELP = "Summarize a sweep directory: summary.md, summary.json and summary.png."
 
@@ -30,7 +30,7 @@ def run(args: argparse.Namespace) -> int:
     write_text_atomic(out / "summary.md", f"# Sweep {store.meta['name']!r}\n\n{len(records)} finished runs, "
                       f"{len(failures)} failed.\n\n{text}\n")
     print(text)
-    from armtransfer.learning.matrix import is_matrix
+    from armtransfer.experiments.matrix import is_matrix
 
     if is_matrix(store.meta["spec"]):
         from armtransfer.commands.matrix import write_summary

@@ -6,19 +6,19 @@ import argparse
 import os
 
 from armtransfer.commands import common
-from armtransfer.execute import robot_specs
+from armtransfer.experiments.execute import robot_specs
 from armtransfer.tasks.catalog import custom_task
-from armtransfer.executors import _check_reachable, _import_ray, run_local, run_ray
+from armtransfer.experiments.executors import _check_reachable, _import_ray, run_local, run_ray
 from armtransfer.tasks.specs import resolve
-from armtransfer.learning import sweep as sweeps
+from armtransfer.experiments import sweep as sweeps
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.learning.store import ResultStore
+from armtransfer.experiments.store import ResultStore
 
 HELP = "Run a sweep file (TOML) into --out; re-running resumes, skipping finished runs."
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("sweep_file", metavar="SWEEP.toml", help="the sweep (see scripts/sweeps/)")
+    p.add_argument("sweep_file", metavar="SWEEP.toml", help="the sweep (see examples/sweeps/)")
     p.add_argument("--out", required=True, help="result store directory")
     p.add_argument("--max-runs", type=common.positive_int, default=sweeps.MAX_RUNS,
                    help=f"refuse a sweep with more runs than this (default {sweeps.MAX_RUNS:,})")

@@ -1,0 +1,56 @@
+"""Run one sweep run: build its task, trajectory and learner, return a JSON-able result.
+
+Robots come in already built (``robots`` maps a spec like ``"fine"`` or
+``"planar2:joint"`` to a ``DiscreteRobot``), so an executor can build each robot once
+and share it with every worker.
+"""
+
+from __future__ import annotations
+
+import time
+
+from armtransfer.tasks.catalog import custom_task
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.learning import methods
+from armtransfer.experiments import experiment
+from armtransfer.learning.config import LearnerConfig
+
+
+def learner_config(run: dict) -> LearnerConfig:
+    """The learner settings a sweep run carries (every LearnerConfig field it names)."""
+    return LearnerConfig.from_options({k: run[k] for k in LearnerConfig.options() if k in run})
+
+
+def robot_specs(runs: list[dict]) -> list[str]:
+    """The distinct robots a list of runs needs, in first-seen order."""
+    seen: dict[str, None] = {}
+    for run in runs:
+        seen.setdefault(run["source"], None)
+        seen.setdefault(run["target"], None)
+    return list(seen)
+
+
+def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
+    """(result, seconds) of one run."""
+    t0 = time.perf_counter()
+    task = custom_task(tuple(run["start"]), tuple(run["goal"]))
+    start, goal = task.cells()
+    source, target = robots[run["source"]], robots[run["target"]]
+    config = learner_config(run)
+    traj = None
+    if methods.get(run["method"]).shaped:
+        traj = experiment.source_trajectory(run["trajectory"], source, start, goal, config, run["seed"])
+    res = experiment.run_method(
+        run["method"], target, start, goal, traj, run["trials"], run["seed"], config,
+        wind=run["wind"], K=run["K"],
+    )
+    result = {
+        "exploration_steps": res.column("exploration_steps"),
+        "total_steps": res.column("total_steps"),
+        "greedy_steps": res.column("greedy_steps"),
+        "converged": res.column("converged"),
+        "episodes": res.column("episodes"),
+        "K": res.extra.get("K"),
+        "trajectory_length": None if traj is None else len(traj),
+    }
+    return result, time.perf_counter() - t0

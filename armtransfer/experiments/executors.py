@@ -1,0 +1,225 @@
+"""Where sweep runs execute: a local process pool, or Ray (a cluster or a local instance).
+
+Both executors hand finished runs back to the driver, which alone writes the store, so
+a run is recorded exactly once. A run whose worker crashes (or is killed) is retried up to
+``retries`` more times, then recorded as failed; it is never lost silently.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+from collections.abc import Callable
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+
+from armtransfer.experiments.execute import execute
+from armtransfer.errors import ArmTransferError
+from armtransfer.cpus import ENV as CPUS_ENV
+from armtransfer.tasks.robot import DiscreteRobot
+
+Done = Callable[[dict, dict, float], None]  # (run, result, seconds)
+Failed = Callable[[dict, str, int], None]  # (run, error, attempts)
+
+
+class ExecutorError(ArmTransferError):
+    """An executor cannot start (e.g. Ray is not installed or unreachable)."""
+
+
+def _worker_init() -> None:
+    # one thread per worker process: the workers are the parallelism
+    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS", CPUS_ENV):
+        os.environ.setdefault(var, "1")
+    _die_with_parent()
+
+
+def _execute_in_ray(run: dict, robots):
+    """``execute`` in a Ray worker, its trials on one thread: Ray's tasks are the parallelism."""
+    os.environ.setdefault(CPUS_ENV, "1")
+    return execute(run, robots)
+
+
+def _die_with_parent() -> None:
+    """A worker ends when the sweep that started it is killed (even by SIGKILL), instead of
+    living on as an orphan: Linux's PR_SET_PDEATHSIG sends it SIGTERM when its parent dies.
+    Elsewhere a thread watches the parent's pid and ends the worker."""
+    parent = os.getppid()
+    try:
+        import ctypes
+        import signal
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        PR_SET_PDEATHSIG = 1
+        if libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGTERM), 0, 0, 0) == 0:
+            if os.getppid() != parent:  # the parent died before the call
+                os._exit(1)
+            return
+    except (OSError, AttributeError):
+        pass
+    import threading
+    import time
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(1.0)
+        os._exit(1)
+
+    threading.Thread(target=watch, daemon=True).start()
+
+
+def run_local(
+    runs: list[dict], robots: dict[str, DiscreteRobot], workers: int, on_done: Done, on_failed: Failed,
+    retries: int = 2, fn: Callable = execute,
+) -> None:
+    """A process pool over this machine's cores.
+
+    At most ``workers`` runs are in flight, so when a worker dies the runs that may have
+    killed it are known: each of them is then retried alone in a fresh one-worker pool,
+    where a crash is its own, and counted against it (up to ``retries`` retries).
+    ``fn(run, robots) -> (result, seconds)`` is what a worker runs (tests inject faults here).
+    """
+    ctx = multiprocessing.get_context("spawn")
+    queue = list(runs)
+    suspects: list[dict] = []
+    attempts = {r["key"]: 0 for r in runs}
+
+    def finish(fut, run) -> bool:
+        """Report a finished future; False when its pool broke."""
+        try:
+            result, secs = fut.result()
+        except BrokenProcessPool:
+            return False
+        except ArmTransferError as err:
+            on_failed(run, str(err), attempts[run["key"]] + 1)
+        except Exception as err:  # noqa: BLE001 - recorded, not lost
+            on_failed(run, f"{type(err).__name__}: {err}", attempts[run["key"]] + 1)
+        else:
+            on_done(run, result, secs)
+        return True
+
+    while queue or suspects:
+        if suspects:
+            run = suspects.pop(0)
+            with ProcessPoolExecutor(max_workers=1, mp_context=ctx, initializer=_worker_init) as pool:
+                fut = pool.submit(fn, run, _robots_for([run], robots))
+                wait([fut])
+                if not finish(fut, run):
+                    attempts[run["key"]] += 1
+                    if attempts[run["key"]] > retries:
+                        on_failed(run, "worker process died", attempts[run["key"]])
+                    else:
+                        suspects.append(run)
+            continue
+        with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init) as pool:
+            shared = _robots_for(queue, robots)
+            in_flight: dict = {}
+            while queue or in_flight:
+                while queue and len(in_flight) < workers:
+                    run = queue.pop(0)
+                    in_flight[pool.submit(fn, run, shared)] = run
+                finished, _ = wait(list(in_flight), return_when=FIRST_COMPLETED)
+                broken = False
+                for fut in finished:
+                    run = in_flight.pop(fut)
+                    if not finish(fut, run):
+                        broken = True
+                        suspects.append(run)
+                if broken:  # every run still in flight may be the culprit
+                    suspects.extend(in_flight.values())
+                    break
+
+
+def _robots_for(runs: list[dict], robots: dict[str, DiscreteRobot]) -> dict[str, DiscreteRobot]:
+    needed = {r["source"] for r in runs} | {r["target"] for r in runs}
+    return {k: v for k, v in robots.items() if k in needed}
+
+
+def _import_ray():
+    try:
+        import ray
+    except ImportError:
+        raise ExecutorError(
+            "--executor ray needs Ray: pip install -e \".[cluster]\" (or pip install ray)"
+        ) from None
+    return ray
+
+
+RAY_CONNECT_TIMEOUT = 10.0
+"""Seconds to wait for a Ray address to answer before saying it cannot be reached."""
+
+
+def _check_reachable(address: str) -> None:
+    """Fail in one line within ``RAY_CONNECT_TIMEOUT`` when nothing answers at ``address``
+    (``host:port`` or ``ray://host:port``); ``ray.init`` alone would retry for minutes."""
+    if address == "auto":
+        return
+    target = address.split("://", 1)[-1]
+    host, _, port = target.rpartition(":")
+    try:
+        port_number = int(port)
+    except ValueError:
+        raise ExecutorError(f"a Ray address is HOST:PORT or ray://HOST:PORT, got {address!r}") from None
+    import socket
+
+    try:
+        with socket.create_connection((host or "127.0.0.1", port_number), timeout=RAY_CONNECT_TIMEOUT):
+            pass
+    except OSError as err:
+        raise ExecutorError(f"cannot reach Ray at {address!r}: {err.strerror or err}") from None
+
+
+def run_ray(
+    runs: list[dict], robots: dict[str, DiscreteRobot], workers: int | None, address: str | None,
+    on_done: Done, on_failed: Failed, retries: int = 2,
+) -> None:
+    """Ray tasks on the cluster at ``address``, or on a local instance with ``workers`` CPUs.
+
+    Each robot is put in Ray's object store once and shared by every task that needs it."""
+    ray = _import_ray()
+    started_here = False
+    if not ray.is_initialized():
+        try:
+            if address:
+                _check_reachable(address)
+                ray.init(address=address, log_to_driver=False, configure_logging=False)
+            else:
+                ray.init(num_cpus=workers or os.cpu_count(), include_dashboard=False,
+                         log_to_driver=False, configure_logging=False)
+        except Exception as err:  # noqa: BLE001 - one line for the user
+            raise ExecutorError(f"cannot start or reach Ray ({address or 'local'}): {err}".splitlines()[0]) from None
+        started_here = True
+    try:
+        remote_execute = ray.remote(max_retries=retries, retry_exceptions=False)(_execute_in_ray)
+        refs = {spec: ray.put(robot) for spec, robot in robots.items()}
+        futures = {}
+        for run in runs:
+            needed = {run["source"]: refs[run["source"]], run["target"]: refs[run["target"]]}
+            futures[remote_execute.remote(run, _RobotRefs(needed))] = run
+        not_done = list(futures)
+        while not_done:
+            finished, not_done = ray.wait(not_done, num_returns=1)
+            for ref in finished:
+                run = futures[ref]
+                try:
+                    result, secs = ray.get(ref)
+                except Exception as err:  # noqa: BLE001 - recorded, not lost
+                    cause = getattr(err, "cause", None) or err
+                    on_failed(run, f"{type(cause).__name__}: {cause}".splitlines()[0], retries + 1)
+                    continue
+                on_done(run, result, secs)
+    finally:
+        if started_here:
+            ray.shutdown()
+
+
+class _RobotRefs(dict):
+    """A dict of robot ObjectRefs that a Ray worker resolves on first access."""
+
+    def __getitem__(self, key):
+        value = super().__getitem__(key)
+        if not isinstance(value, DiscreteRobot):
+            import ray
+
+            value = ray.get(value)
+            super().__setitem__(key, value)
+        return value

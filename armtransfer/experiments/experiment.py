@@ -1,0 +1,453 @@
+"""One transfer experiment: a source trajectory, a target robot, methods x trials.
+
+Every trial of every method gets its own generator from ``SeedSequence([seed, trial])``,
+so the methods meet the same random streams trial by trial (paired comparison) and the
+same seed gives the same result, bit for bit, however many threads run the trials.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor, as_completed
+from dataclasses import dataclass, field
+from typing import TypeVar
+
+import numpy as np
+
+from armtransfer.cpus import cpus as _cpus
+from armtransfer.errors import InvalidParameterError
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.learning import controls, farming, methods, potentials, sarsa
+from armtransfer.experiments import metrics
+from armtransfer.learning.controls import CONTROLS
+from armtransfer.learning import trajectory as trajectories
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.mapping import DEFAULT_MAX_SPAN, ActionMapping, MacroTable
+from armtransfer.learning.trajectory import Trajectory
+
+T = TypeVar("T")
+SHAPING_METHODS = methods.SHAPED
+METHODS = tuple(methods.METHODS)
+"""Every method's name, from the registry ``armtransfer.learning.methods``."""
+
+
+def trial_threads() -> int:
+    """Threads the trials of one method run on: ``armtransfer.cpus.cpus()``
+    (``$ARMTRANSFER_CPUS``, else the CPUs this process may use). The learner's kernel releases
+    the GIL, and every trial has its own generator and arrays, so the results are the same,
+    bit for bit, for any number."""
+    return _cpus()
+
+
+def map_trials(one: Callable[[int], T], trials: int, threads: int | None = None,
+               on_trial: Callable[[], None] | None = None) -> list[T]:
+    """``[one(0), ..., one(trials - 1)]``, computed on ``threads`` threads (None:
+    :func:`trial_threads`). ``one(k)`` must depend on k alone (its own generator, its own
+    arrays), so that the list is the same for any number of threads. ``on_trial`` is called
+    once per finished trial, on this thread. The first error, in trial order, is raised, and
+    no trial starts after an error or Ctrl-C (those running finish first)."""
+    threads = min(trial_threads() if threads is None else int(threads), trials)
+    if trials < 1 or threads < 1:
+        raise InvalidParameterError(f"trials and threads must be positive integers, got {trials} and {threads}")
+    if threads == 1:
+        out = []
+        for trial in range(trials):
+            out.append(one(trial))
+            if on_trial is not None:
+                on_trial()
+        return out
+    with ThreadPoolExecutor(max_workers=threads, thread_name_prefix="trial") as pool:
+        futures = [pool.submit(one, trial) for trial in range(trials)]
+        try:
+            for _ in as_completed(futures):
+                if on_trial is not None:
+                    on_trial()
+            return [f.result() for f in futures]
+        except BaseException:
+            for f in futures:
+                f.cancel()
+            raise
+
+
+def trial_rng(seed: int, trial: int, stream: int = 0) -> np.random.Generator:
+    """The generator of one trial (``stream`` separates e.g. the source robot's learning)."""
+    return np.random.default_rng(np.random.SeedSequence([int(seed), int(stream), int(trial)]))
+
+
+def source_trajectory(
+    kind: str,
+    source: DiscreteRobot,
+    start_cell: int,
+    goal_cell: int,
+    config: LearnerConfig,
+    seed: int,
+) -> Trajectory:
+    """``optimal`` (breadth-first shortest path) or ``learned`` (the source robot's
+    converged greedy path after SARSA(lambda) without transfer)."""
+    if kind == "optimal":
+        return trajectories.shortest(source, start_cell, goal_cell)
+    if kind == "learned":
+        res = sarsa.learn(source, source.start_state(start_cell), goal_cell, config, trial_rng(seed, 0, stream=1))
+        if not res.converged:
+            raise InvalidParameterError(
+                f"the source robot {source.name} did not converge on a path in "
+                f"{config.max_episodes} episodes; use --trajectory optimal"
+            )
+        return trajectories.from_path(source, res.greedy_path)
+    raise InvalidParameterError(f"unknown trajectory kind {kind!r}; valid: optimal, learned, or a JSON path")
+
+
+@dataclass
+class MethodResult:
+    """Every trial of one method on one task; ``control`` names the control trajectory the
+    method was given instead of the real one (None: the real trajectory)."""
+
+    method: str
+    trials: list[sarsa.TrialResult] = field(default_factory=list)
+    extra: dict = field(default_factory=dict)
+    control: str | None = None
+
+    @property
+    def label(self) -> str:
+        """How tables name it: ``dense``, or ``dense [shuffled]`` for a control."""
+        return self.method if self.control is None else f"{self.method} [{self.control}]"
+
+    def column(self, name: str) -> list:
+        return [getattr(t, name) for t in self.trials]
+
+
+def run_method(
+    method: str,
+    target: DiscreteRobot,
+    start_cell: int,
+    goal_cell: int,
+    traj: Trajectory | Sequence[Trajectory] | None,
+    trials: int,
+    seed: int,
+    config: LearnerConfig,
+    wind: float = 0.0,
+    K: float | str | None = "auto",
+    macros=None,
+    on_trial: Callable[[], None] | None = None,
+    beta: float = potentials.DENSE_BETA,
+    control: str | None = None,
+    threads: int | None = None,
+) -> MethodResult:
+    """``trials`` independent trials of one method on the target robot, on ``threads``
+    threads (None: :func:`trial_threads`); the results do not depend on how many."""
+    if trials < 1:
+        raise InvalidParameterError(f"trials must be a positive integer, got {trials}")
+    start_state = target.start_state(start_cell)
+    m = methods.get(method)
+
+    def shaping_for(trajs):
+        if not m.shaped:
+            return None
+        if trajs is None:
+            raise InvalidParameterError(f"method {method!r} needs a trajectory")
+        k = K
+        if m.farmable:  # the exact check: value iteration over this task ('auto' comes out verified)
+            k = farming.check_k(method, target, start_state, goal_cell, trajs, K, config, wind)
+        return methods.build_shaping(method, target, trajs, k, config.step_reward, beta=beta)
+
+    out = MethodResult(method, control=control)
+    if callable(traj):  # each trial its own trajectories (the controls: one draw per trial)
+        shapings: list = [None] * trials
+
+        def one(trial: int):
+            shapings[trial] = sh = shaping_for(traj(trial))
+            return sarsa.learn(target, start_state, goal_cell, config, trial_rng(seed, trial),
+                               shaping=sh, wind=wind, macros=macros)
+
+        out.trials = map_trials(one, trials, threads, on_trial)
+        if m.shaped:
+            out.extra["K"] = [sh.K for sh in shapings]
+        return out
+    shaping = shaping_for(traj)
+    out.trials = map_trials(lambda trial: sarsa.learn(target, start_state, goal_cell, config, trial_rng(seed, trial),
+                                                      shaping=shaping, wind=wind, macros=macros),
+                            trials, threads, on_trial)
+    if shaping is not None:
+        out.extra["K"] = shaping.K
+    return out
+
+
+def run_control(
+    method: str,
+    kind: str,
+    source: DiscreteRobot,
+    target: DiscreteRobot,
+    start_cell: int,
+    goal_cell: int,
+    trajs: Sequence[Trajectory],
+    trials: int,
+    seed: int,
+    config: LearnerConfig,
+    keep_goal: bool = False,
+    **kw,
+) -> MethodResult:
+    """``trials`` trials of a method given ``kind`` control trajectories in place of ``trajs``:
+    each trial draws its own (:func:`control_trajectories` with ``trial``), so the mean is over
+    the control's randomness too, not over one draw. ``keep_goal``: the ablation that keeps the
+    task's goal (labelled ``kind, goal kept``). ``kw`` goes to :func:`run_method`."""
+    if kind not in CONTROLS:
+        raise InvalidParameterError(f"unknown control {kind!r}; valid: {', '.join(CONTROLS)}")
+    return run_method(method, target, start_cell, goal_cell,
+                      lambda trial: control_trajectories(kind, source, trajs, seed, keep_goal, trial),
+                      trials, seed, config, control=controls.label(kind, keep_goal), **kw)
+
+
+def run_mapping(
+    target: DiscreteRobot,
+    start_cell: int,
+    goal_cell: int,
+    traj: Trajectory,
+    mapping: ActionMapping,
+    trials: int,
+    seed: int,
+    config: LearnerConfig,
+    wind: float = 0.0,
+    K: float | str | None = "auto",
+    on_trial: Callable[[], None] | None = None,
+    max_span: int = DEFAULT_MAX_SPAN,
+) -> tuple[MethodResult, ActionMapping]:
+    """Method ``mapping``: pseudo rewards plus the macros ``mapping`` gives on ``traj``.
+
+    Every trial uses ``mapping`` as given (the mappings of earlier tasks only), so trials
+    stay independent and deterministic. Returns the result, with ``mapped_fraction`` per
+    trial in ``extra``, and a new mapping: ``mapping`` plus what each converged trial's
+    greedy path teaches, added in trial order.
+    """
+    table = MacroTable(mapping, traj, target)
+    res = run_method(
+        "mapping", target, start_cell, goal_cell, traj, trials, seed, config,
+        wind=wind, K=K, macros=table if len(table) else None, on_trial=on_trial,
+    )
+    learned = mapping.copy()
+    learned.learned_on(start_cell, goal_cell)
+    fractions = []
+    for t in res.trials:
+        fractions.append(table.mapped_fraction(target, t.greedy_path) if t.converged else None)
+        if t.converged:
+            learned.learn_from(target, t.greedy_path, traj, max_span)
+    res.extra.update(
+        mapped_fraction=fractions,
+        macro_states=len(table),
+        macro_steps_first_episode=[int(t.macro_steps[0]) if len(t.macro_steps) else 0 for t in res.trials],
+        mapping_entries_used=len(mapping),
+    )
+    return res, learned
+
+
+def online_mapping(
+    source: DiscreteRobot,
+    target: DiscreteRobot,
+    start_cell: int,
+    goal_cell: int,
+    result: MethodResult,
+    traj: Trajectory,
+    mapping: ActionMapping | None = None,
+    max_span: int = DEFAULT_MAX_SPAN,
+) -> ActionMapping:
+    """The action sequence mapping learned *during* a task: ``mapping`` (default: empty) plus
+    what each trial's first exposure teaches, in trial order. A trial's first-episode path,
+    its loops erased (``sarsa.TrialResult.first_path``), is set beside ``traj`` as a converged
+    greedy path would be (``mapping.observe``: matched cells, the shorter target sequence wins),
+    so the mapping exists as soon as the goal is first reached, before any trial converges,
+    and the method ``mapping`` can use it on the next task at once."""
+    learned = ActionMapping.for_robots(source, target) if mapping is None else mapping.copy()
+    learned.learned_on(start_cell, goal_cell)
+    for t in result.trials:
+        if t.first_path:
+            learned.learn_from(target, t.first_path, traj, max_span)
+    return learned
+
+
+def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int | None = None) -> dict:
+    """The JSON ``results`` block: per method, per-trial lists, means, CIs, improvement.
+
+    Exploration statistics count every trial (``metrics.exploration_stats``): one that never
+    reached the goal counts at the step cap, ``cap`` (default: the steps its first episode
+    ran before the cap stopped it, i.e. ``config.max_total_steps``), and the mean is then
+    flagged as a lower bound. Improvements are paired (common random numbers,
+    ``trial_rng``) when the baseline has as many trials, else independent."""
+
+    def cap_of(r: MethodResult) -> int:
+        if cap is not None:
+            return int(cap)
+        stopped = [abs(int(t.episode_steps[0])) for t in r.trials
+                   if t.exploration_steps is None and len(t.episode_steps)]
+        return max(stopped, default=0)
+
+    by_name = {r.label: r for r in results}
+    base = by_name.get(baseline)
+    base_ex = base.column("exploration_steps") if base else None
+    out: dict = {}
+    for r in results:
+        ex = r.column("exploration_steps")
+        c = max(cap_of(r), cap_of(base) if base else 0)
+        st = metrics.exploration_stats(ex, c)
+        total = r.column("total_steps")
+        greedy = r.column("greedy_steps")
+        t_mean, t_ci = metrics.mean_ci(total)
+        g_mean, g_ci = metrics.mean_ci(greedy)
+        imp = None
+        if r.label != baseline and base is not None:
+            imp = metrics.paired_improvement(base_ex, ex, c, paired=len(base_ex) == len(ex))
+        entry = {
+            "exploration_steps": ex,
+            "mean": st["mean"],
+            "ci95": st["ci95"],
+            "reached": st["reached"],
+            "cap": c or None,
+            "mean_is_lower_bound": st["mean_is_lower_bound"],
+            "median": st["median"],
+            "median_ci95": st["median_ci95"],
+            "median_ci_coverage": st["median_ci_coverage"],
+            "median_is_lower_bound": st["median_is_lower_bound"],
+            "improvement_percent": None if imp is None else imp["percent"],
+            "improvement_ci95": None if imp is None else imp["ci95"],
+            "improvement_design": None if imp is None else imp["design"],
+            "greedy_steps": greedy,
+            "greedy_mean": g_mean,
+            "greedy_ci95": g_ci,
+            "total_steps": total,
+            "total_mean": t_mean,
+            "total_ci95": t_ci,
+            "converged": r.column("converged"),
+            "episodes": r.column("episodes"),
+            "episode_steps": [t.episode_steps.tolist() for t in r.trials],
+            "greedy_path_states": [[int(s) for s, _ in t.greedy_path] for t in r.trials],
+        }
+        entry.update(r.extra)
+        out[r.label] = entry
+    return out
+
+
+BULKY = ("episode_steps", "greedy_path_states")
+"""Per-trial lists in a summary entry that a report's JSON can do without."""
+
+
+def compact(entry: dict) -> dict:
+    """Drop an entry's per-episode and per-path lists (and per-trial transfer metrics), keeping
+    every per-trial number the tables use; ``rooms --json`` and ``arms`` keep everything."""
+    for key in BULKY:
+        entry.pop(key, None)
+    for m in entry.get("transfer_metrics", {}).values():
+        if isinstance(m, dict):
+            m.pop("per_trial", None)
+    return entry
+
+
+def control_trajectories(
+    kind: str, source: DiscreteRobot, trajs: Sequence[Trajectory], seed: int, keep_goal: bool = False,
+    trial: int | None = None,
+) -> list[Trajectory]:
+    """``shuffled`` or ``random`` stand-ins for the real trajectories, seeded by ``seed`` (and
+    ``trial``: one draw per trial, see :func:`run_control`); with ``keep_goal`` they keep the
+    task's goal (an ablation, see :mod:`controls`) and are otherwise the same cells and actions."""
+    key = [int(seed), 2, CONTROLS.index(kind)] + ([] if trial is None else [int(trial)])
+    rng = np.random.default_rng(np.random.SeedSequence(key))
+    if kind == "shuffled":
+        return [controls.shuffled(t, rng, keep_goal) for t in trajs]
+    return [controls.random_walk(source, t, rng, keep_goal) for t in trajs]
+
+
+def add_transfer_metrics(summary: dict, optimal: int, baseline: str = "none") -> None:
+    """Add Taylor and Stone's metrics (``transfer.learning_metrics``) to every method."""
+    from armtransfer.experiments import learning_metrics as lm
+
+    base = summary.get(baseline)
+    if base is None:
+        return
+    ref_first, ref_area = lm.baseline_reference(list(zip(base["episode_steps"], base["greedy_steps"])))
+    for entry in summary.values():
+        per_trial = [
+            lm.trial_metrics(ep, g, optimal, ref_first, ref_area)
+            for ep, g in zip(entry["episode_steps"], entry["greedy_steps"])
+        ]
+        block = {}
+        for name in ("jumpstart", "time_to_threshold", "area", "transfer_ratio", "asymptotic"):
+            values = [m[name] for m in per_trial]
+            mean, ci = metrics.mean_ci(values)
+            block[name] = {"per_trial": values, "mean": mean, "ci95": ci}
+        block["threshold"] = f"episode <= {lm.THRESHOLD:g} x optimal ({optimal})"
+        block["horizon_episodes"] = lm.HORIZON
+        entry["transfer_metrics"] = block
+
+
+def run_all(
+    source: DiscreteRobot,
+    target: DiscreteRobot,
+    start_cell: int,
+    goal_cell: int,
+    method_names: Sequence[str],
+    trajs: Sequence[Trajectory],
+    trials: int,
+    seed: int,
+    config: LearnerConfig,
+    wind: float = 0.0,
+    K: float | str | None | dict = "auto",
+    beta: float = potentials.DENSE_BETA,
+    mapping: ActionMapping | None = None,
+    max_span: int = DEFAULT_MAX_SPAN,
+    controls: bool = True,
+    tick: Callable[[], None] | None = None,
+) -> tuple[list[MethodResult], ActionMapping | None]:
+    """Every method on one task, then (``controls``) every reward-only method again with each
+    control trajectory. ``K`` is one K for every method or a dict of K per method. Returns the results in that order and, for ``mapping``, the mapping
+    updated from this task's converged trials."""
+    chosen = [methods.get(m) for m in method_names]
+    if any(m.shaped for m in chosen) and not trajs:
+        raise InvalidParameterError("the transfer methods need a trajectory")
+    if any(m.macros for m in chosen) and len(trajs) != 1:
+        raise InvalidParameterError("method 'mapping' takes exactly one trajectory")
+    results: list[MethodResult] = []
+    learned = None
+
+    def k_of(name: str):
+        return K.get(name, "auto") if isinstance(K, dict) else K
+
+    for m in chosen:
+        kw = dict(wind=wind, K=k_of(m.name), on_trial=tick)
+        if m.macros:
+            if mapping is None:
+                mapping = ActionMapping.for_robots(source, target)
+            res, learned = run_mapping(target, start_cell, goal_cell, trajs[0], mapping, trials, seed,
+                                       config, max_span=max_span, **kw)
+            results.append(res)
+        else:
+            results.append(run_method(m.name, target, start_cell, goal_cell, trajs if m.shaped else None,
+                                      trials, seed, config, beta=beta, **kw))
+    if controls:
+        for kind in CONTROLS:
+            for m in chosen:
+                if m.name in SHAPING_METHODS:  # the same K as the real trajectory's
+                    results.append(run_control(m.name, kind, source, target, start_cell, goal_cell, trajs, trials,
+                                               seed, config, beta=beta, wind=wind, K=k_of(m.name), on_trial=tick))
+    return results, learned
+
+
+def summary_of(results: Sequence[MethodResult], target: DiscreteRobot, start_cell: int, goal_cell: int) -> dict:
+    """The ``summarize`` block of ``results`` (keyed by label), with the transfer metrics."""
+    labels = [r.label for r in results]
+    summary = summarize(results, baseline="none" if "none" in labels else "")
+    path = target.shortest_path(target.start_state(start_cell), goal_cell)
+    if path is not None:
+        add_transfer_metrics(summary, len(path) - 1)
+    return summary
+
+
+def run_transfer(
+    source: DiscreteRobot, target: DiscreteRobot, start_cell: int, goal_cell: int, *args, **kwargs
+) -> tuple[dict, ActionMapping | None]:
+    """:func:`run_all`, summarised by label (``dense``, ``dense [shuffled]``, ...), for reports
+    that tabulate every run side by side. Returns the summary and the updated mapping."""
+    results, learned = run_all(source, target, start_cell, goal_cell, *args, **kwargs)
+    return summary_of(results, target, start_cell, goal_cell), learned
+
+
+def count_trials(method_names: Sequence[str], trials: int, controls: bool) -> int:
+    """How many trials ``run_transfer`` runs (for progress bars)."""
+    shaped = sum(m in SHAPING_METHODS for m in method_names)
+    return trials * (len(method_names) + (len(CONTROLS) * shaped if controls else 0))

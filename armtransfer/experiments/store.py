@@ -1,0 +1,203 @@
+"""A result store that loses nothing: one JSON file per finished run, written atomically.
+
+    DIR/sweep.json          the sweep this directory belongs to (its normalised spec and key)
+    DIR/runs/<key>.json     one finished run: its full configuration and its result
+    DIR/failed/<key>.json   a run that failed every attempt, with the error
+
+A run file appears only by ``os.replace`` of a complete temporary file, so after a crash
+(even ``kill -9``) every run file present is whole, and a run without one is simply not
+done. Temporary files a crash leaves behind start with '.' and are removed on open.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import os
+import sys
+from pathlib import Path
+
+from armtransfer.errors import ArmTransferError
+from armtransfer.io import OutputError, parse_json_bytes, write_json_atomic
+from armtransfer.experiments.sweep import Sweep
+
+STORE_FORMAT = "armtransfer-store/1"
+LOCK = ".lock"
+
+
+class StoreError(ArmTransferError):
+    """The output directory cannot hold this sweep."""
+
+
+class ResultStore:
+    def __init__(self, root: str | os.PathLike) -> None:
+        self.root = Path(root)
+        self.runs_dir = self.root / "runs"
+        self.failed_dir = self.root / "failed"
+
+    # -- opening -----------------------------------------------------------------------
+    @classmethod
+    def open_for(cls, root: str | os.PathLike, sweep: Sweep) -> "ResultStore":
+        """Open ``root`` for ``sweep``: create it, or resume it if it holds the same sweep."""
+        store = cls(root)
+        meta_path = store.root / "sweep.json"
+        if store.root.exists() and not store.root.is_dir():
+            raise StoreError(f"output {str(store.root)!r} exists and is not a directory")
+        if meta_path.exists():
+            meta = store._read_meta()
+            if meta.get("key") != sweep.key:
+                raise StoreError(
+                    f"output directory {str(store.root)!r} holds another sweep "
+                    f"({meta.get('name')!r}); choose a new --out"
+                )
+        elif store.root.exists() and any(p.name != LOCK for p in store.root.iterdir()):
+            raise StoreError(
+                f"output directory {str(store.root)!r} is not empty and holds no sweep; choose a new --out"
+            )
+        store.lock()
+        if not meta_path.exists():
+            write_json_atomic(meta_path, {"format": STORE_FORMAT, "name": sweep.name, "key": sweep.key,
+                                          "spec": sweep.spec})
+        for d in (store.runs_dir, store.failed_dir):
+            try:
+                d.mkdir(parents=True, exist_ok=True)
+            except OSError as err:
+                raise OutputError(f"cannot write {str(d)!r}: {err.strerror}") from None
+            for tmp in d.glob(".*.tmp"):
+                tmp.unlink(missing_ok=True)
+        return store
+
+    def lock(self) -> None:
+        """Take the store for this process (an exclusive ``flock`` on DIR/.lock, held until the
+        process ends or :meth:`unlock`), so two sweeps never write one store; the second is
+        refused in one line. Temporary files are cleared only once the lock is held, so a live
+        writer's files are never deleted."""
+        try:
+            self.root.mkdir(parents=True, exist_ok=True)
+            fd = os.open(self.root / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as err:
+            raise OutputError(f"cannot write {str(self.root)!r}: {err.strerror}") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(fd)
+            raise StoreError(f"store {str(self.root)!r} is in use by another sweep; wait for it or choose "
+                             "another --out") from None
+        self._lock_fd = fd
+
+    def unlock(self) -> None:
+        if getattr(self, "_lock_fd", None) is not None:
+            os.close(self._lock_fd)  # closing the descriptor releases the flock
+            self._lock_fd = None
+
+    @classmethod
+    def open_existing(cls, root: str | os.PathLike) -> "ResultStore":
+        store = cls(root)
+        if not (store.root / "sweep.json").is_file():
+            raise StoreError(f"{str(store.root)!r} holds no sweep (no sweep.json)")
+        store._read_meta()
+        return store
+
+    def _read_meta(self) -> dict:
+        path = self.root / "sweep.json"
+        try:
+            meta = parse_json_bytes(path.read_bytes())
+        except (OSError, ValueError):
+            raise StoreError(f"{str(path)!r} is unreadable; this is not a sweep directory") from None
+        if not isinstance(meta, dict) or meta.get("format") != STORE_FORMAT:
+            raise StoreError(f"{str(path)!r} is not an armtransfer sweep")
+        return meta
+
+    @property
+    def meta(self) -> dict:
+        return self._read_meta()
+
+    # -- runs --------------------------------------------------------------------------
+    def run_path(self, key: str) -> Path:
+        return self.runs_dir / f"{key}.json"
+
+    def load_run(self, key: str) -> dict | None:
+        """A finished run, or None when it is absent. A run file that cannot be read or has
+        the wrong shape is reported on stderr and set aside into DIR/bad/ (so the run is
+        redone), never fatal."""
+        path = self.run_path(key)
+        try:
+            raw = path.read_bytes()
+        except FileNotFoundError:
+            return None
+        except OSError as err:
+            return self._set_aside(path, f"cannot be read ({err.strerror})")
+        try:
+            record = parse_json_bytes(raw)
+        except ValueError as err:
+            return self._set_aside(path, str(err))
+        problem = _run_problem(record, key)
+        if problem:
+            return self._set_aside(path, problem)
+        return record
+
+    def _set_aside(self, path: Path, why: str) -> None:
+        bad = self.root / "bad"
+        try:
+            bad.mkdir(exist_ok=True)
+            os.replace(path, bad / path.name)
+            where = f"moved to {str(bad / path.name)!r}"
+        except OSError:
+            where = "left in place"
+        print(f"armtransfer: run file {str(path)!r} {why}; {where}, the run will be redone", file=sys.stderr)
+        return None
+
+    def is_done(self, key: str) -> bool:
+        return self.load_run(key) is not None
+
+    def write_run(self, run: dict, result: dict, elapsed: float) -> None:
+        key = run["key"]
+        write_json_atomic(self.run_path(key), {"key": key, "config": run, "result": result,
+                                               "elapsed_seconds": round(elapsed, 3)})
+        (self.failed_dir / f"{key}.json").unlink(missing_ok=True)
+
+    def write_failure(self, run: dict, error: str, attempts: int) -> None:
+        write_json_atomic(self.failed_dir / f"{run['key']}.json",
+                          {"key": run["key"], "config": run, "error": error, "attempts": attempts})
+
+    def records(self) -> list[dict]:
+        """Every finished run, sorted by key (so summaries do not depend on finishing order)."""
+        out = []
+        for path in sorted(self.runs_dir.glob("*.json")):
+            rec = self.load_run(path.stem)
+            if rec is not None:
+                out.append(rec)
+        return out
+
+    def failures(self) -> list[dict]:
+        out = []
+        for path in sorted(self.failed_dir.glob("*.json")):
+            try:
+                record = parse_json_bytes(path.read_bytes())
+            except (OSError, ValueError):
+                continue
+            if isinstance(record, dict):
+                out.append(record)
+        return out
+
+
+RESULT_LISTS = ("exploration_steps", "total_steps", "greedy_steps", "converged")
+
+
+def _run_problem(record: object, key: str) -> str | None:
+    """What is wrong with a run file's content (None: it is a whole run of ``key``)."""
+    if not isinstance(record, dict) or record.get("key") != key:
+        return f"is not a run record of {key}"
+    if not isinstance(record.get("config"), dict) or record["config"].get("key") != key:
+        return "has no configuration of its run"
+    result = record.get("result")
+    if not isinstance(result, dict):
+        return "has no result"
+    lengths = set()
+    for name in RESULT_LISTS:
+        values = result.get(name)
+        if not isinstance(values, list) or not all(v is None or isinstance(v, (int, float)) for v in values):
+            return f"has no list of numbers {name!r}"
+        lengths.add(len(values))
+    if len(lengths) != 1:
+        return "has result lists of different lengths"
+    return None

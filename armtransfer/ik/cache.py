@@ -1,0 +1,93 @@
+"""On-disk cache of compiled arm robots.
+
+Location: ``$ARMTRANSFER_CACHE``, else ``$XDG_CACHE_HOME/armtransfer``, else
+``~/.cache/armtransfer``. One ``.npz`` per robot, named by the robot and its key; the key
+is a SHA-256 over everything the result depends on (the arm's MJCF bytes, mounting, action
+model, workspace and the source of the compiling modules). Each file stores its full key
+and a checksum of its arrays; a file that cannot be read, has another key (stale) or a
+wrong checksum (corrupt) is rebuilt. Writes go to a temporary file that is then renamed
+over the entry (``os.replace``), so readers never see half a file.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+# the compiling modules, beside this one: a change to any of them is a new key
+_SOURCES = ("compile.py", "solve.py", "scene.py", "labels.py", "workspace.py", "tool.py")
+_HERE = Path(__file__).resolve().parent
+
+
+def cache_dir() -> Path:
+    if os.environ.get("ARMTRANSFER_CACHE"):
+        return Path(os.environ["ARMTRANSFER_CACHE"])
+    if os.environ.get("XDG_CACHE_HOME"):
+        return Path(os.environ["XDG_CACHE_HOME"]) / "armtransfer"
+    return Path.home() / ".cache" / "armtransfer"
+
+
+def cache_key(parts: dict) -> str:
+    """SHA-256 of ``parts`` (JSON-able) plus the source of the compiling modules."""
+    h = hashlib.sha256(json.dumps(parts, sort_keys=True, default=str).encode())
+    for name in _SOURCES:
+        h.update((_HERE / name).read_bytes())
+    return h.hexdigest()
+
+
+def entry_path(name: str, key: str) -> Path:
+    safe = "".join(ch if ch.isalnum() or ch in "-_" else "_" for ch in name)
+    return cache_dir() / f"{safe}-{key[:16]}.npz"
+
+
+def _checksum(arrays: dict[str, np.ndarray]) -> str:
+    h = hashlib.sha256()
+    for name in sorted(arrays):
+        a = np.ascontiguousarray(arrays[name])
+        h.update(name.encode())
+        h.update(str(a.dtype).encode())
+        h.update(str(a.shape).encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def load(name: str, key: str) -> tuple[dict[str, np.ndarray] | None, str]:
+    """(arrays, status): status is "hit", "miss" (no entry) or "stale"/"corrupt"."""
+    path = entry_path(name, key)
+    if not path.exists():
+        return None, "miss"
+    try:
+        with np.load(path, allow_pickle=False) as f:
+            arrays = {k: f[k] for k in f.files}
+        stored_key = str(arrays.pop("__key__"))
+        stored_sum = str(arrays.pop("__checksum__"))
+    except Exception:  # noqa: BLE001 - any unreadable entry is simply rebuilt
+        return None, "corrupt"
+    if stored_key != key:
+        return None, "stale"
+    if stored_sum != _checksum(arrays):
+        return None, "corrupt"
+    return arrays, "hit"
+
+
+def save(name: str, key: str, arrays: dict[str, np.ndarray]) -> Path:
+    path = entry_path(name, key)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    payload = dict(arrays)
+    payload["__key__"] = np.array(key)
+    payload["__checksum__"] = np.array(_checksum(arrays))
+    fd, tmp = tempfile.mkstemp(prefix=path.stem + ".", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            np.savez(f, **payload)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path

@@ -1,0 +1,175 @@
+"""Every transfer method, defined once: the registry the API, the command, sweeps, reports,
+the wrappers and the scripts read.
+
+A method is a name, a one-line description, whether it is the paper's, how its shaping
+arrays are built from a robot and the transferred trajectories (``None``: no shaping), its
+automatic K, whether a too-large K can be farmed, and whether it runs mapped macros. Adding a
+method is one :class:`Method` entry in :data:`METHODS` (and, for a new kind of reward term,
+a mode in ``armtransfer.learning.shaping`` that the kernel understands).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from armtransfer.errors import InvalidParameterError
+from armtransfer.learning import guide, potentials
+from armtransfer.learning import shaping as modes
+from armtransfer.learning.rewards import as_list, farming_bound, longest_n, union_index
+from armtransfer.learning.shaping import Shaping
+from armtransfer.learning.trajectory import Trajectory
+from armtransfer.tasks.robot import DiscreteRobot
+
+HALF_BOUND = 0.5
+"""K='auto' of a method without its own ``auto_k`` starts at this fraction of the farming
+bound -step_reward/n (a farmable method's is then verified by value iteration, see
+``armtransfer.learning.farming``)."""
+
+Builder = Callable[[DiscreteRobot, list[Trajectory], float, float], Shaping]
+"""(robot, trajectories, K, beta) -> the shaping arrays."""
+
+
+@dataclass(frozen=True)
+class Method:
+    name: str
+    description: str
+    """One line, for --help and reports."""
+    paper: bool
+    """The paper's own method (section III), not one added here."""
+    build: Builder | None = None
+    """The shaping arrays; None for a method without shaping (``none``)."""
+    auto_k: float | None = None
+    """K for ``K='auto'`` in units of -step_reward; None: half the farming bound -step_reward/n.
+    Chosen on held-out start/goal pairs by research/select_defaults.py, never on Table I."""
+    farmable: bool = False
+    """A state bonus that a loop could collect forever: K is checked against farming."""
+    macros: bool = False
+    """Runs the action sequence mapping's macros (needs exactly one trajectory)."""
+    chooses: bool = False
+    """Changes how the learner chooses actions, not only its rewards (so no reward wrapper can
+    give it to another learner)."""
+
+    @property
+    def shaped(self) -> bool:
+        return self.build is not None
+
+    def resolve_k(self, K: float | str | None, step_reward: float, trajs: Sequence[Trajectory]) -> float:
+        """The K this method uses: ``K`` itself, or its automatic K for 'auto'/None."""
+        if K is None or K == "auto":
+            if step_reward >= 0:
+                raise InvalidParameterError("K='auto' needs a negative step reward (it is scaled by -step_reward)")
+            if self.auto_k is not None:
+                return self.auto_k * -step_reward
+            return HALF_BOUND * farming_bound(step_reward, trajs)
+        try:
+            k = float(K)
+        except (TypeError, ValueError):
+            raise InvalidParameterError(f"K must be a non-negative number or 'auto', got {K!r}") from None
+        if not np.isfinite(k) or k < 0:
+            raise InvalidParameterError(f"K must be a non-negative number or 'auto', got {K!r}")
+        return k
+
+
+def _pseudo(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
+    eff, ids = union_index(robot, trajs)
+    return Shaping(modes.MODE_PSEUDO, eff * k, ids, np.zeros(robot.n_states), k)
+
+
+def _first_visit(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
+    eff, ids = union_index(robot, trajs)
+    return Shaping(modes.MODE_FIRST_VISIT, eff * k, ids, np.zeros(robot.n_states), k)
+
+
+def _progress(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
+    eff, ids = union_index(robot, trajs)
+    return Shaping(modes.MODE_PROGRESS, eff * k, ids, np.zeros(robot.n_states), k)
+
+
+def _potential(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
+    eff, ids = union_index(robot, trajs)
+    return Shaping(modes.MODE_POTENTIAL, np.zeros(robot.n_states), ids, eff * k, k)
+
+
+def _dense(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
+    if not (np.isfinite(beta) and beta >= 0):
+        raise InvalidParameterError(f"beta must be a non-negative number, got {beta}")
+    _, ids = union_index(robot, trajs)
+    phi = np.max([potentials.dense(robot, t, k, beta) for t in trajs], axis=0)
+    return Shaping(modes.MODE_POTENTIAL, np.zeros(robot.n_states), ids, phi, k)
+
+
+def _guided(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
+    # no reward term: Algorithm 1's updates unchanged; the model chooses in the exploration phase
+    _, ids = union_index(robot, trajs)
+    n = robot.n_states
+    return Shaping(modes.MODE_NONE, np.zeros(n), ids, np.zeros(n), k, guide=guide.build(robot, trajs))
+
+
+METHODS: dict[str, Method] = {
+    m.name: m
+    for m in (
+        Method("none", "Algorithm 1 without transfer", paper=True),
+        Method("pseudo", "the paper's pseudo reward i*K on reaching the i-th trajectory cell",
+               paper=True, build=_pseudo, farmable=True),
+        Method("mapping", "pseudo plus the action sequence mapping's macros (the paper's III.C)",
+               paper=True, build=_pseudo, farmable=True, macros=True),
+        Method("first-visit", "the pseudo reward paid at most once per cell per episode",
+               paper=False, build=_first_visit, auto_k=10.0),
+        Method("potential", "potential-based shaping with phi = i*K (Ng, Harada and Russell)",
+               paper=False, build=_potential, auto_k=3.0),
+        Method("progress", "pays only for passing the highest trajectory index reached so far",
+               paper=False, build=_progress, auto_k=30.0),
+        Method("dense", "potential from the progress along the trajectory and the distance to it",
+               paper=False, build=_dense, auto_k=potentials.DENSE_K),
+        Method("guided", "robot 2 learns while it explores what its own actions do to its cell (an arm that moves its "
+               "joints: where its tip is) and, until the goal is first reached, prefers those predicted to lead on along "
+               "the trajectory; after every episode it plans over the moves it has tried",
+               paper=False, build=_guided, auto_k=0.0, chooses=True),
+    )
+}
+"""Every method, ``none`` first. The order is the order of reports."""
+
+SHAPED = tuple(name for name, m in METHODS.items() if m.shaped and not m.macros)
+
+REWARD_ONLY = tuple(name for name, m in METHODS.items() if m.shaped and not m.chooses)
+"""The methods whose transfer is a reward term alone (what ``armtransfer.wrappers`` can add)."""
+"""The methods that are a reward term only (controls run these)."""
+
+
+def get(name: str) -> Method:
+    """The method called ``name``; an unknown name is a one-line error listing the valid ones."""
+    try:
+        return METHODS[name]
+    except (KeyError, TypeError):
+        raise InvalidParameterError(f"unknown method {name!r}; valid methods: {', '.join(METHODS)}") from None
+
+
+def build_shaping(
+    method: str,
+    robot: DiscreteRobot,
+    trajs: Trajectory | Sequence[Trajectory],
+    K: float | str | None,
+    step_reward: float,
+    beta: float | None = None,
+) -> Shaping:
+    """The shaping arrays of ``method`` for ``robot`` from one or several trajectories.
+
+    A farmable method (``pseudo``, ``mapping``) refuses a K with step_reward + n*K >= 0, at
+    which standing on the last trajectory cell pays at least as much as moving on."""
+    m = get(method)
+    if not m.shaped:
+        raise InvalidParameterError(f"method {method!r} has no shaping")
+    trajs = as_list(trajs)
+    k = m.resolve_k(K, step_reward, trajs)
+    if m.farmable:
+        n = longest_n(trajs)
+        if step_reward + n * k >= 0:
+            raise InvalidParameterError(
+                f"K={k:g} can be farmed: step reward {step_reward:g} + largest pseudo reward "
+                f"n*K = {n}*{k:g} >= 0; use K < {farming_bound(step_reward, trajs):.6g} "
+                f"(-step_reward/n) or the method 'first-visit'"
+            )
+    return m.build(robot, trajs, k, potentials.DENSE_BETA if beta is None else float(beta))

@@ -1,0 +1,531 @@
+"""SARSA(lambda) with knowledge-based pseudo rewards: the paper's Algorithm 1, compiled.
+
+One call to :func:`learn` is one trial: episodes from the start state until the greedy
+path has converged (or a limit is hit). The inner loop is a numba kernel over the robot's
+plain arrays, so it runs the same on grid robots and compiled arms.
+
+Faithful to Algorithm 1:
+  * Q(s, a) = 0 and e(s, a) = 0 at the start; traces are reset at every episode start.
+  * epsilon-greedy: with probability epsilon a uniformly random action, otherwise an action
+    of largest Q with ties broken uniformly at random.
+  * delta = r + r'(s') + gamma Q(s', a') - Q(s, a), with Q(terminal, .) = 0;
+    e(s, a) += 1 (accumulating); then for every (s, a): Q += alpha delta e; e *= gamma lambda.
+  * The shaping term r' is the paper's pseudo reward i*K on reaching the i-th trajectory
+    state (``pseudo``), or one of the other methods in :mod:`transfer.rewards`.
+
+Method ``guided`` adds one step after every episode: value iteration over the pairs robot 2
+has tried, on the successors it observed (``transfer.guide.plan``); it draws nothing.
+
+The first episode's path, its loops erased, is kept as ``TrialResult.first_path`` for the
+online action sequence mapping (``experiment.online_mapping``); it draws nothing.
+
+Sparse traces: only pairs with a non-zero trace are stored. A trace that decays below
+``trace_cutoff`` is dropped; with ``trace_cutoff=0`` nothing is dropped until it underflows
+to 0, and the result is bit-for-bit the dense Algorithm 1 (``transfer.reference``), as a
+test checks.
+
+The random stream, in the order it is drawn (the dense reference draws the same):
+  1. choosing an action at a state with a macro (``transfer.mapping``), when no macro is
+     running: one draw u, the macro runs when u < 1 - epsilon. A running macro supplies
+     its next action without a draw; it ends after its last action, or is abandoned when
+     a step is blocked: the robot did not move, s' == s observed after wind (the robot
+     cannot tell a wall from a gust that pushed it back). Right after an abandoned macro the next
+     action is Algorithm 1's (no draw for a macro), so a macro blocked at its first step
+     is not retried at once; after a macro that ran to its end, a macro at the state
+     reached may start (macros chain);
+  2. epsilon-greedy: one draw u; if u < epsilon one more draw picks the action as
+     floor(u2 * n_actions); otherwise, when k > 1 actions tie for the largest Q, one more
+     draw picks the floor(u2 * k)-th of them in index order;
+     With a guide (method ``guided``, ``transfer.guide``), in its exploration phase, the
+     largest value is that of Q(s, a) - weight * score(a) instead of Q, and the extra draw
+     is made only when m > 1 actions tie for it, picking the floor(u2 * m)-th of them in
+     index order (no other draw is added);
+  3. wind, only when its probability p > 0: one draw after every move, pushing when < p.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numba
+import numpy as np
+
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.learning.config import LearnerConfig
+
+from armtransfer.learning import guide as _guide
+from armtransfer.learning import jitcache as _jitcache
+from armtransfer.learning.shaping import (  # noqa: E402  (the kernel's shaping modes)
+    MODE_FIRST_VISIT,
+    MODE_NONE,
+    MODE_POTENTIAL,
+    MODE_PROGRESS,
+    MODE_PSEUDO,
+    Shaping,
+)
+
+
+@numba.njit(cache=True, inline="always")
+def _egreedy(Q, s, n_actions, eps, rng):
+    if rng.random() < eps:
+        return int(rng.random() * n_actions)
+    best = Q[s, 0]
+    ties = 1
+    for a in range(1, n_actions):
+        q = Q[s, a]
+        if q > best:
+            best = q
+            ties = 1
+        elif q == best:
+            ties += 1
+    if ties == 1:
+        for a in range(n_actions):
+            if Q[s, a] == best:
+                return a
+    k = int(rng.random() * ties)
+    for a in range(n_actions):
+        if Q[s, a] == best:
+            if k == 0:
+                return a
+            k -= 1
+    return n_actions - 1  # unreachable
+
+
+@numba.njit(cache=True, inline="always")
+def _macro_step(s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start, macro_len, macro_actions):
+    """(True, the running macro's next step, in_macro, m_pos, m_end); else a new macro starting
+    at s (one draw, runs when < 1 - epsilon); else (False, -1, ...). m_pos/m_end index the flat
+    macro actions."""
+    if in_macro:
+        return True, macro_actions[m_pos], True, m_pos + 1, m_end
+    if may_start and macro_len[s] > 0 and rng.random() < 1.0 - eps:
+        m_pos = macro_start[s]
+        return True, macro_actions[m_pos], True, m_pos + 1, m_pos + macro_len[s]
+    return False, -1, False, m_pos, m_end
+
+
+@numba.njit(cache=True, inline="always")
+def _choose(Q, s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start, macro_len, macro_actions):
+    """The next action at s: a macro's step (``_macro_step``), else epsilon-greedy. Returns
+    (action, in_macro, m_pos, m_end, 1 for a macro step else 0)."""
+    found, a, in_macro, m_pos, m_end = _macro_step(s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start,
+                                                   macro_len, macro_actions)
+    if found:
+        return a, in_macro, m_pos, m_end, 1
+    return _egreedy(Q, s, Q.shape[1], eps, rng), False, m_pos, m_end, 0
+
+
+@numba.njit(cache=True, inline="always")
+def _choose_guided(Q, s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start, macro_len, macro_actions,
+                   guided, g, gm):
+    """``_choose`` with the guide's epsilon-greedy (``transfer.guide.egreedy``) in its
+    exploration phase (``guided``)."""
+    found, a, in_macro, m_pos, m_end = _macro_step(s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start,
+                                                   macro_len, macro_actions)
+    if found:
+        return a, in_macro, m_pos, m_end, 1
+    if guided and not _guide.exhausted(g, gm):  # every trajectory given up on: Algorithm 1's own
+        return _guide.egreedy(Q, s, eps, rng, g, gm), False, m_pos, m_end, 0
+    return _egreedy(Q, s, Q.shape[1], eps, rng), False, m_pos, m_end, 0
+
+
+@numba.njit(cache=True)
+def _greedy_path(Q, next_state, label, start, goal, stamp, stamp_id, path_out):
+    """Follow argmax Q (lowest index on ties, no wind) from start. Returns the number of
+    states written to path_out, negated when the goal is not reached (a loop or a cap)."""
+    n_actions = next_state.shape[1]
+    s = start
+    n = 0
+    cap = path_out.shape[0]
+    while True:
+        path_out[n] = s
+        n += 1
+        if label[s] == goal:
+            return n
+        if stamp[s] == stamp_id or n >= cap:
+            return -n
+        stamp[s] = stamp_id
+        best = Q[s, 0]
+        ba = 0
+        for a in range(1, n_actions):
+            if Q[s, a] > best:
+                best = Q[s, a]
+                ba = a
+        s = next_state[s, ba]
+
+
+@numba.njit(cache=True)
+def _shaping(mode, s, s2, terminal, bonus, traj_index, phi, gamma, paid_stamp, episode, best):
+    """The shaping term for the move s -> s2; returns (term, the best bonus so far)."""
+    if mode == MODE_PSEUDO:
+        return bonus[s2], best
+    if mode == MODE_FIRST_VISIT:
+        i = traj_index[s2]
+        if i > 0 and paid_stamp[i] != episode:
+            paid_stamp[i] = episode
+            return bonus[s2], best
+        return 0.0, best
+    if mode == MODE_POTENTIAL:
+        phi2 = 0.0 if terminal else phi[s2]
+        return gamma * phi2 - phi[s], best
+    if mode == MODE_PROGRESS:
+        # pay only the part of the bonus beyond the best reached so far this episode
+        if bonus[s2] > best:
+            return bonus[s2] - best, bonus[s2]
+        return 0.0, best
+    return 0.0, best
+
+
+def _make_run_trial(with_guide: bool):
+    """The trial kernel, compiled with or without the guide (``with_guide``, a constant to numba).
+
+    Why two: handed the guide's 21 arrays, even empty and unused, the plain methods ran about
+    a third slower (``benchmarks/bench_kernels.py``, BENCHMARKS.md). Compiled without the guide,
+    every guide branch (``if with_guide``) is dropped before typing and ``g``/``gm`` are
+    None. Both come from this one body, so they cannot drift apart; numba caches each (the
+    constant is part of its cache key)."""
+
+    @numba.njit(cache=True, nogil=True)  # nogil: trials run on threads (experiment.trial_threads)
+    def _run_trial(
+        next_state,
+        wind_state,
+        label,
+        start,
+        goal,
+        mode,
+        bonus,
+        traj_index,
+        phi,
+        macro_start,
+        macro_len,
+        macro_actions,
+        macro_episodes,
+        alpha,
+        gamma,
+        lam,
+        eps,
+        r_step,
+        r_goal,
+        wind_p,
+        cutoff,
+        max_episodes,
+        max_total_steps,
+        max_episode_steps,
+        patience,
+        rng,
+        g,
+        gm,
+        Q,
+        episode_steps,
+        greedy_len,
+        macro_steps_out,
+        path_buf,
+        prev_path,
+        fp_states,
+        fp_actions,
+    ):
+        n_states, n_actions = next_state.shape
+        # the first episode's path with its loops erased (for the online action sequence mapping):
+        # fp_states[0..fp_n-1], fp_actions[i] taken at fp_states[i]; fp_pos: a state's place in it
+        fp_pos = np.full(n_states, -1, np.int64)
+        fp_n = 0
+        n_traj = traj_index.max() + 1 if traj_index.shape[0] > 0 else 1
+        paid_stamp = np.full(max(n_traj, 1), -1, np.int64)
+        stamp = np.full(n_states, -1, np.int64)
+        # sparse traces: tr_sa holds s * n_actions + a, pos maps a pair to its slot
+        cap = n_states * n_actions
+        tr_sa = np.empty(cap, np.int64)
+        tr_e = np.empty(cap, np.float64)
+        pos = np.full(cap, -1, np.int64)
+        n_tr = 0
+        decay = gamma * lam
+        total = 0
+        prev_n = 0
+        stable = 0
+        converged_episode = -1
+        episodes = 0
+        has_macros = macro_actions.shape[0] > 0
+        # Every use of the guide sits under ``if with_guide``, a constant: compiled without the
+        # guide, numba drops those branches before typing, and g and gm may be None.
+        has_guide = False
+        guide_episodes = 0
+        plan = False
+        if with_guide:
+            has_guide = g[5].shape[0] > 1  # the guide has at least one trajectory (transfer.guide)
+            guide_episodes = int(g[6][5])
+            plan = g[6][8] > 0.0
+        for ep in range(max_episodes):
+            guided = has_guide and ep < guide_episodes  # the model chooses in the exploration phase
+            use_macros = has_macros and ep < macro_episodes
+            # reset traces
+            for k in range(n_tr):
+                pos[tr_sa[k]] = -1
+            n_tr = 0
+            s = start
+            best = 0.0
+            if with_guide and has_guide:
+                _guide.reset_progress(g, gm, s, guided)
+            # choose the first action (m_pos: position in the running macro, m_end: its end)
+            if with_guide:
+                a, in_macro, m_pos, m_end, macro_used = _choose_guided(
+                    Q, s, eps, rng, False, 0, 0, use_macros, macro_start, macro_len, macro_actions, guided, g, gm
+                )
+            else:
+                a, in_macro, m_pos, m_end, macro_used = _choose(
+                    Q, s, eps, rng, False, 0, 0, use_macros, macro_start, macro_len, macro_actions
+                )
+            if ep == 0:
+                fp_states[0] = s
+                fp_pos[s] = 0
+                fp_n = 1
+            steps = 0
+            reached = False
+            limit = max_total_steps - total
+            if ep > 0 and max_episode_steps < limit:
+                limit = max_episode_steps
+            while steps < limit:
+                s2 = next_state[s, a]
+                if wind_p > 0.0 and rng.random() < wind_p:
+                    s2 = wind_state[s2]
+                blocked = s2 == s  # what the robot observes: it did not move (after wind)
+                steps += 1
+                if ep == 0:  # loop erasure: back to s2's place if it is on the path, else append it
+                    fp_actions[fp_n - 1] = a
+                    p2 = fp_pos[s2]
+                    if p2 >= 0:
+                        for i in range(p2 + 1, fp_n):
+                            fp_pos[fp_states[i]] = -1
+                        fp_n = p2 + 1
+                    else:
+                        fp_states[fp_n] = s2
+                        fp_pos[s2] = fp_n
+                        fp_n += 1
+                if with_guide and has_guide:  # robot 2 records what its move did to the label it perceives
+                    _guide.observe(g, gm, s, a, s2, guided)
+                    _guide.update_progress(g, gm, s2)
+                terminal = label[s2] == goal
+                r = r_step
+                if terminal:
+                    r += r_goal
+                if mode != MODE_NONE:
+                    term, best = _shaping(
+                        mode, s, s2, terminal, bonus, traj_index, phi, gamma, paid_stamp, ep, best
+                    )
+                    r += term
+                if terminal:
+                    q_next = 0.0
+                    a2 = 0
+                else:
+                    abandoned = False
+                    if in_macro and (blocked or m_pos >= m_end):
+                        abandoned = blocked
+                        in_macro = False
+                    # right after an abandoned macro, Algorithm 1 chooses (no immediate retry)
+                    if with_guide:
+                        a2, in_macro, m_pos, m_end, used = _choose_guided(
+                            Q, s2, eps, rng, in_macro, m_pos, m_end, use_macros and not abandoned,
+                            macro_start, macro_len, macro_actions, guided, g, gm,
+                        )
+                    else:
+                        a2, in_macro, m_pos, m_end, used = _choose(
+                            Q, s2, eps, rng, in_macro, m_pos, m_end, use_macros and not abandoned,
+                            macro_start, macro_len, macro_actions,
+                        )
+                    macro_used += used
+                    q_next = Q[s2, a2]
+                sa = s * n_actions + a
+                delta = r + gamma * q_next - Q[s, a]
+                p = pos[sa]
+                if p < 0:
+                    pos[sa] = n_tr
+                    tr_sa[n_tr] = sa
+                    tr_e[n_tr] = 1.0
+                    n_tr += 1
+                else:
+                    tr_e[p] += 1.0
+                k = 0
+                while k < n_tr:
+                    pair = tr_sa[k]
+                    e = tr_e[k]
+                    Q[pair // n_actions, pair % n_actions] += alpha * delta * e
+                    e *= decay
+                    if e < cutoff or e == 0.0:
+                        # drop: move the last trace into this slot
+                        pos[pair] = -1
+                        n_tr -= 1
+                        if k < n_tr:
+                            tr_sa[k] = tr_sa[n_tr]
+                            tr_e[k] = tr_e[n_tr]
+                            pos[tr_sa[k]] = k
+                        continue
+                    tr_e[k] = e
+                    k += 1
+                if terminal:
+                    reached = True
+                    break
+                s = s2
+                a = a2
+            total += steps
+            if with_guide and has_guide and plan:  # robot 2 plans over the moves it has tried (transfer.guide.plan)
+                _guide.plan(g, gm, Q, label, goal, gamma, r_step, r_goal)
+            episode_steps[ep] = steps if reached else -steps
+            macro_steps_out[ep] = macro_used
+            episodes = ep + 1
+            n = _greedy_path(Q, next_state, label, start, goal, stamp, ep, path_buf)
+            greedy_len[ep] = n - 1 if n > 0 else -1
+            same = n > 0 and n == prev_n
+            if same:
+                for i in range(n):
+                    if path_buf[i] != prev_path[i]:
+                        same = False
+                        break
+            if same:
+                stable += 1
+            else:
+                stable = 0
+                converged_episode = ep if n > 0 else -1
+                prev_n = n
+                for i in range(abs(n)):
+                    prev_path[i] = path_buf[i]
+            if n > 0 and stable >= patience:
+                break
+            if total >= max_total_steps:
+                break
+        if stable < patience:
+            converged_episode = -1
+        if not (episodes > 0 and episode_steps[0] > 0):
+            fp_n = 0  # the first episode did not reach the goal: no path
+        return episodes, converged_episode, prev_n, fp_n
+
+    return _run_trial
+
+
+_run_trial = _make_run_trial(False)
+"""The kernel for a run without a guide."""
+_run_trial_guided = _make_run_trial(True)
+"""The kernel for method ``guided``."""
+
+
+@dataclass
+class TrialResult:
+    """What one trial of :func:`learn` measured."""
+
+    exploration_steps: int | None
+    """Steps of the first episode, i.e. until the goal is first reached (None: never)."""
+    converged: bool
+    total_steps: int | None
+    """Steps until the greedy path stopped changing (through its first episode)."""
+    greedy_steps: int | None
+    """Length of the converged greedy path (None when not converged)."""
+    episodes: int
+    episode_steps: np.ndarray
+    """Steps per episode (negative: the episode hit a cap before the goal)."""
+    greedy_lengths: np.ndarray
+    """Greedy path length after each episode (-1: the greedy path misses the goal)."""
+    macro_steps: np.ndarray
+    """Primitive steps taken inside mapped macros, per episode."""
+    greedy_path: list[tuple[int, int]] = field(default_factory=list)
+    """The converged greedy path as (state, action) pairs ending with (goal state, -1)."""
+    first_path: list[tuple[int, int]] = field(default_factory=list)
+    """The first episode's path (until the goal was first reached) with its loops erased, as
+    (state, action) pairs ending with (goal state, -1); empty when the goal was not reached.
+    What the online action sequence mapping learns from (``mapping.ActionMapping.learn_from``)."""
+    Q: np.ndarray | None = None
+
+
+def learn(
+    robot: DiscreteRobot,
+    start_state: int,
+    goal_cell: int,
+    config: LearnerConfig,
+    rng: np.random.Generator,
+    shaping=None,
+    wind: float = 0.0,
+    macros=None,
+    q_init: np.ndarray | None = None,
+    keep_q: bool = False,
+    guide_arrays: tuple | None = None,
+) -> TrialResult:
+    """Run one trial of SARSA(lambda) on ``robot`` from ``start_state`` to ``goal_cell``.
+
+    ``shaping`` is a :class:`armtransfer.learning.shaping.Shaping` (None: no transfer); ``macros`` a
+    :class:`transfer.mapping.MacroTable` (None: no action sequence mapping); its attribute
+    ``episodes`` (None: all) says in how many first episodes macros are offered. ``rng`` is
+    the only source of randomness. ``guide_arrays``: the guide's model arrays to learn into
+    (``transfer.guide.model_arrays_for``), to read what robot 2 learned afterwards; None: new ones.
+    """
+    n = robot.n_states
+    sh = shaping if shaping is not None else Shaping.none(n)
+    m_episodes = None
+    guide = getattr(sh, "guide", None)
+    kernel = _run_trial if guide is None else _run_trial_guided
+    if guide is not None:
+        g = _guide.as_tuple(guide)
+        gm = _guide.model_arrays_for(guide, n, robot.n_actions) if guide_arrays is None else guide_arrays
+    elif kernel is _run_trial_guided:  # run without a guide (benchmarks/bench_kernels.py, a test)
+        g, gm = _guide.inactive(robot.n_actions)
+    else:  # the plain kernel never reads them
+        g, gm = None, None
+    if macros is None:
+        m_start = np.zeros(n, np.int64)
+        m_len = np.zeros(n, np.int64)
+        m_actions = np.zeros(0, np.int64)
+    else:
+        m_start, m_len, m_actions = macros.arrays(robot)
+        m_episodes = getattr(macros, "episodes", None)
+    Q = np.zeros((n, robot.n_actions)) if q_init is None else np.array(q_init, dtype=np.float64)
+    E = config.max_episodes
+    episode_steps = np.zeros(E, np.int64)
+    greedy_len = np.zeros(E, np.int64)
+    macro_steps = np.zeros(E, np.int64)
+    path_buf = np.zeros(n + 1, np.int64)
+    prev_path = np.zeros(n + 1, np.int64)
+    fp_states = np.zeros(n + 1, np.int64)
+    fp_actions = np.zeros(n + 1, np.int64)
+    episodes, conv_ep, path_n, fp_n = kernel(
+        robot.next_state, robot.wind_state, robot.label, int(start_state), int(goal_cell),
+        sh.mode, sh.bonus, sh.traj_index, sh.phi,
+        m_start, m_len, m_actions, config.max_episodes if m_episodes is None else int(m_episodes),
+        config.alpha, config.gamma, config.lam, config.epsilon,
+        config.step_reward, config.goal_reward, float(wind), config.trace_cutoff,
+        config.max_episodes, config.max_total_steps, config.max_episode_steps, config.patience,
+        rng, g, gm, Q, episode_steps, greedy_len, macro_steps, path_buf, prev_path, fp_states, fp_actions,
+    )
+    episode_steps = episode_steps[:episodes].copy()
+    first = int(episode_steps[0]) if episodes and episode_steps[0] > 0 else None
+    converged = conv_ep >= 0
+    path: list[tuple[int, int]] = []
+    if converged:
+        states = prev_path[:path_n]
+        for i in range(path_n - 1):
+            s, t = int(states[i]), int(states[i + 1])
+            a = _greedy_action(Q, s)
+            assert robot.next_state[s, a] == t
+            path.append((s, a))
+        path.append((int(states[-1]), -1))
+    first_path = [(int(fp_states[i]), int(fp_actions[i])) for i in range(fp_n - 1)]
+    if fp_n:
+        first_path.append((int(fp_states[fp_n - 1]), -1))
+    return TrialResult(
+        exploration_steps=first,
+        converged=converged,
+        total_steps=int(np.abs(episode_steps[: conv_ep + 1]).sum()) if converged else None,
+        greedy_steps=path_n - 1 if converged else None,
+        episodes=int(episodes),
+        episode_steps=episode_steps,
+        greedy_lengths=greedy_len[:episodes].copy(),
+        macro_steps=macro_steps[:episodes].copy(),
+        greedy_path=path,
+        first_path=first_path,
+        Q=Q if keep_q else None,
+    )
+
+
+def _greedy_action(Q: np.ndarray, s: int) -> int:
+    """argmax with the lowest index on ties, as the kernel's greedy path uses."""
+    return int(np.argmax(Q[s]))
+
+
+# The kernels above call the guide's jitted functions; numba's cache does not notice an edit to
+# guide.py alone (``jitcache``), so their cache is emptied when that file changes.
+_jitcache.invalidate_stale(__name__, [_egreedy, _macro_step, _choose, _choose_guided, _greedy_path, _shaping, _run_trial, _run_trial_guided], [_guide.__file__])

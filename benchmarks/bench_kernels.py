@@ -1,0 +1,123 @@
+"""The learner kernel against its variants, in one process, so that the machine's drift (the
+baseline of ``armtransfer bench`` moves by half within an hour here) cancels out.
+
+    python benchmarks/bench_kernels.py                      # plain kernel against the guided one, no guide
+    python benchmarks/bench_kernels.py --against 0cd2902    # ... and against an older commit's kernel
+    python benchmarks/bench_kernels.py --fast               # a smoke run
+
+Each round runs every contender on the same work, in turn: Table I task 1, the fine robot, no
+transfer, trials back to back until ``--steps`` steps (``armtransfer bench``'s measurement),
+seed = the round. Reported: each contender's median steps/s over the rounds and the median of
+the per-round ratios to the first. ``--against REV`` loads ``armtransfer/learning/sarsa.py`` and
+``armtransfer/learning/guide.py`` as they were at git revision REV of this checkout, beside today's
+(a revision whose kernel takes other arguments than ``sarsa.learn`` gives them fails in one line).
+"""
+
+from __future__ import annotations
+
+import importlib
+import statistics
+import subprocess
+import argparse
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from armtransfer import script
+from armtransfer.errors import ArmTransferError
+from armtransfer.learning import sarsa
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.tasks.catalog import table_task
+from armtransfer.tasks.grid_robots import grid_robot
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def load_revision(rev: str, where: Path):
+    """``sarsa`` of git revision ``rev``, importing its own ``guide`` of that revision."""
+    files = {}
+    for name in ("sarsa", "guide"):
+        try:
+            proc = subprocess.run(["git", "-C", str(ROOT), "show", f"{rev}:transfer/{name}.py"],
+                                  capture_output=True, text=True)
+        except OSError as e:
+            raise ArmTransferError(f"--against needs git and this checkout's history: {e}") from None
+        if proc.returncode != 0:
+            raise ArmTransferError(f"cannot read transfer/{name}.py at revision {rev!r}: "
+                                   f"{proc.stderr.strip().splitlines()[-1] if proc.stderr.strip() else 'git failed'}")
+        files[name] = proc.stdout
+    tag = "".join(c for c in rev if c.isalnum())
+    (where / f"guide_{tag}.py").write_text(files["guide"])
+    src = files["sarsa"].replace("from armtransfer.learning import guide as _guide", f"import guide_{tag} as _guide")
+    (where / f"sarsa_{tag}.py").write_text(src)
+    sys.path.insert(0, str(where))
+    return importlib.import_module(f"sarsa_{tag}")
+
+
+def measure(learn, steps: int, seed: int) -> float:
+    robot = grid_robot("fine")
+    start, goal = table_task(1).cells()
+    s0 = robot.start_state(start)
+    rng = np.random.default_rng(seed)
+    done = 0
+    t0 = time.perf_counter()
+    while done < steps:
+        res = learn(robot, s0, goal, LearnerConfig(max_total_steps=steps - done), rng)
+        done += int(np.abs(res.episode_steps).sum())
+    return done / (time.perf_counter() - t0)
+
+
+def guided_kernel_without_guide(*args, **kwargs):
+    """``sarsa.learn`` on the kernel compiled with the guide, for a run that has none."""
+    plain = sarsa._run_trial
+    sarsa._run_trial = sarsa._run_trial_guided
+    try:
+        return sarsa.learn(*args, **kwargs)
+    finally:
+        sarsa._run_trial = plain
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = script.parser(__doc__)
+    p.add_argument("--rounds", type=int, default=8)
+    p.add_argument("--steps", type=int, default=1_000_000, help="steps per contender per round")
+    p.add_argument("--against", metavar="REV", help="also time the kernel of this git revision")
+    p.add_argument("--fast", action="store_true", help="a smoke run: 2 rounds of 20,000 steps")
+    args = p.parse_args(argv)
+    return script.run(_run, args)
+
+
+def _run(args: argparse.Namespace) -> int:
+    if args.rounds < 1 or args.steps < 1:
+        raise ArmTransferError("--rounds and --steps must be >= 1")
+    rounds, steps = (2, 20_000) if args.fast else (args.rounds, args.steps)
+    contenders = {"plain kernel (no guide compiled in)": sarsa.learn,
+                  "guided kernel, run without a guide": guided_kernel_without_guide}
+    with tempfile.TemporaryDirectory() as tmp:
+        if args.against:
+            old = load_revision(args.against, Path(tmp))
+            contenders[f"kernel at {args.against}"] = old.learn
+        for learn in contenders.values():  # compile or load every kernel outside the timing
+            try:
+                measure(learn, 1_000, 0)
+            except TypeError as e:
+                raise ArmTransferError(f"that revision's kernel does not run here: {e}") from None
+        rates = {name: [] for name in contenders}
+        for r in range(rounds):
+            for name, learn in contenders.items():
+                rates[name].append(measure(learn, steps, r))
+    first = next(iter(rates))
+    print(f"{rounds} rounds of {steps:,} steps each (Table I task 1, fine, no transfer)")
+    for name, xs in rates.items():
+        ratio = statistics.median(x / y for x, y in zip(xs, rates[first]))
+        print(f"  {name}: median {statistics.median(xs):,.0f} steps/s, "
+              f"{ratio:.2f}x the first (per-round ratios {min(x / y for x, y in zip(xs, rates[first])):.2f}-"
+              f"{max(x / y for x, y in zip(xs, rates[first])):.2f})")
+    return 0
+
+
+if __name__ == "__main__":
+    script.exit_with(main)
