@@ -36,12 +36,17 @@ _LAZY = {
     "METHODS": "armtransfer.learning.methods",
     "Method": "armtransfer.learning.methods",
     "resolve_robot": "armtransfer.tasks.specs",
-    "register_envs": "armtransfer.tasks.envs",
+    "register_envs": "armtransfer.registration",
     "TransferReward": "armtransfer.wrappers",
     "ArmTransferError": "armtransfer.errors",
 }
 
 __all__ = sorted(_LAZY)
+
+
+from armtransfer.registration import register_envs as _register_envs  # noqa: E402
+
+_register_envs()
 
 
 def __getattr__(name: str):

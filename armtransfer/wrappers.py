@@ -4,7 +4,6 @@
     import armtransfer
     from armtransfer.wrappers import TransferReward
 
-    armtransfer.register_envs()
     env = gym.make("armtransfer/Rooms-v0", task=1, robot="fine")
     env = TransferReward(env, "trajectory.json", method="pseudo", K="auto")
 

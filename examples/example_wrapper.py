@@ -40,7 +40,6 @@ if args.fast:
     args.seeds, args.episodes = 1, 2
 
 # 1. The environment: robot 2, an arm on the rooms table.
-armtransfer.register_envs()
 
 
 def make_env(transfer: bool) -> gym.Env:

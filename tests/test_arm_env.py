@@ -7,9 +7,8 @@ from gymnasium.utils.env_checker import check_env
 import numpy as np
 
 from armtransfer.errors import ArmTransferError
-from armtransfer.tasks.envs import register_envs
+import armtransfer  # noqa: F401  (registers the environments)
 
-register_envs()
 
 
 @pytest.mark.parametrize("arm, actions", [("planar2", "joint"), ("ur5e_like", "cartesian")])

@@ -177,7 +177,6 @@ def test_arm_rooms_env_takes_the_tool_and_mount_options(gripper_xml):
 
     import armtransfer
 
-    armtransfer.register_envs()
     env = gym.make("armtransfer/ArmRooms-v0", xml_path=str(gripper_xml), actions="cartesian", tip_body="pen",
                    tip_offset=(0, 0, -0.116), base_pos=(-0.1, 0.0, 0.0), base_yaw=0.0, arm_name="grip",
                    start=(10, 10), goal=(15, 16))

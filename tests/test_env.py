@@ -4,9 +4,8 @@ import gymnasium as gym
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-from armtransfer.tasks.envs import register_envs
+import armtransfer  # noqa: F401  (registers the environments)
 
-register_envs()
 
 
 @pytest.mark.parametrize("robot", ["fine", "coarse"])
@@ -55,3 +54,16 @@ def test_rooms_rgb_array_shows_the_robot_and_goal():
     assert blue[25 * 6 + 3, 25 * 6 + 3]
     env.step(0)  # F: +y, one row up in the picture
     assert np.all(env.render()[24 * 6 + 3, 25 * 6 + 3] == (40, 90, 230))
+
+
+def test_importing_armtransfer_registers_the_environments():
+    """As in Gymnasium's ecosystem: the import alone registers, in a fresh process."""
+    import subprocess
+    import sys
+
+    code = ("import gymnasium as gym, armtransfer\n"
+            "env = gym.make('armtransfer/Rooms-v0', task=1, robot='fine')\n"
+            "print(env.spec.id, type(env.unwrapped).__name__, env.unwrapped.robot.name, env.spec.max_episode_steps)\n")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.split() == ["armtransfer/Rooms-v0", "RobotRoomsEnv", "fine", "100000"]

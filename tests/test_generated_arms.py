@@ -134,13 +134,11 @@ def test_an_arm_file_keeps_its_generated_mount_everywhere(generated):
     import gymnasium as gym
 
     from armtransfer.tasks.arms import arm_robot
-    from armtransfer.tasks.envs import register_envs
 
     arm = generated["spatial6"]
     side = read_sidecar(arm.xml_path)
     robot = arm_robot(None, "cartesian", xml_path=arm.xml_path)
     assert robot.arm.mount == tuple(side["mount_pos"]) and robot.arm.yaw == side["mount_yaw"]
-    register_envs()
     env = gym.make("armtransfer/ArmRooms-v0", xml_path=str(arm.xml_path), actions="cartesian", task=1)
     assert env.unwrapped.robot.arm.mount == robot.arm.mount
     assert env.unwrapped.robot.name == f"{arm.name}:cartesian"

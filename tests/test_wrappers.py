@@ -18,11 +18,10 @@ from armtransfer.learning import sarsa
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.tasks.catalog import table_task
-from armtransfer.tasks.envs import register_envs
+import armtransfer  # noqa: F401  (registers the environments)
 from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.wrappers import TransferReward
 
-register_envs()
 SHAPED = list(registry.REWARD_ONLY)
 
 

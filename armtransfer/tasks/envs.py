@@ -1,9 +1,8 @@
 """Gymnasium environments over any discrete robot (rooms-world grid robots and arms).
 
-``armtransfer.register_envs()`` registers ``armtransfer/Rooms-v0`` (a grid robot) and
+``import armtransfer`` registers ``armtransfer/Rooms-v0`` (a grid robot) and
 ``armtransfer/ArmRooms-v0`` (an arm robot); then ``gymnasium.make("armtransfer/Rooms-v0",
-task=1, robot="fine")``. Registering is explicit: importing never registers. The observation is the robot's
-own state index, the action an index into its action model; each step costs
+task=1, robot="fine")``. The observation is the robot's own state index, the action an index into its action model; each step costs
 ``step_reward`` and reaching the goal cell pays ``goal_reward`` and terminates. With
 ``wind=p`` the robot is pushed one cell towards +x with probability p after its move.
 """
@@ -18,6 +17,7 @@ from gymnasium import spaces
 
 from armtransfer.tasks.catalog import Task, custom_task, table_task
 from armtransfer.errors import InvalidParameterError
+from armtransfer.registration import register_envs  # noqa: F401  (kept importable from here)
 from armtransfer.tasks.robot import DiscreteRobot
 
 
@@ -143,19 +143,3 @@ def make_arm_rooms_env(arm: str | None = None, actions: str = "joint", task: int
         arm, actions = parse_robot_spec(f"{arm or 'planar2'}:{actions}")
     the_task = custom_task(start, goal) if start is not None and goal is not None else table_task(task)
     return RobotRoomsEnv(arm_robot(arm, actions, **robot_kwargs), the_task, **kwargs)
-
-
-def register_envs() -> None:
-    """Register this project's environments with Gymnasium (idempotent)."""
-    if "armtransfer/Rooms-v0" not in gym.registry:
-        gym.register(
-            id="armtransfer/Rooms-v0",
-            entry_point="armtransfer.tasks.envs:make_rooms_env",
-            max_episode_steps=100_000,
-        )
-    if "armtransfer/ArmRooms-v0" not in gym.registry:
-        gym.register(
-            id="armtransfer/ArmRooms-v0",
-            entry_point="armtransfer.tasks.envs:make_arm_rooms_env",
-            max_episode_steps=100_000,
-        )
