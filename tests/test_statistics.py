@@ -153,3 +153,16 @@ def test_learning_curve_means_include_converged_trials():
 def test_learning_curves_figure_draws(tmp_path):
     figures.learning_curves({"a": [[50, 10], [400, 300, 200]]}, "t", tmp_path / "c.png", greedy={"a": [10, None]})
     assert (tmp_path / "c.png").stat().st_size > 0
+
+
+def test_learning_curve_bands_stay_inside_the_trials_steps():
+    """On a log axis a symmetric interval around a skewed mean reaches below one step; the
+    band is the trials' middle half, so it stays within the steps observed."""
+    trials = [[5000, 40, 20], [30, 20], [25, 20], [20]]
+    mean, low, high = figures.curve_band(trials, greedy=[20, 20, 20, 20])
+    arr = np.array([[5000, 40, 20], [30, 20, 20], [25, 20, 20], [20, 20, 20]], dtype=float)
+    assert np.allclose(mean, arr.mean(axis=0))
+    assert np.all(low >= arr.min(axis=0)) and np.all(high <= arr.max(axis=0))
+    assert low[0] == np.percentile(arr[:, 0], 25) and high[0] == np.percentile(arr[:, 0], 75)
+    t_low = mean[0] - 3.182 * arr[:, 0].std(ddof=1) / 2  # the old t-band: below zero here
+    assert t_low < 0 < low[0]

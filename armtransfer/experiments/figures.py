@@ -61,32 +61,38 @@ def learning_curves(
     curves: dict[str, list[list[int]]], title: str, path: str | os.PathLike, max_episodes: int = 200,
     greedy: dict[str, list[int | None]] | None = None,
 ) -> None:
-    """Steps per episode: the mean over ALL trials and its 95% confidence band, log scale.
+    """Steps per episode on a log scale: the mean over ALL trials, and a band holding the middle
+    half of the trials (their 25th to 75th percentile at each episode).
 
+    The band comes from the trials' own quantiles, so on the log axis it never leaves the range
+    of the steps observed (a symmetric interval around the mean would reach below one step).
     Every trial contributes to every episode, by ``learning_metrics.curve`` (the one
     definition the transfer metrics use too): after its last episode a converged trial
     counts its greedy path length (``greedy[label][i]``), an unconverged one its last
     episode. Without ``greedy`` a converged trial also counts its last episode. So late
     episodes are not an average of the slow trials only (no survivorship bias)."""
-    from armtransfer.experiments.metrics import t95
-
     fig, ax = plt.subplots(figsize=(7, 4))
     for label, trials in curves.items():
-        arr = _matrix(trials, (greedy or {}).get(label), max_episodes)
-        n = arr.shape[1]
-        eps = np.arange(1, n + 1)
-        mean = arr.mean(axis=0)
-        k = len(trials)
-        half = t95(k - 1) * arr.std(axis=0, ddof=1) / np.sqrt(k) if k > 1 else np.zeros(n)
-        ax.plot(eps, mean, label=f"{label} (mean of {k})")
-        ax.fill_between(eps, np.maximum(mean - half, 1.0), mean + half, alpha=0.25)
+        mean, low, high = curve_band(trials, (greedy or {}).get(label), max_episodes)
+        eps = np.arange(1, len(mean) + 1)
+        ax.plot(eps, mean, label=f"{label} (mean of {len(trials)})")
+        ax.fill_between(eps, low, high, alpha=0.25)
     ax.set_yscale("log")
     ax.set_xlabel("episode")
-    ax.set_ylabel("steps per episode (mean of all trials, 95% CI)")
+    ax.set_ylabel("steps per episode\n(line: mean of all trials; band: middle half)")
     ax.set_title(title)
     ax.legend()
     ax.grid(alpha=0.3)
     _save(fig, path)
+
+
+def curve_band(trials: list[list[int]], greedy: list[int | None] | None = None,
+               max_episodes: int = 200) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(mean, 25th percentile, 75th percentile) per episode of the curves
+    :func:`learning_curves` draws for one label."""
+    arr = _matrix(trials, greedy, max_episodes)
+    low, high = np.percentile(arr, [25, 75], axis=0)
+    return arr.mean(axis=0), low, high
 
 
 def curve_means(curves: dict[str, list[list[int]]], greedy: dict[str, list[int | None]] | None = None,
