@@ -1,4 +1,7 @@
+import fcntl
+import json
 import os
+from pathlib import Path
 
 # Offscreen rendering needs the GL backend chosen before mujoco is first imported.
 os.environ.setdefault("MUJOCO_GL", "egl")
@@ -19,11 +22,18 @@ SCARA_XML = """<mujoco model="my_scara"><compiler angle="radian"/><worldbody>
 """A bring-your-own 2-joint SCARA with its tip site named ``pen_tip``."""
 
 
+def run_dir(tmp_path_factory) -> Path:
+    """A folder all the run's xdist workers share (each worker's own basetemp is below it)."""
+    base = tmp_path_factory.getbasetemp()
+    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+
+
 @pytest.fixture(scope="session", autouse=True)
 def arm_cache(tmp_path_factory):
-    """Compiled arm robots go to one cache for the session, never the user's own."""
+    """Compiled arm robots go to one cache for the whole run, never the user's own: the
+    workers share it, and the cache's build lock makes each arm compile once per run."""
     mp = pytest.MonkeyPatch()
-    mp.setenv("ARMTRANSFER_CACHE", str(tmp_path_factory.getbasetemp() / "armcache"))
+    mp.setenv("ARMTRANSFER_CACHE", str(run_dir(tmp_path_factory) / "armcache"))
     yield
     mp.undo()
 
@@ -40,7 +50,13 @@ def reproduce_fast(tmp_path_factory):
     """One fast `armtransfer reproduce --trials 2` shared by the tests that read its output."""
     from armtransfer.cli import main
 
-    out = tmp_path_factory.mktemp("reproduce") / "rep"
-    # a lower step cap keeps the controls that never find the goal from dominating the time
-    code = main(["reproduce", "--trials", "2", "--max-total-steps", "2000000", "--out", str(out)])
-    return code, out
+    shared = run_dir(tmp_path_factory) / "reproduce"
+    (shared / "out").mkdir(parents=True, exist_ok=True)
+    out, done = shared / "out" / "rep", shared / "exit-code.json"  # rep alone in its folder
+    with open(shared / "lock", "a") as lock:  # the first worker runs it; the others wait, then read it
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not done.exists():
+            # a lower step cap keeps the controls that never find the goal from dominating the time
+            code = main(["reproduce", "--trials", "2", "--max-total-steps", "2000000", "--out", str(out)])
+            done.write_text(json.dumps(code))
+    return json.loads(done.read_text()), out

@@ -128,6 +128,24 @@ def test_cache_hits_misses_and_rebuilds(tmp_path, monkeypatch):
     assert arm_robot("planar2", "joint", cache=False).arm.cache == "off"
 
 
+
+def test_two_processes_that_want_one_arm_at_once_compile_it_once(tmp_path):
+    """The cache's build lock: the second process waits for the first, then loads its entry."""
+    import os
+    import subprocess
+    import sys
+
+    code = ("from armtransfer.tasks.arms import arm_robot\n"
+            "print(arm_robot('planar2', 'joint', progress=True).arm.cache)\n")
+    env = dict(os.environ, ARMTRANSFER_CACHE=str(tmp_path / "cache"))
+    procs = [subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    outs = [p.communicate(timeout=300) for p in procs]
+    assert [p.returncode for p in procs] == [0, 0], [err[-1000:] for _, err in outs]
+    assert sorted(out.strip() for out, _ in outs) == ["hit", "miss"]
+    assert sum(err.count("compiling planar2:joint") for _, err in outs) == 1
+    assert len(list((tmp_path / "cache").glob("*.npz"))) == 1
+
 BYO_ARM = """
 <mujoco model="my_scara"><compiler angle="radian"/>
   <worldbody>

@@ -6,15 +6,20 @@ is a SHA-256 over everything the result depends on (the arm's MJCF bytes, mounti
 model, workspace and the source of the compiling modules). Each file stores its full key
 and a checksum of its arrays; a file that cannot be read, has another key (stale) or a
 wrong checksum (corrupt) is rebuilt. Writes go to a temporary file that is then renamed
-over the entry (``os.replace``), so readers never see half a file.
+over the entry (``os.replace``), so readers never see half a file. A process that builds an
+entry holds its lock (:func:`building`), so processes that want the same entry at once (sweep
+workers, test workers, two runs) build it once: the others wait, then load it.
 """
 
 from __future__ import annotations
 
+import fcntl
 import hashlib
 import json
 import os
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -91,3 +96,16 @@ def save(name: str, key: str, arrays: dict[str, np.ndarray]) -> Path:
             os.unlink(tmp)
         raise
     return path
+
+
+@contextmanager
+def building(entry: Path) -> Iterator[None]:
+    """Hold the build lock of cache entry ``entry`` (a file ``<entry>.lock`` beside it) for as
+    long as the block runs; another process asking for the same lock waits until then."""
+    entry.parent.mkdir(parents=True, exist_ok=True)
+    with open(entry.with_name(entry.name + ".lock"), "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)

@@ -183,17 +183,25 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
     robot_name = f"{name}:{model.name}"
     status = "off"
     start = time.perf_counter()
-    arrays = None
-    if cache:
-        _check_cache_dir()
-        arrays, status = _cache.load(robot_name, key)
-    if arrays is None:
+
+    def build() -> dict[str, np.ndarray]:
         if progress:
             print(f"compiling {robot_name} ...", file=sys.stderr, flush=True)
-        scene = _scene(path, tool, mount, yaw, cell_size, layout)
-        arrays = _compile(scene, model, tip_down, step, progress)
-        if cache:
-            _cache.save(robot_name, key, arrays)
+        return _compile(_scene(path, tool, mount, yaw, cell_size, layout), model, tip_down, step, progress)
+
+    if not cache:
+        arrays = build()
+    else:
+        _check_cache_dir()
+        arrays, status = _cache.load(robot_name, key)
+        if arrays is None:
+            with _cache.building(_cache.entry_path(robot_name, key)):
+                meanwhile, again = _cache.load(robot_name, key)  # built by another process while we waited
+                if meanwhile is None:
+                    arrays = build()
+                    _cache.save(robot_name, key, arrays)
+                else:
+                    arrays, status = meanwhile, again
     seconds = time.perf_counter() - start
     dof = int(arrays["qpos"].shape[1])
     if "joint_step" in arrays:
