@@ -55,7 +55,7 @@ def run_methods(
         )
         for entry in summary.values():
             experiment.compact(entry)
-        optimal = len(fine.shortest_path(fine.start_state(start), goal)) - 1
+        optimal = fine.distance(fine.start_state(start), goal)
         out[t] = {"distance": optimal, "results": summary}
     return out
 
@@ -211,7 +211,7 @@ def oracle_markdown(coarse: DiscreteRobot, fine: DiscreteRobot, trials: int, see
             trials)
         st = metrics.exploration_stats(steps, config.max_total_steps)
         mean, ci = st["mean"], st["ci95"]
-        d = len(fine.shortest_path(fine.start_state(start), goal)) - 1
+        d = fine.distance(fine.start_state(start), goal)
         out[t] = {"mean": mean, "ci95": ci, "distance": d, "reached": st["reached"],
                   "mean_is_lower_bound": st["mean_is_lower_bound"]}
         cells.append(f"task {t}: {fmt_mean(st, 0)} {fmt_ci(ci, 0)} ({mean / d:.1f}x, reached {st['reached']}/{trials})")

@@ -6,7 +6,10 @@ stands for the paper's "NA".
 
 from __future__ import annotations
 
-TABLE_II = {
+Row = dict[str, float | None]
+
+
+TABLE_II: dict[int, Row] = {
     # task: A (no transfer), B (transfer), C (% improvement), D (transfer + mapping),
     #       E (% of mapped sequences in the final path), F (% improvement with mapping)
     1: {"A": 9777.80, "B": 5200.1, "C": 46.82, "D": 3152.4, "E": None, "F": None},
@@ -16,7 +19,7 @@ TABLE_II = {
 }
 """Table II: coarse (larger) -> fine robot, deterministic, 10 trials."""
 
-TABLE_V = {
+TABLE_V: dict[int, Row] = {
     # task: A (no transfer), B (transfer), C (% improvement), D (transfer + mapping),
     #       E (% improvement with mapping)
     1: {"A": 3365.89, "B": 331.89, "C": 90.14, "D": 371.0, "E": None},
@@ -26,7 +29,7 @@ TABLE_V = {
 }
 """Table V: fine (finer) -> coarse robot, deterministic, 10 trials."""
 
-TABLE_IV = {
+TABLE_IV: dict[str, Row] = {
     # row: distance of the transferred path, A (exploration steps with transfer),
     #      B (% improvement), C (greedy steps of the converged policy), D (% improvement of C)
     "no transfer": {"distance": None, "A": 7338.80, "B": None, "C": 104.4, "D": None},

@@ -20,6 +20,8 @@ What runs (every number with a 95% confidence interval over ``trials`` trials):
 
 from __future__ import annotations
 
+from typing import Any
+
 from collections.abc import Callable
 
 from armtransfer.tasks.catalog import TABLE_I
@@ -71,7 +73,7 @@ def _compare(
         "source": source,
         "target": target,
         "wind": wind,
-        "distance": len(tgt.shortest_path(tgt.start_state(start), goal)) - 1,
+        "distance": tgt.distance(tgt.start_state(start), goal),
         "trajectory_kind": kind,
         "trajectory_length": len(traj),
         "trajectory_cells": len(traj) * src.cell_step,
@@ -174,7 +176,7 @@ def run_all(
     out: dict = {"trials": trials, "seed": seed, "config": config.to_dict(),
                  "trajectory": trajectory, "mapping_from": mapping_from}
     both = ("none", "pseudo")
-    kw = dict(tick=tick, kind=trajectory)
+    kw: dict[str, Any] = dict(tick=tick, kind=trajectory)
     out["table_ii"] = {t: _compare(t, "coarse", "fine", both, trials, seed, config, **kw) for t in TASKS}
     out["table_v"] = {t: _compare(t, "fine", "coarse", both, trials, seed, config, **kw) for t in TASKS}
     out["wind"] = {
@@ -194,7 +196,7 @@ def run_all(
         _improve(r, base)
         r["greedy_improvement_percent"] = metrics.improvement_percent(base["greedy_mean"], r["greedy_mean"])
     out["table_iv"] = rows
-    mkw = dict(tick=tick, kind=trajectory, mapping_from=mapping_from)
+    mkw: dict[str, Any] = dict(tick=tick, kind=trajectory, mapping_from=mapping_from)
     out["mapping_coarse_fine"] = mapping_protocol("coarse", "fine", trials, seed, config, **mkw)
     _add_improvement(out["mapping_coarse_fine"], out["table_ii"])
     out["mapping_fine_coarse"] = mapping_protocol("fine", "coarse", trials, seed, config, **mkw)

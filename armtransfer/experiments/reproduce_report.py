@@ -291,7 +291,9 @@ def _ratio_sentence(protocol: dict, base: dict, where: str) -> str:
 
 def _vs_paper(rows: list[tuple[int, dict, float | None]]) -> tuple[list[int], list[int], list[int]]:
     """(tasks better than the paper, within CI, worse), from improvement CIs."""
-    better, same, worse = [], [], []
+    better: list[int] = []
+    same: list[int] = []
+    worse: list[int] = []
     for t, r, theirs in rows:
         v = _verdict(r.get("improvement_percent"), r.get("improvement_ci95"), theirs)
         {"as paper (within CI)": same, "better than paper": better, "**worse than paper**": worse}.get(v, []).append(t)

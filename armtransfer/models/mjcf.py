@@ -202,7 +202,7 @@ BUILT_IN = {
 
 # Home configurations of the spatial arms: the tip over the table centre, pointing down,
 # for the mounting in armtransfer/models/__init__.py (found with mink IK and rounded).
-HOMES = {
+HOMES: dict[str, list[float]] = {
     "ur5e_like": [-0.323, -1.293, 2.381, -2.66, -1.571, 0.148],
     "panda_like": [0.023, 0.417, -0.01, -2.656, 0.057, 3.073, 0.874],
 }

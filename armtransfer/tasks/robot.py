@@ -101,6 +101,13 @@ class DiscreteRobot:
             frontier = succ
         return seen
 
+    def distance(self, start: int, goal_cell: int) -> int:
+        """The fewest moves from state ``start`` to a state labelled ``goal_cell``."""
+        path = self.shortest_path(start, goal_cell)
+        if path is None:
+            raise InvalidCellError(f"{self.name} cannot reach cell {goal_cell} from state {start}")
+        return len(path) - 1
+
     def shortest_path(self, start: int, goal_cell: int) -> list[tuple[int, int]] | None:
         """Breadth-first shortest path from state ``start`` to any state labelled ``goal_cell``.
 
