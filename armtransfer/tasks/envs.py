@@ -35,16 +35,13 @@ class RobotRoomsEnv(gym.Env):
         goal_reward: float = 0.0,
         render_mode: str | None = None,
     ) -> None:
-        if not 0.0 <= wind <= 1.0:
-            raise InvalidParameterError(f"wind must be a probability in [0, 1], got {wind}")
+        check_wind(wind)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise InvalidParameterError(
                 f"unknown render_mode {render_mode!r}; valid: {', '.join(self.metadata['render_modes'])}")
         self.robot = robot
         self.task = task
-        start_cell, self.goal_cell = task.cells()
-        self.start_state = robot.start_state(start_cell)
-        robot.start_state(self.goal_cell, what="goal")  # the goal must be reachable by label
+        self.start_state, self.goal_cell = task_states(robot, task)
         self.wind = float(wind)
         self.step_reward = float(step_reward)
         self.goal_reward = float(goal_reward)
@@ -112,6 +109,26 @@ def grid_image(layout, robot_cell: int, goal_cell: int, cell_pixels: int = CELL_
     return np.ascontiguousarray(image)
 
 
+def check_wind(wind: float) -> None:
+    if not 0.0 <= wind <= 1.0:
+        raise InvalidParameterError(f"wind must be a probability in [0, 1], got {wind}")
+
+
+def task_states(robot: DiscreteRobot, task: Task) -> tuple[int, int]:
+    """(the robot's start state, the goal cell) of ``task``; a cell the robot cannot reach is a
+    one-line error."""
+    start_cell, goal_cell = task.cells()
+    start = robot.start_state(start_cell)
+    robot.start_state(goal_cell, what="goal")  # the goal must be reachable by label
+    return start, goal_cell
+
+
+def rooms_task(task: int | None = 1, start: tuple[int, int] | None = None,
+               goal: tuple[int, int] | None = None) -> Task:
+    """A Table I task, or the custom task from ``start`` to ``goal`` when both are given."""
+    return custom_task(start, goal) if start is not None and goal is not None else table_task(task)
+
+
 def make_rooms_env(
     task: int | None = 1,
     robot: str = "fine",
@@ -122,12 +139,24 @@ def make_rooms_env(
     """Entry point of ``armtransfer/Rooms-v0``: a grid robot on a Table I or custom task."""
     from armtransfer.tasks.grid_robots import grid_robot
 
-    the_task = custom_task(start, goal) if start is not None and goal is not None else table_task(task)
-    return RobotRoomsEnv(grid_robot(robot), the_task, **kwargs)
+    return RobotRoomsEnv(grid_robot(robot), rooms_task(task, start, goal), **kwargs)
 
 
-_ARM_OPTIONS = ("cell_size", "xml_path", "tip_site", "tip_body", "tip_offset", "arm_name", "base_pos", "base_yaw",
-                "joint_step", "cache")
+ARM_OPTIONS = ("cell_size", "xml_path", "tip_site", "tip_body", "tip_offset", "arm_name", "base_pos", "base_yaw",
+               "joint_step", "cache")
+"""The keywords of an arm environment that build its robot (the rest set up the task)."""
+
+
+def rooms_arm(arm: str | None, actions: str, options: dict[str, Any]) -> DiscreteRobot:
+    """The arm robot of an arm environment: a built-in ``arm`` (planar2 by default), or the arm
+    file ``xml_path=`` with its options; the robot's keywords (:data:`ARM_OPTIONS`) are taken
+    out of ``options``, the rest left for the task."""
+    from armtransfer.tasks.arms import arm_robot, parse_robot_spec
+
+    robot_kwargs = {k: options.pop(k) for k in ARM_OPTIONS if k in options}
+    if robot_kwargs.get("xml_path") is None:  # a built-in arm, planar2 by default
+        arm, actions = parse_robot_spec(f"{arm or 'planar2'}:{actions}")
+    return arm_robot(arm, actions, **robot_kwargs)
 
 
 def make_arm_rooms_env(arm: str | None = None, actions: str = "joint", task: int | None = 1,
@@ -136,10 +165,5 @@ def make_arm_rooms_env(arm: str | None = None, actions: str = "joint", task: int
     """Entry point of ``armtransfer/ArmRooms-v0``: an arm robot (compiled or loaded from the
     cache) on a Table I or custom task. Bring-your-own arms: ``xml_path=`` with ``tip_site=`` or
     ``tip_body=``, ``tip_offset=``, ``arm_name=``, ``base_pos=``/``base_yaw=`` (automatic without)."""
-    from armtransfer.tasks.arms import arm_robot, parse_robot_spec
-
-    robot_kwargs = {k: kwargs.pop(k) for k in _ARM_OPTIONS if k in kwargs}
-    if robot_kwargs.get("xml_path") is None:  # a built-in arm, planar2 by default
-        arm, actions = parse_robot_spec(f"{arm or 'planar2'}:{actions}")
-    the_task = custom_task(start, goal) if start is not None and goal is not None else table_task(task)
-    return RobotRoomsEnv(arm_robot(arm, actions, **robot_kwargs), the_task, **kwargs)
+    the_task = rooms_task(task, start, goal)  # a bad task fails before any compiling
+    return RobotRoomsEnv(rooms_arm(arm, actions, kwargs), the_task, **kwargs)
