@@ -49,8 +49,10 @@ def family(spec: str) -> str:
 
 
 def matrix_spec(robots: Sequence[str], tasks: Sequence[int], methods: Sequence[str], trials: int,
-                seeds: Sequence[int] = (0,), trajectory: str = "learned", name: str = "matrix") -> dict:
-    """The sweep of every ordered pair of ``robots`` (each robot to itself too)."""
+                seeds: Sequence[int] = (0,), trajectory: str = "learned", name: str = "matrix",
+                arms: dict | None = None) -> dict:
+    """The sweep of every ordered pair of ``robots`` (each robot to itself too); ``arms`` names
+    bring-your-own arms as a sweep file's ``[arms.NAME]`` tables do (``NAME[:ACTIONS]`` robots)."""
     robots = list(robots)
     if len(robots) < 2:
         raise InvalidParameterError("a matrix needs at least two robots")
@@ -63,12 +65,15 @@ def matrix_spec(robots: Sequence[str], tasks: Sequence[int], methods: Sequence[s
         raise InvalidParameterError("a matrix needs a transfer method beside 'none'")
     raw = {"sweep": {"name": name, "tasks": list(tasks), "pairs": [[s, t] for s in robots for t in robots],
                      "methods": methods, "seeds": list(seeds), "trials": trials, "trajectory": trajectory}}
+    if arms:
+        raw["arms"] = arms
     return sweeps.normalise(raw, where="matrix")
 
 
 def matrix_sweep(robots: Sequence[str], tasks: Sequence[int], methods: Sequence[str], trials: int,
-                 seeds: Sequence[int] = (0,), trajectory: str = "learned", name: str = "matrix") -> sweeps.Sweep:
-    spec = matrix_spec(robots, tasks, methods, trials, seeds, trajectory, name)
+                 seeds: Sequence[int] = (0,), trajectory: str = "learned", name: str = "matrix",
+                 arms: dict | None = None) -> sweeps.Sweep:
+    spec = matrix_spec(robots, tasks, methods, trials, seeds, trajectory, name, arms)
     return sweeps.Sweep(spec["name"], spec, tuple(sweeps.expand(spec)))
 
 
