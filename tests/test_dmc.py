@@ -61,7 +61,7 @@ class ShapedConformance(ConformanceChecks, unittest.TestCase):
     def make_object_under_test(self):
         plain = dmc.load(**ARM)
         task = plain.task
-        traj = trajectories.shortest(task.robot, task.task.cells()[0], task.goal_cell)
+        traj = trajectories.shortest(task.robot, task.start_cell, task.goal_cell)
         return dmc.load(**ARM, trajectory=traj, method="potential")
 
 
@@ -100,8 +100,7 @@ def test_an_episode_gives_the_gymnasium_envs_rewards_and_states(wind):
 
 def test_the_shaped_rewards_are_the_gymnasium_wrappers():
     plain = dmc.load(**ARM)
-    start, goal = plain.task.task.cells()
-    traj = trajectories.shortest(plain.task.robot, start, goal)
+    traj = trajectories.shortest(plain.task.robot, plain.task.start_cell, plain.task.goal_cell)
     for method in ("pseudo", "first-visit", "progress", "potential", "dense"):
         genv = TransferReward(gym.make("armtransfer/ArmRooms-v0", **ARM), traj, method=method, K="auto")
         denv = dmc.load(**ARM, trajectory=traj, method=method)

@@ -54,6 +54,11 @@ class RoomsTask(base.Task):
         return self._random
 
     @property
+    def start_cell(self) -> int:
+        """The shared cell the robot starts in."""
+        return int(self.robot.label[self.start_state])
+
+    @property
     def label(self) -> int:
         """The shared cell the robot is in."""
         return int(self.robot.label[self.state])
