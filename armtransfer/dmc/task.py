@@ -21,11 +21,11 @@ from dm_env import specs
 from armtransfer.errors import InvalidActionError, UnknownRobotError
 from armtransfer.ik.physics import ArmPhysics
 from armtransfer.tasks.catalog import Task
-from armtransfer.tasks.envs import check_wind, task_states
+from armtransfer.tasks.envs import RoomsRules
 from armtransfer.tasks.robot import DiscreteRobot
 
 
-class RoomsTask(base.Task):
+class RoomsTask(RoomsRules, base.Task):
     """Reach ``task``'s goal cell with ``robot`` (an arm robot) from its start cell.
 
     ``random``: the one ``numpy.random.Generator`` the wind draws from, or a seed for one
@@ -38,16 +38,9 @@ class RoomsTask(base.Task):
                  goal_reward: float = 0.0, random: int | np.random.Generator | None = None) -> None:
         if robot.arm is None:
             raise UnknownRobotError(f"robot {robot.name} is not an arm robot; a dm_control task needs ARM:ACTIONS")
-        check_wind(wind)
         super().__init__(random=0)  # base state (reward colours); the RandomState is replaced below
+        self._set_rules(robot, task, wind, step_reward, goal_reward)
         self._random = random if isinstance(random, np.random.Generator) else np.random.default_rng(random)
-        self.robot = robot
-        self.task = task
-        self.start_state, self.goal_cell = task_states(robot, task)
-        self.wind = float(wind)
-        self.step_reward = float(step_reward)
-        self.goal_reward = float(goal_reward)
-        self.state = self.start_state
 
     @property
     def random(self) -> np.random.Generator:
@@ -80,11 +73,7 @@ class RoomsTask(base.Task):
         super().initialize_episode(physics)  # runs after_step: the arm at the start state
 
     def before_step(self, action, physics: ArmPhysics) -> None:
-        a = self._action(action)
-        s = int(self.robot.next_state[self.state, a])
-        if self.wind > 0.0 and self._random.random() < self.wind:
-            s = int(self.robot.wind_state[s])
-        self.state = s
+        self._move(self._action(action), self._random)
 
     def after_step(self, physics: ArmPhysics) -> None:
         physics.set_configuration(self.robot.arm.qpos[self.state])
@@ -98,10 +87,10 @@ class RoomsTask(base.Task):
         )
 
     def get_reward(self, physics: ArmPhysics) -> float:
-        return self.step_reward + (self.goal_reward if self.label == self.goal_cell else 0.0)
+        return self._outcome()[0]
 
     def get_termination(self, physics: ArmPhysics) -> float | None:
-        return 0.0 if self.label == self.goal_cell else None
+        return 0.0 if self._outcome()[1] else None
 
     def _action(self, action) -> int:
         """The action as an index into the robot's action model; anything else is refused."""

@@ -21,7 +21,39 @@ from armtransfer.registration import register_envs  # noqa: F401  (kept importab
 from armtransfer.tasks.robot import DiscreteRobot
 
 
-class RobotRoomsEnv(gym.Env):
+class RoomsRules:
+    """The rules of a start/goal task for one discrete robot, shared by the Gymnasium
+    environment and the dm_control task (``armtransfer.dmc.task``): an action moves the robot
+    by its own transition table, wind then pushes it one cell towards +x with probability
+    ``wind``, every step costs ``step_reward`` and reaching the goal cell pays ``goal_reward``
+    and ends the episode."""
+
+    def _set_rules(self, robot: DiscreteRobot, task: Task, wind: float, step_reward: float,
+                   goal_reward: float) -> None:
+        check_wind(wind)
+        self.robot = robot
+        self.task = task
+        self.start_state, self.goal_cell = task_states(robot, task)
+        self.wind = float(wind)
+        self.step_reward = float(step_reward)
+        self.goal_reward = float(goal_reward)
+        self.state = self.start_state
+
+    def _move(self, action: int, rng: np.random.Generator) -> int:
+        """The robot's next state after ``action``, the wind drawn from ``rng``; it becomes the state."""
+        s = int(self.robot.next_state[self.state, action])
+        if self.wind > 0.0 and rng.random() < self.wind:
+            s = int(self.robot.wind_state[s])
+        self.state = s
+        return s
+
+    def _outcome(self) -> tuple[float, bool]:
+        """(the reward of the step that led to the current state, whether it is at the goal)."""
+        terminated = int(self.robot.label[self.state]) == self.goal_cell
+        return self.step_reward + (self.goal_reward if terminated else 0.0), terminated
+
+
+class RobotRoomsEnv(RoomsRules, gym.Env):
     """A start/goal task for one discrete robot, in the style of Gymnasium's toy_text."""
 
     metadata = {"render_modes": ["ansi", "rgb_array"], "render_fps": 4}
@@ -35,20 +67,13 @@ class RobotRoomsEnv(gym.Env):
         goal_reward: float = 0.0,
         render_mode: str | None = None,
     ) -> None:
-        check_wind(wind)
+        self._set_rules(robot, task, wind, step_reward, goal_reward)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise InvalidParameterError(
                 f"unknown render_mode {render_mode!r}; valid: {', '.join(self.metadata['render_modes'])}")
-        self.robot = robot
-        self.task = task
-        self.start_state, self.goal_cell = task_states(robot, task)
-        self.wind = float(wind)
-        self.step_reward = float(step_reward)
-        self.goal_reward = float(goal_reward)
         self.render_mode = render_mode
         self.observation_space = spaces.Discrete(robot.n_states)
         self.action_space = spaces.Discrete(robot.n_actions)
-        self.state = self.start_state
         self._snapshot = None
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
@@ -57,14 +82,9 @@ class RobotRoomsEnv(gym.Env):
         return int(self.state), {"label": int(self.robot.label[self.state])}
 
     def step(self, action):
-        s = int(self.robot.next_state[self.state, int(action)])
-        if self.wind > 0.0 and self.np_random.random() < self.wind:
-            s = int(self.robot.wind_state[s])
-        self.state = s
-        label = int(self.robot.label[s])
-        terminated = label == self.goal_cell
-        reward = self.step_reward + (self.goal_reward if terminated else 0.0)
-        return s, reward, terminated, False, {"label": label}
+        s = self._move(int(action), self.np_random)
+        reward, terminated = self._outcome()
+        return s, reward, terminated, False, {"label": int(self.robot.label[s])}
 
     def render(self):
         """``ansi``: a text map; ``rgb_array``: for an arm robot the arm drawn by MuJoCo
