@@ -134,6 +134,15 @@ def test_an_action_outside_the_spec_is_refused_in_one_line(action):
     assert isinstance(err.value, ArmTransferError)
 
 
+def test_the_wind_draws_from_the_injected_generator():
+    rng = np.random.default_rng(5)
+    env = dmc.load(**ARM, wind=1.0, random=rng)
+    assert env.task.random is rng
+    env.reset()
+    env.step(0)
+    assert rng.bit_generator.state != np.random.default_rng(5).bit_generator.state  # it drew
+
+
 def test_actions_of_the_spec_are_taken():
     env = dmc.load(**ARM)
     env.reset()
@@ -170,6 +179,8 @@ def test_an_episode_is_cut_after_step_limit_steps():
     (dict(arm="planar2", actions="swim"), "valid action models"),
     (dict(tip_sight="tip"), "unknown option 'tip_sight'; valid arm options:"),
     (dict(wind=2.0), "wind must be a probability"),
+    (dict(random="seven"), "random must be a numpy Generator, a seed"),
+    (dict(random=-1), "random must be a numpy Generator, a seed"),
     (dict(task=9), "task"),
     (dict(step_limit=0), "step_limit must be a positive integer"),
     (dict(environment_kwargs=dict(time_limit=3)), "unknown environment option 'time_limit'"),

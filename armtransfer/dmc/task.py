@@ -18,7 +18,7 @@ import numpy as np
 from dm_control.suite import base
 from dm_env import specs
 
-from armtransfer.errors import InvalidActionError, UnknownRobotError
+from armtransfer.errors import InvalidActionError, InvalidParameterError, UnknownRobotError
 from armtransfer.ik.physics import ArmPhysics
 from armtransfer.tasks.catalog import Task
 from armtransfer.tasks.envs import RoomsRules
@@ -40,6 +40,10 @@ class RoomsTask(RoomsRules, base.Task):
             raise UnknownRobotError(f"robot {robot.name} is not an arm robot; a dm_control task needs ARM:ACTIONS")
         super().__init__(random=0)  # base state (reward colours); the RandomState is replaced below
         self._set_rules(robot, task, wind, step_reward, goal_reward)
+        if not (random is None or isinstance(random, np.random.Generator)
+                or (isinstance(random, (int, np.integer)) and not isinstance(random, bool) and random >= 0)):
+            raise InvalidParameterError(f"random must be a numpy Generator, a seed (an integer >= 0) or None, "
+                                        f"got {random!r}")
         self._random = random if isinstance(random, np.random.Generator) else np.random.default_rng(random)
 
     @property
