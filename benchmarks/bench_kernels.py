@@ -40,7 +40,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 LEARNER_FOLDERS = ("armtransfer/learning", "transfer")
 """Where a revision keeps its learner: today's path, then the one before the move."""
-KERNEL_FILES = ("sarsa.py", "guide.py", "guide/")
+KERNEL_FILES = ("sarsa.py", "guide.py", "guide/")  # a revision's guide is one file or a package
 """The learner's compiled files, loaded as they were at the revision (a folder: all its files);
 every other import resolves to today's modules."""
 RENAMES = ((re.compile(r"\bfrom tasks\."), "from armtransfer.tasks."),

@@ -453,13 +453,13 @@ def learn(
 ) -> tuple[np.ndarray, list[int]]:
     """Run ``episodes`` episodes; returns (Q, steps per episode).
 
-    ``macros`` (a ``transfer.mapping.MacroTable``): at a state with a macro, when none is
+    ``macros`` (a ``learning.mapping.MacroTable``): at a state with a macro, when none is
     running, one draw u and the macro's target sequence runs when u < 1 - epsilon; its
     steps are ordinary steps; it is abandoned when a step is blocked (the robot did not move,
     observed after wind), and then the next
     action is epsilon-greedy without a macro draw.
 
-    ``guide`` (a ``transfer.guide.Guide``, method ``guided``): its model breaks the ties of
+    ``guide`` (a ``learning.guide.Guide``, method ``guided``): its model breaks the ties of
     epsilon-greedy (:class:`GuideModel`). ``trace``, when given, gets every state visited.
     """
     model = None if guide is None else GuideModel(guide, robot.n_states, robot.n_actions)

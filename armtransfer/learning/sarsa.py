@@ -11,21 +11,21 @@ Faithful to Algorithm 1:
   * delta = r + r'(s') + gamma Q(s', a') - Q(s, a), with Q(terminal, .) = 0;
     e(s, a) += 1 (accumulating); then for every (s, a): Q += alpha delta e; e *= gamma lambda.
   * The shaping term r' is the paper's pseudo reward i*K on reaching the i-th trajectory
-    state (``pseudo``), or one of the other methods in :mod:`transfer.rewards`.
+    state (``pseudo``), or one of the other methods in :mod:`armtransfer.learning.methods`.
 
 Method ``guided`` adds one step after every episode: value iteration over the pairs robot 2
-has tried, on the successors it observed (``transfer.guide.plan``); it draws nothing.
+has tried, on the successors it observed (``guide.planner``); it draws nothing.
 
 The first episode's path, its loops erased, is kept as ``TrialResult.first_path`` for the
 online action sequence mapping (``experiment.online_mapping``); it draws nothing.
 
 Sparse traces: only pairs with a non-zero trace are stored. A trace that decays below
 ``trace_cutoff`` is dropped; with ``trace_cutoff=0`` nothing is dropped until it underflows
-to 0, and the result is bit-for-bit the dense Algorithm 1 (``transfer.reference``), as a
+to 0, and the result is bit-for-bit the dense Algorithm 1 (``learning.reference``), as a
 test checks.
 
 The random stream, in the order it is drawn (the dense reference draws the same):
-  1. choosing an action at a state with a macro (``transfer.mapping``), when no macro is
+  1. choosing an action at a state with a macro (``learning.mapping``), when no macro is
      running: one draw u, the macro runs when u < 1 - epsilon. A running macro supplies
      its next action without a draw; it ends after its last action, or is abandoned when
      a step is blocked: the robot did not move, s' == s observed after wind (the robot
@@ -36,7 +36,7 @@ The random stream, in the order it is drawn (the dense reference draws the same)
   2. epsilon-greedy: one draw u; if u < epsilon one more draw picks the action as
      floor(u2 * n_actions); otherwise, when k > 1 actions tie for the largest Q, one more
      draw picks the floor(u2 * k)-th of them in index order;
-     With a guide (method ``guided``, ``transfer.guide``), in its exploration phase, the
+     With a guide (method ``guided``, ``learning.guide``), in its exploration phase, the
      largest value is that of Q(s, a) - weight * score(a) instead of Q, and the extra draw
      is made only when m > 1 actions tie for it, picking the floor(u2 * m)-th of them in
      index order (no other draw is added);
@@ -284,6 +284,7 @@ def _make_run_trial(with_guide: bool):
         Q, episode_steps, greedy_len, macro_steps_out = out.Q, out.episode_steps, out.greedy_len, out.macro_steps
         path_buf, prev_path, fp_states, fp_actions = out.path_buf, out.prev_path, out.fp_states, out.fp_actions
         n_states, n_actions = next_state.shape
+        q_flat = Q.reshape(n_states * n_actions)  # a view: the trace loop indexes pairs s * n_actions + a
         # the first episode's path with its loops erased (for the online action sequence mapping):
         # fp_states[0..fp_n-1], fp_actions[i] taken at fp_states[i]; fp_pos: a state's place in it
         fp_pos = np.full(n_states, -1, np.int64)
@@ -402,7 +403,7 @@ def _make_run_trial(with_guide: bool):
                 while k < n_tr:
                     pair = tr_sa[k]
                     e = tr_e[k]
-                    Q[pair // n_actions, pair % n_actions] += alpha * delta * e
+                    q_flat[pair] += alpha * delta * e
                     e *= decay
                     if e < cutoff or e == 0.0:
                         # drop: move the last trace into this slot
@@ -504,7 +505,7 @@ def learn(
     """Run one trial of SARSA(lambda) on ``robot`` from ``start_state`` to ``goal_cell``.
 
     ``shaping`` is a :class:`armtransfer.learning.shaping.Shaping` (None: no transfer); ``macros`` a
-    :class:`transfer.mapping.MacroTable` (None: no action sequence mapping); its attribute
+    :class:`armtransfer.learning.mapping.MacroTable` (None: no action sequence mapping); its attribute
     ``episodes`` (None: all) says in how many first episodes macros are offered. ``rng`` is
     the only source of randomness. ``guide_model``: what robot 2 learns with the guide, to learn
     into (``guide.new_model``) and read afterwards; None: a new one.
