@@ -11,7 +11,11 @@ import numpy as np
 
 from armtransfer.errors import InvalidParameterError
 from armtransfer.learning.guide import displacement, fill, planner, progress, tip
-from armtransfer.learning.guide.tip import tip_features, uses_tip
+from armtransfer.learning.guide.displacement import Displacement
+from armtransfer.learning.guide.fill import Fill
+from armtransfer.learning.guide.planner import Planner
+from armtransfer.learning.guide.progress import Progress
+from armtransfer.learning.guide.tip import TipModel, tip_features, uses_tip
 from armtransfer.learning.guide.params import (
     BLOCKED, EPISODES, FILL, FILL_COST, GIVE_UP, KNN, MEMORY, PLAN, PLAN_TOL, REACH, TIP, TIP_ANCHOR, TIP_NEAREST,
     TIP_ORDER, TIP_RIDGE, WEIGHT, WINDOW, Params,
@@ -47,11 +51,11 @@ class Guide(NamedTuple):
 class Model(NamedTuple):
     """What robot 2 learns during a trial, one record per mechanism (``new_model``)."""
 
-    displacement: displacement.Displacement
-    progress: progress.Progress
-    planner: planner.Planner
-    tip: tip.TipModel
-    fill: fill.Fill
+    displacement: Displacement
+    progress: Progress
+    planner: Planner
+    tip: TipModel
+    fill: Fill
 
 
 def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW, reach: float = REACH,
