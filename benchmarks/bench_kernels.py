@@ -2,13 +2,14 @@
 baseline of ``armtransfer bench`` moves by half within an hour here) cancels out.
 
     python benchmarks/bench_kernels.py                      # plain kernel against the guided one, no guide
-    python benchmarks/bench_kernels.py --against 0cd2902    # ... and against an older commit's kernel
+    python benchmarks/bench_kernels.py --against 7f3bd4f    # ... and against an older commit's kernel
+    python benchmarks/bench_kernels.py --against 7f3bd4f main  # ... and against several
     python benchmarks/bench_kernels.py --fast               # a smoke run
 
 Each round runs every contender on the same work, in turn: Table I task 1, the fine robot, no
 transfer, trials back to back until ``--steps`` steps (``armtransfer bench``'s measurement),
 seed = the round. Reported: each contender's median steps/s over the rounds and the median of
-the per-round ratios to the first. ``--against REV`` loads the learner's kernel (``sarsa.py`` and
+the per-round ratios to the first. ``--against REV ...`` loads the learner's kernel (``sarsa.py`` and
 its guide) as it was at git revision REV of this checkout, from ``armtransfer/learning/`` or, before
 the move, ``transfer/``, beside today's (a revision whose kernel takes other arguments than
 ``sarsa.learn`` gives them fails in one line).
@@ -61,10 +62,12 @@ def _git(*args: str) -> str:
 
 
 def load_revision(rev: str, where: Path):
-    """``sarsa`` of git revision ``rev``, with that revision's guide, as package ``rev_<rev>``
+    """``sarsa`` of git revision ``rev``, with that revision's guide, as package ``rev_<commit>``
     under ``where``. The learner is read from ``armtransfer/learning/`` or, for a revision before
     the move, ``transfer/``."""
-    tag = "rev_" + "".join(c for c in rev if c.isalnum())
+    tag = "rev_" + _git("rev-parse", "--short=12", f"{rev}^{{commit}}").strip()
+    if tag in sys.modules:
+        return sys.modules[f"{tag}.sarsa"]
     for folder in LEARNER_FOLDERS:
         names = _git("ls-tree", "-r", "--name-only", rev, "--", folder + "/").split()
         if f"{folder}/sarsa.py" in names:
@@ -115,7 +118,8 @@ def main(argv: list[str] | None = None) -> int:
     p = script.parser(__doc__)
     p.add_argument("--rounds", type=int, default=8)
     p.add_argument("--steps", type=int, default=1_000_000, help="steps per contender per round")
-    p.add_argument("--against", metavar="REV", help="also time the kernel of this git revision")
+    p.add_argument("--against", metavar="REV", nargs="+", default=[],
+                   help="also time the kernel of each of these git revisions")
     p.add_argument("--fast", action="store_true", help="a smoke run: 2 rounds of 20,000 steps")
     args = p.parse_args(argv)
     return script.run(_run, args)
@@ -128,9 +132,8 @@ def _run(args: argparse.Namespace) -> int:
     contenders = {"plain kernel (no guide compiled in)": sarsa.learn,
                   "guided kernel, run without a guide": guided_kernel_without_guide}
     with tempfile.TemporaryDirectory() as tmp:
-        if args.against:
-            old = load_revision(args.against, Path(tmp))
-            contenders[f"kernel at {args.against}"] = old.learn
+        for rev in args.against:
+            contenders[f"kernel at {rev}"] = load_revision(rev, Path(tmp)).learn
         for learn in contenders.values():  # compile or load every kernel outside the timing
             try:
                 measure(learn, 1_000, 0)
