@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -33,30 +34,37 @@ def _egreedy(q_row: np.ndarray, eps: float, rng: np.random.Generator) -> int:
     return ties[int(rng.random() * len(ties))]
 
 
+@dataclass
+class Effect:
+    """What the moves of one pair did to the label: summed displacement and their number."""
+
+    dx: float = 0.0
+    dy: float = 0.0
+    n: int = 0
+
+
 class Displacement:
     """``guide.displacement``, written out plainly: what each move did to the label, and its
     generalisation to untried pairs by the nearest states where the action was tried."""
 
     def __init__(self, g: Guide, n_actions: int):
         self.g = g
-        self.sums: dict[tuple[int, int], list[float]] = {}  # (s, a) -> [sum dx, sum dy, count]
+        self.sums: dict[tuple[int, int], Effect] = {}
         self.tried_at: list[list[int]] = [[] for _ in range(n_actions)]  # states, in order
         self.generalised: set[tuple[int, int]] = set()  # pairs whose effect is generalised
         self.moved: set[tuple[int, int]] = set()  # pairs seen to move at least once
 
     def record(self, s: int, a: int, s2: int) -> None:
         g = self.g
-        entry = self.sums.get((s, a))
-        if entry is None:
-            entry = self.sums[(s, a)] = [0.0, 0.0, 0]
+        effect = self.sums.setdefault((s, a), Effect())
         if s2 != s:
             self.moved.add((s, a))
         if (s2 != s or g.params.blocked) and (s, a) not in self.generalised:  # blocked: only if asked
             self.generalised.add((s, a))
             self.tried_at[a].append(s)
-        entry[0] += g.lxy[s2][0] - g.lxy[s][0]
-        entry[1] += g.lxy[s2][1] - g.lxy[s][1]
-        entry[2] += 1
+        effect.dx += g.lxy[s2][0] - g.lxy[s][0]
+        effect.dy += g.lxy[s2][1] - g.lxy[s][1]
+        effect.n += 1
 
     def recent(self, a: int) -> list[int]:
         """The most recent ``memory`` states a was tried at, in the kernel's ring-buffer slot order."""
@@ -85,16 +93,16 @@ class Displacement:
 
     def predict(self, s: int, a: int):
         if (s, a) in self.sums:
-            sx, sy, n = self.sums[(s, a)]
-            return sx / n, sy / n
+            e = self.sums[(s, a)]
+            return e.dx / e.n, e.dy / e.n
         near = self.nearest(s, a, self.g.params.knn)
         if not near:
             return None
         sx = sy = 0.0
         for u in near:
-            ex, ey, n = self.sums[(u, a)]
-            sx += ex / n
-            sy += ey / n
+            e = self.sums[(u, a)]
+            sx += e.dx / e.n
+            sy += e.dy / e.n
         return sx / len(near), sy / len(near)
 
 
@@ -279,20 +287,18 @@ class Planner:
 
     def __init__(self, g: Guide):
         self.g = g
-        self.successors: dict[tuple[int, int], list[list[int]]] = {}  # (s, a) -> [[s2, count], ...] first seen first
+        self.successors: dict[tuple[int, int], dict[int, int]] = {}  # (s, a) -> {s2: count}, first seen first
         self.preds: dict[int, list[int]] = {}  # s2 -> the states of the pairs it followed, first seen first
 
     def observe(self, s: int, a: int, s2: int) -> None:
-        seen = self.successors.setdefault((s, a), [])
-        for item in seen:
-            if item[0] == s2:
-                item[1] += 1
-                break
-        else:
-            if len(seen) >= guide_module.SUCCESSORS:
-                raise ValueError("more distinct successors of one move than the planner keeps")
-            seen.append([s2, 1])
-            self.preds.setdefault(s2, []).append(s)
+        seen = self.successors.setdefault((s, a), {})
+        if s2 in seen:
+            seen[s2] += 1
+            return
+        if len(seen) >= guide_module.SUCCESSORS:
+            raise ValueError("more distinct successors of one move than the planner keeps")
+        seen[s2] = 1
+        self.preds.setdefault(s2, []).append(s)
 
     def plan(self, Q: np.ndarray, label: np.ndarray, goal: int, config: LearnerConfig) -> None:
         tol = self.g.params.plan_tol
@@ -312,9 +318,9 @@ class Planner:
                 seen = self.successors.get((x, a))
                 if seen is None:
                     continue
-                n = sum(c for _, c in seen)
+                n = sum(seen.values())
                 total = 0.0
-                for y, c in seen:
+                for y, c in seen.items():
                     w = c / n
                     if label[y] == goal:
                         total += w * (config.step_reward + config.goal_reward)
@@ -408,7 +414,8 @@ class GuideModel:
                 if p is None:
                     v = np.inf
                 else:
-                    ha = progress.score(x + p[0], y + p[1])
+                    dx, dy = p
+                    ha = progress.score(x + dx, y + dy)
                     if filling and (s, a) in d.sums:
                         hu = fill.ahead(epoch, s, a)
                         if hu is not None:

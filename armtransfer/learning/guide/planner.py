@@ -47,8 +47,12 @@ class Planner(NamedTuple):
     """bool [S]: scratch, whether a state is in the queue."""
     has_pair: np.ndarray
     """bool [S]: the state has a tried pair."""
-    stats: np.ndarray
-    """int64 [3]: plannings, the most backups in one, plannings that hit the cap."""
+    plannings: np.ndarray
+    """int64 [1]: plannings so far."""
+    most_backups: np.ndarray
+    """int64 [1]: the most backups in one planning."""
+    capped: np.ndarray
+    """int64 [1]: plannings that hit the cap (``PLAN_CAP``)."""
 
 
 def new(n_states: int, n_actions: int) -> Planner:
@@ -58,7 +62,8 @@ def new(n_states: int, n_actions: int) -> Planner:
                    np.zeros(pairs, np.int64), np.full(n_states, -1, np.int64), np.full(n_states, -1, np.int64),
                    np.full(pairs * SUCCESSORS, -1, np.int64), np.zeros(pairs * SUCCESSORS, np.int64),
                    np.zeros(1, np.int64), np.zeros(n_states), np.zeros(n_states, np.int64),
-                   np.zeros(n_states, np.bool_), np.zeros(n_states, np.bool_), np.zeros(3, np.int64))
+                   np.zeros(n_states, np.bool_), np.zeros(n_states, np.bool_), np.zeros(1, np.int64),
+                   np.zeros(1, np.int64), np.zeros(1, np.int64))
 
 
 @numba.njit(cache=True)
@@ -158,11 +163,10 @@ def plan(g, pl, Q, label, goal, gamma, r_step, r_goal):
                     inq[p] = True
                     qn += 1
                 e = enext[e]
-    stats = pl.stats
-    stats[0] += 1
-    stats[1] = max(stats[1], backups)
+    pl.plannings[0] += 1
+    pl.most_backups[0] = max(pl.most_backups[0], backups)
     if qn > 0:
-        stats[2] += 1
+        pl.capped[0] += 1
     while qn > 0:  # the cap was hit: leave the queue empty for the next planning
         inq[queue[qh]] = False
         qh = (qh + 1) % n_states
