@@ -17,7 +17,7 @@ candidate's score is the mean first exposure / optimal distance of its worst rob
 issue's target is on the mean, which a rare long trial dominates). The grid GUIDED is
 searched first; then GIVE_UP with the best of it, taking the smallest value within 2% of
 never giving up. Chosen this way (8 pairs, 20 trials, seed 2026): weight 2, window 2,
-reach 1, knn 8, blocked moves generalised, give up after 100 moves (``transfer.guide``).
+reach 1, knn 8, blocked moves generalised, give up after 100 moves (``armtransfer.learning.guide.params``).
 They were chosen without the tip model and the grid runs without it, as then; ``guided-tip``
 then chooses the tip model's parameters with those in place (``select_tip``).
 """
@@ -83,9 +83,9 @@ def score(method: str, params: dict, pairs, trials: int) -> float:
 
 GUIDED = [{"weight": wt, "window": w, "reach": r, "knn": k, "blocked": b}
           for wt, w, r, k, b in itertools.product((1.0, 2.0, 3.0), (1.0, 2.0, 4.0), (1.0, 1.5), (3, 8), (False, True))]
-"""Candidates for method ``guided`` (transfer.guide: WEIGHT, WINDOW, REACH, KNN, BLOCKED)."""
+"""Candidates for method ``guided`` (armtransfer.learning.guide.params: WEIGHT, WINDOW, REACH, KNN, BLOCKED)."""
 GIVE_UP = (25, 50, 100, 200)
-"""Then transfer.guide.GIVE_UP, smallest first."""
+"""Then guide.params.GIVE_UP, smallest first."""
 GUIDED_PAIRS = [("coarse", "fine"), ("fine", "coarse"),
                 ("planar2:joint", "ur5e_like:cartesian"), ("ur5e_like:cartesian", "planar2:joint")]
 
@@ -181,7 +181,7 @@ def select_guided(pairs: int, trials: int, seed: int) -> None:
 
 TIP = [{"tip": False}] + [{"tip_anchor": an, "tip_ridge": r, "tip_nearest": k}
                           for an, r, k in itertools.product((False, True), (1e-3, 1e-2, 1e-1, 1.0), (1, 3, 8))]
-"""Candidates for the tip model of method ``guided`` (transfer.guide: TIP_ANCHOR, TIP_RIDGE,
+"""Candidates for the tip model of method ``guided`` (armtransfer.learning.guide.params: TIP_ANCHOR, TIP_RIDGE,
 TIP_NEAREST), chosen after the grid GUIDED; the first is the tip model off, the baseline."""
 
 
@@ -219,7 +219,7 @@ def select_tip(pairs: int, trials: int, seed: int) -> None:
     """The tip model's parameters, the other guided parameters at their defaults, on two held-out
     sets of each robot pair of GUIDED_PAIRS whose target moves its joints: its tasks of
     ``guided_held_out`` and those of ``unreachable_held_out``. A candidate's score is the worse
-    of its two means (transfer.guide: chosen this way, 8 pairs each, 20 trials, seed 2026)."""
+    of its two means (armtransfer.learning.guide.params: chosen this way, 8 pairs each, 20 trials, seed 2026)."""
     sets = tip_held_out(pairs, seed)
     for name, held in zip(("held-out", "held-out with unreachable cells"), sets):
         for key, (_, tasks) in held.items():
@@ -236,7 +236,7 @@ def select_tip(pairs: int, trials: int, seed: int) -> None:
 
 
 FILL = (0.0, 0.1, 0.25, 0.5, 1.0, 2.0)
-"""Candidates for the fill of method ``guided`` (transfer.guide.FILL_COST), 0 first (off), chosen
+"""Candidates for the fill of method ``guided`` (guide.params.FILL_COST), 0 first (off), chosen
 after the tip model's parameters on the same two held-out sets."""
 
 
