@@ -143,7 +143,7 @@ def run_method(
     def shaping_for(trajs):
         if not m.shaped:
             return None
-        if trajs is None:
+        if trajs is None and m.uses_trajectory:
             raise InvalidParameterError(f"method {method!r} needs a trajectory")
         k = K
         if m.farmable:  # the exact check: value iteration over this task ('auto' comes out verified)
@@ -398,7 +398,7 @@ def run_all(
     control trajectory. ``K`` is one K for every method or a dict of K per method. Returns the results in that order and, for ``mapping``, the mapping
     updated from this task's converged trials."""
     chosen = [methods.get(m) for m in method_names]
-    if any(m.shaped for m in chosen) and not trajs:
+    if any(m.shaped and m.uses_trajectory for m in chosen) and not trajs:
         raise InvalidParameterError("the transfer methods need a trajectory")
     if any(m.macros for m in chosen) and len(trajs) != 1:
         raise InvalidParameterError("method 'mapping' takes exactly one trajectory")

@@ -275,8 +275,8 @@ def check_k(method: str, robot: DiscreteRobot, start_state: int, goal_cell: int,
     mapping) returns :func:`auto_k`. The others are never farmable (see the module
     docstring) and get their own ``Method.resolve_k``.
     """
-    trajs = rewards.as_list(trajs)
     m = methods.get(method)
+    trajs = rewards.as_list(trajs) if m.uses_trajectory else []
     k = m.resolve_k(K, config.step_reward, trajs)  # the same input checks for every method
     if not m.farmable:
         return k
