@@ -130,7 +130,7 @@ def transfer(
         if registry.get(m).shaped:
             k_per_method[m] = farming.check_k(m, tgt, tgt.start_state(start_cell), goal_cell, trajs, K, config,
                                               wind)
-            registry.build_shaping(m, tgt, trajs, k_per_method[m], config.step_reward, beta=beta)
+            registry.build_shaping(m, tgt, trajs, k_per_method[m], config.step_reward, beta=beta, gamma=config.gamma)
 
     entries_before = 0 if mapping_obj is None else len(mapping_obj)
     runs, learned = experiment.run_all(

@@ -65,8 +65,9 @@ class TransferReward(gym.Wrapper, gym.utils.RecordConstructorArgs):
         self.robot = base.robot
         self.trajectories = [self._load(t) for t in _as_list(trajectory)]
         self.method = m.name
-        self.shaping = registry.build_shaping(m.name, self.robot, self.trajectories, K, base.step_reward, beta=beta)
         self.gamma = float(gamma)
+        self.shaping = registry.build_shaping(m.name, self.robot, self.trajectories, K, base.step_reward, beta=beta,
+                                              gamma=self.gamma)
         self.goal_cell = int(base.goal_cell)
         n_ids = int(self.shaping.traj_index.max()) + 1 if len(self.shaping.traj_index) else 1
         self._paid = np.full(max(n_ids, 1), -1, np.int64)

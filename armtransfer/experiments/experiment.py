@@ -148,7 +148,9 @@ def run_method(
         k = K
         if m.farmable:  # the exact check: value iteration over this task ('auto' comes out verified)
             k = farming.check_k(method, target, start_state, goal_cell, trajs, K, config, wind)
-        return methods.build_shaping(method, target, trajs, k, config.step_reward, beta=beta)
+        sh = methods.build_shaping(method, target, trajs, k, config.step_reward, beta=beta, gamma=config.gamma)
+        farming.check_self_loops(method, target, goal_cell, sh, config, wind)
+        return sh
 
     out = MethodResult(method, control=control)
     if callable(traj):  # each trial its own trajectories (the controls: one draw per trial)

@@ -19,12 +19,13 @@ no-transfer one first, and :func:`with_baselines` adds them to a list of methods
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from armtransfer.errors import InvalidParameterError
 from armtransfer.learning import guide, potentials
+from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning import shaping as modes
 from armtransfer.learning.rewards import as_list, farming_bound, longest_n, union_index
 from armtransfer.learning.shaping import Shaping
@@ -36,6 +37,9 @@ HALF_BOUND = 0.5
 """K='auto' of a method without its own ``auto_k`` starts at this fraction of the farming
 bound -step_reward/n (a farmable method's is then verified by value iteration, see
 ``armtransfer.learning.farming``)."""
+
+DEFAULT_GAMMA = LearnerConfig().gamma
+"""The discount :func:`build_shaping` bounds potentials for unless told the learner's."""
 
 Builder = Callable[[DiscreteRobot, list[Trajectory], float, float], Shaping]
 """(robot, trajectories, K, beta) -> the shaping arrays."""
@@ -247,11 +251,15 @@ def build_shaping(
     K: float | str | None,
     step_reward: float,
     beta: float | None = None,
+    gamma: float = DEFAULT_GAMMA,
 ) -> Shaping:
-    """The shaping arrays of ``method`` for ``robot`` from one or several trajectories.
+    """The shaping arrays of ``method`` for ``robot`` from one or several trajectories, for a
+    learner with discount ``gamma``.
 
     A farmable method (``pseudo``, ``mapping``) refuses a K with step_reward + n*K >= 0, at
-    which standing on the last trajectory cell pays at least as much as moving on."""
+    which standing on the last trajectory cell pays at least as much as moving on. A
+    potential-based method's potential is bounded for ``gamma`` (``potentials.bounded``), so
+    that none of its self-loops pays."""
     m = get(method)
     if not m.shaped:
         raise InvalidParameterError(f"method {method!r} has no shaping")
@@ -265,4 +273,7 @@ def build_shaping(
                 f"n*K = {n}*{k:g} >= 0; use K < {farming_bound(step_reward, trajs):.6g} "
                 f"(-step_reward/n) or the method 'first-visit'"
             )
-    return m.build(robot, trajs, k, potentials.DENSE_BETA if beta is None else float(beta))
+    sh = m.build(robot, trajs, k, potentials.DENSE_BETA if beta is None else float(beta))
+    if sh.mode == modes.MODE_POTENTIAL:
+        sh = replace(sh, phi=potentials.bounded(sh.phi, gamma, step_reward))
+    return sh
