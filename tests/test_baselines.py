@@ -10,7 +10,7 @@ import armtransfer
 from armtransfer.learning import guide, methods, sarsa
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.experiments import matrix
+from armtransfer.experiments import experiment, matrix
 from test_first_exposure import SMALL, assert_kernel_is_reference, small_task
 
 EXACT = LearnerConfig(trace_cutoff=0.0, max_episodes=6, patience=1000)
@@ -103,3 +103,20 @@ def test_pseudo_plan_is_the_pseudo_reward_on_plans_learner():
     assert pp.mode == pseudo.mode and np.array_equal(pp.bonus, pseudo.bonus)
     assert np.array_equal(pp.guide.params, plan.guide.params)
     assert methods.get("pseudo-plan").farmable  # the planner does not change what a loop earns
+
+
+def test_summaries_state_each_improvement_against_the_baselines_sharing_its_learner():
+    fine, coarse, start, goal = small_task()
+    traj = trajectories.shortest(coarse, start, goal)
+    config = LearnerConfig(max_episodes=30)
+    names = methods.with_baselines(["none", "dense", "guided"])
+    runs = [experiment.run_method(n, fine, start, goal, [traj], 4, 0, config) for n in names]
+    out = experiment.summarize(runs)
+    assert set(out["guided"]["improvement_against"]) == {"plan", "goal-only"}
+    assert set(out["dense"]["improvement_against"]) == {"none"}
+    assert out["dense"]["improvement_against"]["none"]["percent"] == out["dense"]["improvement_percent"]
+    assert out["none"]["improvement_against"] == {} and out["plan"]["improvement_against"] == {}
+    plan = np.array(out["plan"]["exploration_steps"], float)
+    guided = np.array(out["guided"]["exploration_steps"], float)
+    assert out["guided"]["improvement_against"]["plan"]["percent"] == pytest.approx(
+        100 * (1 - guided.mean() / plan.mean()))

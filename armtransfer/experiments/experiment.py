@@ -272,7 +272,11 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int 
     reached the goal counts at the step cap, ``cap`` (default: the steps its first episode
     ran before the cap stopped it, i.e. ``config.max_total_steps``), and the mean is then
     flagged as a lower bound. Improvements are paired (common random numbers,
-    ``trial_rng``) when the baseline has as many trials, else independent."""
+    ``trial_rng``) when the baseline has as many trials, else independent.
+
+    ``improvement_against`` holds, for every baseline that shares the method's learner
+    (``Method.baselines``, the no-transfer one first) and is among ``results``, the same
+    improvement measured against it: ``{name: {"percent", "ci95", "design"}}``."""
 
     def cap_of(r: MethodResult) -> int:
         if cap is not None:
@@ -296,6 +300,14 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int 
         imp = None
         if r.label != baseline and base is not None:
             imp = metrics.paired_improvement(base_ex, ex, c, paired=len(base_ex) == len(ex))
+        against = {}
+        known = methods.METHODS.get(r.method)  # None: a result made outside the registry
+        for name in known.baselines if known is not None else ():
+            if name in by_name and name != r.label:
+                b_ex = by_name[name].column("exploration_steps")
+                bc = max(cap_of(r), cap_of(by_name[name]))
+                d = metrics.paired_improvement(b_ex, ex, bc, paired=len(b_ex) == len(ex))
+                against[name] = {"percent": d["percent"], "ci95": d["ci95"], "design": d["design"]}
         entry = {
             "exploration_steps": ex,
             "mean": st["mean"],
@@ -310,6 +322,7 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int 
             "improvement_percent": None if imp is None else imp["percent"],
             "improvement_ci95": None if imp is None else imp["ci95"],
             "improvement_design": None if imp is None else imp["design"],
+            "improvement_against": against,
             "greedy_steps": greedy,
             "greedy_mean": g_mean,
             "greedy_ci95": g_ci,
