@@ -119,11 +119,11 @@ def draw_tasks(src, dst, n: int, seed: int, keep) -> list[tuple]:
     return tasks
 
 
-def guided_held_out(n: int, seed: int) -> dict:
-    """For each robot pair of GUIDED_PAIRS: n held-out start/goal pairs that both robots can
+def guided_held_out(n: int, seed: int, robot_pairs=GUIDED_PAIRS) -> dict:
+    """For each robot pair of ``robot_pairs``: n held-out start/goal pairs that both robots can
     do, at least 20 target steps apart, none a Table I task; with the source's shortest path."""
     out = {}
-    for src_name, dst_name in GUIDED_PAIRS:
+    for src_name, dst_name in robot_pairs:
         src, dst = _robot(src_name), _robot(dst_name)
 
         def keep(s, g, src=src):
@@ -140,14 +140,24 @@ def score_guided(params: dict, held: dict, trials: int, cap: int = 50_000) -> di
     from armtransfer.learning import guide
     from armtransfer.learning.shaping import MODE_NONE
 
+    def shaping_for(dst, traj):
+        gd = guide.build(dst, [traj], **{"give_up": 0, **params})  # give_up is chosen afterwards
+        n = dst.n_states
+        return Shaping(MODE_NONE, np.zeros(n), np.full(n, -1, np.int64), np.zeros(n), 0.0, guide=gd)
+
+    return score_per_pair(shaping_for, held, trials, cap)
+
+
+def score_per_pair(shaping_for, held: dict, trials: int, cap: int) -> dict:
+    """The mean over the held-out tasks and trials of first exposure / optimal distance per robot
+    pair (an unreached trial at the cap), with ``shaping_for(target, trajectory)``, and the worst
+    pair's under "all"."""
     config = LearnerConfig(max_episodes=1, max_total_steps=cap)
     per = {}
     for key, (dst, tasks) in held.items():
         ratios = []
         for s, g, traj, optimal in tasks:
-            gd = guide.build(dst, [traj], **{"give_up": 0, **params})  # give_up is chosen afterwards
-            n = dst.n_states
-            shaping = Shaping(MODE_NONE, np.zeros(n), np.full(n, -1, np.int64), np.zeros(n), 0.0, guide=gd)
+            shaping = shaping_for(dst, traj)
             runs = map_trials(lambda t: sarsa.learn(dst, dst.start_state(s), g, config, trial_rng(12345, t),
                                                     shaping=shaping), trials)
             ratios += [(res.exploration_steps or cap) / optimal for res in runs]
@@ -261,36 +271,23 @@ def score_bound(margin: float | None, held: dict, trials: int, cap: int = 300_00
     """``dense`` (its default K and beta) with its potential bounded at ``margin``: the mean over
     the held-out tasks and trials of first exposure / optimal distance per robot pair, an
     unreached trial at the cap, and the worst pair's."""
-    config = LearnerConfig(max_episodes=1, max_total_steps=cap)
-    per = {}
-    for key, (dst, tasks) in held.items():
-        ratios = []
-        for s, g, traj, optimal in tasks:
-            phi = potentials.dense(dst, traj)
-            if margin is not None:
-                phi = potentials.bounded(phi, config.gamma, config.step_reward, margin)
-            shaping = Shaping.potential(phi, potentials.DENSE_K)
-            runs = map_trials(lambda t: sarsa.learn(dst, dst.start_state(s), g, config, trial_rng(12345, t),
-                                                    shaping=shaping), trials)
-            ratios += [(res.exploration_steps or cap) / optimal for res in runs]
-        per[key] = float(np.mean(ratios))
-    per["all"] = max(per.values())
-    return per
+    config = LearnerConfig()
+
+    def shaping_for(dst, traj):
+        phi = potentials.dense(dst, traj)
+        if margin is not None:
+            phi = potentials.bounded(phi, config.gamma, config.step_reward, margin)
+        return Shaping.potential(phi, potentials.DENSE_K)
+
+    return score_per_pair(shaping_for, held, trials, cap)
 
 
 def select_bound(pairs: int, trials: int, seed: int) -> None:
     """potentials.LOOP_MARGIN on held-out tasks of BOUND_PAIRS (the source's shortest path as the
-    trajectory): the smallest worst-pair mean (chosen this way, 4 pairs, 5 trials, seed 2026)."""
-    held = {}
-    for src_name, dst_name in BOUND_PAIRS:
-        src, dst = _robot(src_name), _robot(dst_name)
-
-        def keep(s, g, src=src):
-            return None if src.shortest_path(src.start_state(s), g) is None else trajectories.shortest(src, s, g)
-
-        held[(src_name, dst_name)] = (dst, draw_tasks(src, dst, pairs, seed, keep))
-        print(f"bound held-out {src_name} -> {dst_name}:",
-              [(ROOMS.xy(s), ROOMS.xy(g)) for s, g, _, _ in held[(src_name, dst_name)][1]], flush=True)
+    trajectory): the smallest worst-pair mean (chosen this way, 8 pairs, 10 trials, seed 2026)."""
+    held = guided_held_out(pairs, seed, BOUND_PAIRS)
+    for key, (_, tasks) in held.items():
+        print(f"bound held-out {key[0]} -> {key[1]}:", [(ROOMS.xy(s), ROOMS.xy(g)) for s, g, _, _ in tasks])
     results = []
     for margin in BOUND:
         per = score_bound(margin, held, trials)
