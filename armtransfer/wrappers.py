@@ -34,7 +34,8 @@ class TransferReward(gym.Wrapper, gym.utils.RecordConstructorArgs):
     ``step_reward`` and ``goal_cell`` and reports the robot's state as its observation.
     ``trajectory``: a :class:`Trajectory`, a trajectory JSON file, or a list of them.
     ``gamma`` is the discount of the potential-based methods' F = gamma*phi(s') - phi(s):
-    set it to your learner's discount.
+    set it to your learner's discount (their potential is bounded for it, so that no move
+    that leaves the state unchanged pays; ``potentials.bounded``).
     """
 
     def __init__(self, env: gym.Env, trajectory: TrajectoryLike | Sequence[TrajectoryLike], method: str = "pseudo",

@@ -34,13 +34,14 @@ def guided_shaping(robot, trajs, **params):
     return replace(sh, guide=guide.build(robot, trajs, **params)) if params else sh
 
 
-def assert_kernel_is_reference(robot, start, goal, config, seed, shaping, wind=0.0) -> list[int]:
+def assert_kernel_is_reference(robot, start, goal, config, seed, shaping, wind=0.0, traj=None) -> list[int]:
     """The numba kernel and the dense reference (Algorithm 1 with the guide, written out plainly)
-    give the same episode lengths and the same Q, bit for bit; returns the episode lengths."""
+    give the same episode lengths and the same Q, bit for bit; returns the episode lengths.
+    ``traj``: the reference also pays the pseudo reward of this trajectory at ``shaping.K``."""
     s0 = robot.start_state(start)
     fast = sarsa.learn(robot, s0, goal, config, np.random.default_rng(seed), shaping=shaping, wind=wind, keep_q=True)
     Q, steps = reference.learn(robot, s0, goal, config, np.random.default_rng(seed), episodes=config.max_episodes,
-                               guide=shaping.guide, wind=wind)
+                               guide=shaping.guide, wind=wind, traj=traj, K=shaping.K if traj is not None else 0.0)
     assert fast.episode_steps.tolist() == steps
     assert np.array_equal(fast.Q, Q)
     return steps

@@ -49,8 +49,9 @@ class TransferTerm:
         self.robot = robot
         self.trajectories = [self._load(t) for t in _as_list(trajectory)]
         self.method = m.name
-        self.shaping = registry.build_shaping(m.name, robot, self.trajectories, K, step_reward, beta=beta)
         self.gamma = float(gamma)
+        self.shaping = registry.build_shaping(m.name, robot, self.trajectories, K, step_reward, beta=beta,
+                                              gamma=self.gamma)
         n_ids = int(self.shaping.traj_index.max()) + 1 if len(self.shaping.traj_index) else 1
         self._paid = np.full(max(n_ids, 1), -1, np.int64)
         self._episode = -1
