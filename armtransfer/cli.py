@@ -57,8 +57,6 @@ def _join_xy_values(argv: list[str]) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    # Offscreen rendering needs the GL backend chosen before mujoco is first imported.
-    os.environ.setdefault("MUJOCO_GL", "egl")
     argv = sys.argv[1:] if argv is None else list(argv)
     command = next((a for a in argv if a in COMMANDS), "")
     try:
