@@ -188,3 +188,27 @@ def test_a_render_that_fails_after_learning_keeps_everything_else(tmp_path, monk
     assert err.startswith("armtransfer arms: wrote the results, table and figures but not the video: ")
     assert "FatalError: an OpenGL platform library" in err
     _names_the_fix(err, "egl", "--no-video")
+
+
+@pytest.mark.rendering
+def test_opengl_failing_while_drawing_is_an_offscreen_error_and_leaves_nothing(tmp_path, monkeypatch):
+    import mujoco
+
+    from armtransfer.ik import render
+    from armtransfer.ik.replay import replay
+    from armtransfer.tasks.arms import robot
+    from armtransfer.tasks.layout import ROOMS
+
+    r = robot("planar2:cartesian")
+    path = r.shortest_path(r.start_state(ROOMS.free_cell(0, 0)), ROOMS.free_cell(2, 1))
+    rp = replay(r, [s for s, _ in path], segment_seconds=0.05, settle_seconds=0.0)
+
+    def lost(self, qpos):
+        raise mujoco.FatalError("gl error 0x505 (out of memory)")
+
+    monkeypatch.setattr(render.PanelRenderer, "render", lost)
+    with pytest.raises(offscreen.OffscreenError) as err:
+        render.render_rollouts([render.RolloutPanel(rp)], tmp_path / "v.gif", width=32, height=32)
+    assert "FatalError: gl error 0x505" in str(err.value) and "\n" not in str(err.value)
+    _names_the_fix(str(err.value), offscreen.imported_backend(), "draw nothing")
+    assert list(tmp_path.iterdir()) == []

@@ -34,6 +34,7 @@ import copy
 import math
 import numbers
 import os
+import sys
 import tempfile
 import time
 from dataclasses import dataclass, field
@@ -65,6 +66,15 @@ WITHOUT = "draw nothing (learning and replays need no OpenGL)"
 
 class RenderError(ArmTransferError):
     """A video cannot be made as asked (unknown format, bad size or fps)."""
+
+
+def gl_errors() -> tuple[type[BaseException], ...]:
+    """The exceptions by which MuJoCo and PyOpenGL say that OpenGL failed."""
+    errors: list[type[BaseException]] = [mujoco.FatalError]
+    pyopengl = sys.modules.get("OpenGL.error")  # imported by the GL backend, if any
+    if pyopengl is not None:
+        errors.append(pyopengl.Error)
+    return tuple(errors)
 
 
 def offscreen_renderer(model: mujoco.MjModel, height: int, width: int, max_geom: int,
@@ -397,6 +407,8 @@ def render_rollouts(panels: Sequence[RolloutPanel] | RolloutPanel, path: str | o
         encode_s += time.perf_counter() - t1
         os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, dest)
+    except gl_errors() as err:  # the context was made, then OpenGL failed drawing
+        raise offscreen.broken(err, without) from None
     except OSError as err:
         raise OutputError(f"cannot write {str(dest)!r}: {err.strerror or err}") from None
     finally:
