@@ -14,8 +14,12 @@ from __future__ import annotations
 
 import json
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from armtransfer.errors import ArmTransferError
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 EXTRA = "frames"
 COUNTS = ("exploration_steps", "total_steps", "greedy_steps", "episodes", "step_cap")
@@ -71,7 +75,7 @@ def trial_rows(method: str, control: str | None, per_trial: dict[str, Sequence],
     return rows
 
 
-def frame(rows: list[dict]):
+def frame(rows: list[dict]) -> "pd.DataFrame":
     """The rows as a DataFrame: :data:`LEAD` columns first, counts as nullable integers."""
     pd = pandas()
     df = pd.DataFrame.from_records(rows)

@@ -14,6 +14,7 @@ result shows the table ``armtransfer rooms`` prints.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from armtransfer.experiments import frames, report
 from armtransfer.experiments.experiment import MethodResult, summary_of
@@ -22,6 +23,9 @@ from armtransfer.learning.mapping import ActionMapping
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.catalog import Task
 from armtransfer.tasks.robot import DiscreteRobot
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 @dataclass(frozen=True)
@@ -100,7 +104,7 @@ class TransferResult:
         """The summary entries of :meth:`runs`, in that order."""
         return [*out["results"].values(), *(e for by in out["controls"].values() for e in by.values())]
 
-    def to_frame(self):
+    def to_frame(self) -> "pd.DataFrame":
         """A tidy pandas DataFrame: one row per trial of every method and control (``control``
         names it, None for the real trajectory), every per-trial metric a column (exploration,
         total and greedy steps, convergence, episodes, the K used, Taylor and Stone's transfer

@@ -15,10 +15,14 @@ import fcntl
 import os
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from armtransfer.errors import ArmTransferError
 from armtransfer.io import OutputError, parse_json_bytes, write_json_atomic
 from armtransfer.experiments.sweep import Sweep
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 STORE_FORMAT = "armtransfer-store/1"
 LOCK = ".lock"
@@ -168,7 +172,7 @@ class ResultStore:
                 out.append(rec)
         return out
 
-    def to_frame(self):
+    def to_frame(self) -> "pd.DataFrame":
         """Every finished trial as a tidy pandas DataFrame (a matrix's store too): one row per
         trial of each run, its per-trial metrics (exploration, total and greedy steps,
         convergence, episodes, the K used, the step cap a trial that never reached the goal is
