@@ -5,6 +5,12 @@ search), its trajectory of (cell, action index) is transferred, the target arm l
 each method; then the results, a Table II-style table, learning curves, a top-down map and
 a physics-replay video of both arms go into one output directory.
 
+The video needs offscreen OpenGL: before anything is compiled or learned the command checks
+that a backend works here (``armtransfer.ik.offscreen``) and stops in one line naming the
+system packages to install and ``--no-video`` when none does. A render that fails after the
+learning anyway costs the video only: the results, table and figures are written, one line
+says the video was not, and the exit code is 1.
+
 Nothing half-written is left as if complete: every output is first written into a hidden
 temporary directory beside ``--out``, which is renamed into place only when all of them are.
 """
@@ -13,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import datetime as _dt
+import sys
 import time
 from pathlib import Path
 
@@ -84,12 +91,17 @@ def run(args: argparse.Namespace) -> int:
 
         video_format(args.render, None)
     common.check_arm_flags(args)
+    renders = not args.no_video or bool(args.render)
+    if renders:  # before anything is compiled or learned: a machine without OpenGL is told what to install
+        from armtransfer.ik import offscreen
+
+        offscreen.require(_without(args))
     with common.phase("compiling arms"):  # before anything is written: a bad arm writes nothing
         options = arm_options(args)
         source = resolve(args.source, xml_path=args.arm_xml, progress=common.interactive(), **options)
         target = resolve(args.target, xml_path=args.arm_xml, progress=common.interactive(), **options)
         scenes: dict = {}  # the checked scenes, rendered from: each is built once
-        if not args.no_video or args.render:  # a replay that cannot be made fails now, not after learning
+        if renders:  # a replay that cannot be made fails now, not after learning
             from armtransfer.ik.replay import check_replayable
 
             for robot in (source, target):
@@ -105,9 +117,30 @@ def run(args: argparse.Namespace) -> int:
             if target.suffix.lower() == tmp_video.suffix.lower():
                 copy_atomic(tmp_video, target)
             else:
-                _video(result, args, target, scenes)
+                result["no_video"] = _try_video(result, args, target, scenes)
     print(f"wrote {out}/ ({', '.join(sorted(p.name for p in out.iterdir()))}) in {time.perf_counter() - t0:.0f} s")
+    if result["no_video"]:
+        print(f"armtransfer arms: wrote the results, table and figures but not the video: {result['no_video']}",
+              file=sys.stderr)
+        return 1
     return 0
+
+
+def _without(args: argparse.Namespace) -> str:
+    """How this run goes on without OpenGL."""
+    return "run with --no-video" + (" and without --render" if args.render else "")
+
+
+def _try_video(result: dict, args, path: Path, scenes: dict | None) -> str | None:
+    """Render the video to ``path``; None when written, else why not (the render failed after
+    the learning, e.g. the GL context could not be made, and the run keeps everything else)."""
+    from armtransfer.ik.offscreen import OffscreenError
+
+    try:
+        result["stats"] = _video(result, args, path, scenes)
+    except OffscreenError as err:
+        return str(err)
+    return None
 
 
 def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target: DiscreteRobot,
@@ -140,10 +173,12 @@ def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target
     traj_xy = [list(ROOMS.xy(c)) for c in paths["trajectory_cells"]] + [list(out_json["task"]["goal"])]
     figures.mapping_paths(ROOMS.wall_mask, ROOMS.lo, traj_xy, paths["target_xy"] or traj_xy, [],
                           f"{source.name} (dashed) -> {target.name} (solid)", tmp / "map.png")
-    video = None
+    video, no_video = None, None
     if not args.no_video:
-        video = "rollout.mp4"
-        stats = _video({"paths": paths, "source": source, "target": target}, args, tmp / video, scenes)
+        rendered = {"paths": paths, "source": source, "target": target}
+        no_video = _try_video(rendered, args, tmp / "rollout.mp4", scenes)
+    if not args.no_video and no_video is None:
+        video, stats = "rollout.mp4", rendered["stats"]
         # results.json stays the same for the same seed: wall-clock timings go to timings.json
         out_json["rollout"] = {k: v for k, v in stats.items() if k not in TIMINGS} | {"video": str(final / video)}
         write_json_atomic(tmp / "timings.json", {"rollout": {k: stats[k] for k in TIMINGS if k in stats}})
@@ -151,7 +186,8 @@ def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target
         for label, rp in zip(("source", "target"), stats["replays"]):
             print(f"replay {label}: largest tip deviation {rp['max_deviation_cells']:.2f} cell, "
                   f"reached the goal cell: {'yes' if rp['reached_goal'] else 'no'}")
-    return {"json": out_json, "video": video, "paths": paths, "source": source, "target": target}
+    return {"json": out_json, "video": video, "paths": paths, "source": source, "target": target,
+            "no_video": no_video}
 
 
 def arm_json(robot: DiscreteRobot) -> dict:
@@ -219,7 +255,7 @@ def _video(result: dict, args, path: Path, scenes: dict | None = None) -> dict:
             [(result["source"], paths["source_states"]), (result["target"], paths["target_states"])],
             path, trajectory_cells=paths["trajectory_cells"], goal_cell=paths["goal"],
             width=size[0], height=size[1], fps=fps,
-            scenes=[(scenes or {}).get(id(result[k])) for k in ("source", "target")],
+            scenes=[(scenes or {}).get(id(result[k])) for k in ("source", "target")], without=_without(args),
         )
 
 

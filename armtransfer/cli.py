@@ -1,4 +1,5 @@
-"""The ``armtransfer`` command: one subcommand per module in ``armtransfer/commands``.
+"""The ``armtransfer`` command: a subcommand per job, each defined by a module of
+``armtransfer.commands`` (``add_arguments``, ``run``, a one-sentence ``HELP`` and an ``EXAMPLE``).
 
 Every error a user can cause is an ``ArmTransferError`` (or an argparse error) and ends as
 one line on stderr with exit code 2; anything else is a bug and keeps its traceback.
@@ -8,8 +9,8 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import os
 import sys
+import textwrap
 
 from armtransfer import script as _script
 from armtransfer.script import OneLineParser as _Parser  # a usage error is one line
@@ -27,13 +28,34 @@ COMMANDS = {
 }
 
 
+DESCRIPTION = ("Transfer learning between robots that cannot imitate each other: a robot that solved a task "
+               "hands over its trajectory, and a robot with other actions learns the task faster with it.")
+
+
+def command_list(modules: dict) -> str:
+    """The commands, what each is for and one example each, for the top-level help."""
+    width = max(map(len, modules)) + 4
+    lines = ["commands:"]
+    for name, module in modules.items():
+        text = textwrap.wrap(module.HELP, 88 - width)
+        lines += [f"  {name:<{width - 2}}{text[0]}", *(" " * width + t for t in text[1:]),
+                  " " * width + f"e.g. {module.EXAMPLE}"]
+    return "\n".join(lines)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="armtransfer", description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    from armtransfer import __version__
+
+    modules = {name: importlib.import_module(f"armtransfer.commands.{module}") for name, module in COMMANDS.items()}
+    parser = _Parser(prog="armtransfer", usage="%(prog)s [-h] [--version] COMMAND ...", description=f"{textwrap.fill(DESCRIPTION, 88)}\n\n{command_list(modules)}",
+                     epilog="'armtransfer COMMAND --help' lists a command's options.",
+                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"armtransfer {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser, help=argparse.SUPPRESS)
     sub.required = True
-    for name, module_name in COMMANDS.items():
-        module = importlib.import_module(f"armtransfer.commands.{module_name}")
-        p = sub.add_parser(name, help=module.HELP, description=module.HELP)
+    for name, module in modules.items():
+        p = sub.add_parser(name, description=module.HELP, epilog=f"example:\n  {module.EXAMPLE}",
+                           formatter_class=argparse.RawDescriptionHelpFormatter)
         module.add_arguments(p)
         p.set_defaults(_run=module.run)
     return parser
@@ -57,8 +79,6 @@ def _join_xy_values(argv: list[str]) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    # Offscreen rendering needs the GL backend chosen before mujoco is first imported.
-    os.environ.setdefault("MUJOCO_GL", "egl")
     argv = sys.argv[1:] if argv is None else list(argv)
     command = next((a for a in argv if a in COMMANDS), "")
     try:
@@ -81,7 +101,7 @@ def _main(argv: list[str]) -> int:
 
 
 def run() -> None:
-    """The console script and ``python -m armtransfer.cli``: ``main``, then exit with its code
+    """The console script and ``python -m armtransfer``: ``main``, then exit with its code
     (``script.exit_with``: quiet when stdout's reader goes away; 130 after Ctrl-C)."""
     _script.exit_with(main)
 

@@ -10,7 +10,9 @@ map.png and rollout.mp4 (both arms replayed in MuJoCo physics, rendered offscree
     python scripts/transfer_arms.py --fast          # a quick smoke run
     python scripts/transfer_arms.py --source planar3:joint --target panda_like:cartesian --task 3
 
-Every option of `armtransfer arms` works here (see --help).
+Every option of `armtransfer arms` works here (see --help). The video needs offscreen OpenGL
+(EGL or OSMesa, see docs/setup.md); where neither works the script says what to install
+before it learns anything, and --no-video runs everything but the video.
 """
 
 import sys

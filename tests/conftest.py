@@ -3,10 +3,11 @@ import json
 import os
 from pathlib import Path
 
-# Offscreen rendering needs the GL backend chosen before mujoco is first imported.
-os.environ.setdefault("MUJOCO_GL", "egl")
+import pytest
 
-import pytest  # noqa: E402
+# Offscreen rendering needs the GL backend named before mujoco is first imported (by a test
+# module, at collection): armtransfer.ik names EGL unless MUJOCO_GL is set.
+from armtransfer.ik import offscreen
 
 SCARA_XML = """<mujoco model="my_scara"><compiler angle="radian"/><worldbody>
   <body name="upper" pos="0.05 0.02 0.15">
@@ -20,6 +21,31 @@ SCARA_XML = """<mujoco model="my_scara"><compiler angle="radian"/><worldbody>
     </body>
   </body></worldbody></mujoco>"""
 """A bring-your-own 2-joint SCARA with its tip site named ``pen_tip``."""
+
+
+RENDER_WITHOUT = "deselect the tests that render with -m 'not rendering'"
+
+
+def pytest_configure(config):
+    """With MUJOCO_GL unset, find the backend that works here (EGL, else OSMesa) before any
+    test module imports mujoco; the tests marked ``rendering`` are skipped when none does."""
+    if offscreen.named() is None:
+        try:
+            offscreen.require(RENDER_WITHOUT)
+        except offscreen.OffscreenError:
+            pass  # pytest_collection_modifyitems skips the tests that render, saying why
+
+
+def pytest_collection_modifyitems(config, items):
+    rendering = [item for item in items if item.get_closest_marker("rendering")]
+    if not rendering:
+        return
+    try:
+        offscreen.require(RENDER_WITHOUT)
+    except offscreen.OffscreenError as err:
+        skip = pytest.mark.skip(reason=f"no offscreen OpenGL backend works here: {err}")
+        for item in rendering:
+            item.add_marker(skip)
 
 
 def run_dir(tmp_path_factory) -> Path:

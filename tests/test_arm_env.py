@@ -40,6 +40,7 @@ def test_unknown_arm_is_a_one_line_error():
         gym.make("armtransfer/ArmRooms-v0", arm="puma", actions="joint")
 
 
+@pytest.mark.rendering
 @pytest.mark.parametrize("arm, actions", [("planar2", "joint"), ("ur5e_like", "cartesian")])
 def test_rgb_array_draws_the_arm_and_passes_check_env(arm, actions):
     env = gym.make("armtransfer/ArmRooms-v0", arm=arm, actions=actions, task=1, render_mode="rgb_array")

@@ -20,6 +20,7 @@ def fast_run(tmp_path_factory):
     return code, out
 
 
+@pytest.mark.rendering
 def test_fast_mode_writes_every_output_file(fast_run):
     code, out = fast_run
     assert code == 0
@@ -41,6 +42,7 @@ def test_fast_mode_writes_every_output_file(fast_run):
     assert not list(out.parent.glob(".*.tmp"))  # the temporary directory was renamed away
 
 
+@pytest.mark.rendering
 def test_same_seed_same_results_byte_for_byte(fast_run, tmp_path):
     """Timings and temporary paths stay out of results.json, so a re-run gives the same bytes
     (but for the output directory it names as the video's place)."""

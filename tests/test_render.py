@@ -90,6 +90,7 @@ def test_polyline_distance():
     np.testing.assert_allclose(d, [1.0, 1.0, 1.0])
 
 
+@pytest.mark.rendering
 def test_frame_shape_not_blank_and_arm_moves(replays):
     rp = replays["ur5e_like:cartesian"]
     q = rp.frames_qpos(30)
@@ -102,6 +103,7 @@ def test_frame_shape_not_blank_and_arm_moves(replays):
     assert moved.mean() > 0.005  # the arm's pixels moved between start and end
 
 
+@pytest.mark.rendering
 @pytest.mark.parametrize("suffix", [".mp4", ".gif"])
 def test_video_decodes_with_expected_frames(replays, tmp_path, suffix):
     import imageio.v3 as iio
@@ -120,6 +122,7 @@ def test_video_decodes_with_expected_frames(replays, tmp_path, suffix):
     assert [p.name for p in tmp_path.iterdir()] == [out.name]  # no temp file left
 
 
+@pytest.mark.rendering
 def test_rollout_video_report(robots, tmp_path):
     r = robots["planar2:cartesian"]
     states, g = _path(r)
@@ -134,6 +137,7 @@ def test_rollout_video_report(robots, tmp_path):
     assert rep["replays"][0]["max_deviation_cells"] < 0.75
 
 
+@pytest.mark.rendering
 def test_rollout_video_renders_from_a_scene_it_is_given(robots, tmp_path, monkeypatch):
     from armtransfer.ik import replay as replay_module
     from armtransfer.ik.replay import check_replayable
@@ -196,6 +200,7 @@ def test_output_is_a_directory(replays, tmp_path):
         render_rollouts([RolloutPanel(replays["planar2:cartesian"])], tmp_path / "d.mp4")
 
 
+@pytest.mark.rendering
 def test_failed_render_leaves_no_temp_file(replays, tmp_path, monkeypatch):
     import armtransfer.ik.render as render
 

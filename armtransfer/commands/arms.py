@@ -7,8 +7,9 @@ import argparse
 
 from armtransfer.commands import common
 
-HELP = ("transfer a trajectory from one arm to another (default: planar2:joint -> ur5e_like:cartesian, "
-        "task 1); 'arms list' lists the arm robots; 'arms generate' draws arms from a family")
+HELP = ("Transfer a trajectory from one MuJoCo arm to another; write results, table, figures and a rollout video "
+        "('arms list' lists the arms, 'arms generate' draws new ones).")
+EXAMPLE = "armtransfer arms --fast --out runs/demo"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

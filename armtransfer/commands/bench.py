@@ -17,7 +17,8 @@ from armtransfer.learning import sarsa
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.io import check_writable, write_json_atomic
 
-HELP = "Measure the learner's steps per second on task 1 without transfer (median of repeats)."
+HELP = "Measure how many learning steps per second the learner runs on this machine."
+EXAMPLE = "armtransfer bench --repeats 3"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

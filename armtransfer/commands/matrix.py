@@ -17,7 +17,8 @@ from armtransfer.io import write_bytes_atomic, write_json_atomic, write_text_ato
 from armtransfer.experiments import matrix
 from armtransfer.experiments.store import ResultStore
 
-HELP = "Run every ordered source -> target pair of the robots (a robot to itself too) and draw the matrix."
+HELP = "Measure which robots help which: every ordered source -> target pair of a set of robots, as a heatmap."
+EXAMPLE = "armtransfer matrix --robots coarse,fine --tasks 1 --trials 5 --out runs/matrix"
 
 
 def _task_list(text: str) -> list[int]:

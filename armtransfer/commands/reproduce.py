@@ -21,7 +21,8 @@ from armtransfer.learning.mapping import ActionMapping
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.layout import ROOMS
 
-HELP = "Reproduce the paper's tables and figures on the rooms world; writes report.md."
+HELP = "Reproduce the paper's tables and figures on the rooms world into one report.md."
+EXAMPLE = "armtransfer reproduce --trials 5 --out runs/paper"
 
 NAMES = {"fig3": "fig3_layout.png", "fig4": "fig4_coarse_to_fine.png", "fig5": "fig5_fine_to_coarse.png",
          "fig6": "fig6_wind.png", "fig7": "fig7_mapping.png", "methods": "fig_methods.png"}

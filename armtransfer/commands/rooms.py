@@ -9,7 +9,9 @@ from armtransfer.commands import common
 from armtransfer.io import check_writable, write_json_atomic
 from armtransfer.experiments import experiment, report
 
-HELP = "Transfer a trajectory from one grid robot to another in the rooms world (Table II style)."
+HELP = ("Transfer a trajectory between two grid robots of the paper's rooms world and print its "
+        "Table II-style table.")
+EXAMPLE = "armtransfer rooms --task 2 --trials 5"
 
 
 def add_arguments(p: argparse.ArgumentParser, source: str = "coarse", target: str = "fine") -> None:
@@ -34,26 +36,14 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def results_table(out: dict) -> str:
-    """The methods, then their control runs, as one Table II-style table."""
-    rows = dict(out["results"])
-    for kind, by in out.get("controls", {}).items():
-        rows.update({f"{m} [{kind}]": entry for m, entry in by.items()})
-    return report.method_table(rows)
+results_table = report.transfer_table
 
 
 def print_results(out: dict) -> None:
-    t = out["task"]
-    print(
-        f"{t['name']}: {tuple(t['start'])} -> {tuple(t['goal'])}, {out['source']} -> {out['target']}, "
-        f"target's optimal distance {out['distance']}, {out['trials']} trials, seed {out['seed']}"
-        + (f", wind {out['wind']}" if out["wind"] else "")
-    )
+    print(report.transfer_heading(out))
     print(results_table(out))
     if out.get("controls"):
-        print("[shuffled] and [random] are controls: the same method given the trajectory's cells in a "
-              "random order, or a random walk of the source robot of the same length, a new draw each "
-              "trial, neither ending at the task's goal.")
+        print(report.CONTROLS_NOTE)
     info = out["mapping"]
     if info is not None:
         if info["macro_states"] == 0:

@@ -9,7 +9,8 @@ from armtransfer.io import write_json_atomic, write_text_atomic
 from armtransfer.experiments.store import ResultStore
 from armtransfer.experiments.summary import plot, summarize, summary_markdown
 
-HELP = "Summarize a sweep directory: summary.md, summary.json and summary.png."
+HELP = "Turn a result store into tables and a plot: summary.md, summary.json and summary.png."
+EXAMPLE = "armtransfer summarize runs/quick"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

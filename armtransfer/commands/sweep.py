@@ -14,7 +14,8 @@ from armtransfer.experiments import sweep as sweeps
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.experiments.store import ResultStore
 
-HELP = "Run a sweep file (TOML) into --out; re-running resumes, skipping finished runs."
+HELP = "Run a grid of tasks, robots, methods and settings from a TOML file into a resumable result store."
+EXAMPLE = "armtransfer sweep examples/sweeps/quick.toml --out runs/quick"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

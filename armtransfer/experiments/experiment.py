@@ -115,6 +115,15 @@ class MethodResult:
     def column(self, name: str) -> list:
         return [getattr(t, name) for t in self.trials]
 
+    def __repr__(self) -> str:
+        """One line: the method, its trials, how many reached the goal and converged, and the
+        mean exploration steps of those that reached it (every trial's arrays stay out)."""
+        reached = [x for x in self.column("exploration_steps") if x is not None]
+        mean = f"{sum(reached) / len(reached):,.1f}" if reached else "n/a"
+        return (f"<MethodResult {self.label}: {len(self.trials)} trials, reached {len(reached)}/{len(self.trials)}, "
+                f"converged {sum(map(bool, self.column('converged')))}/{len(self.trials)}, mean exploration steps "
+                f"of those reached {mean}>")
+
 
 def run_method(
     method: str,

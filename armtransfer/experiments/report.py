@@ -25,13 +25,29 @@ def fmt_reached(entry: dict) -> str:
     return f"{k}/{len(ex)}"
 
 
-def fmt_median(entry: dict, digits: int = 1) -> str:
-    """Median [order-statistic CI]; the CI's coverage is named when below 95% (fewer than 6
-    trials), and ``≥`` marks a median that censoring reached."""
+def fmt_median(entry: dict, digits: int = 1, note: bool = True) -> str:
+    """Median [order-statistic CI]; with ``note`` the CI's coverage is named when below 95%
+    (fewer than 6 trials), and ``≥`` marks a median that censoring reached."""
     cov = entry.get("median_ci_coverage")
-    note = f" ({100 * cov:.0f}% CI)" if cov is not None and cov < 0.95 else ""
+    note = f" ({100 * cov:.0f}% CI)" if note and cov is not None and cov < 0.95 else ""
     return (("≥ " if entry.get("median_is_lower_bound") else "")
             + f"{fmt_num(entry.get('median'), digits)} {fmt_ci(entry.get('median_ci95'), digits)}{note}")
+
+
+def _coverage(entry: dict) -> str | None:
+    cov = entry.get("median_ci_coverage")
+    return None if cov is None else ("95%" if cov >= 0.95 else f"{100 * cov:.0f}%")
+
+
+def median_column(entries) -> tuple[str, object]:
+    """(header, cell formatter) of a median column: the header names the coverage its CIs hold
+    (``median [75% CI]`` for 3 trials, ``median [95% CI]`` from 6 on); only where the rows'
+    coverages differ does each cell name its own."""
+    coverages = {_coverage(e) for e in entries} - {None}
+    if len(coverages) <= 1:
+        label = coverages.pop() if coverages else "95%"
+        return f"median [{label} CI]", lambda e: fmt_median(e, note=False)
+    return "median [CI, coverage named when below 95%]", fmt_median
 
 
 def markdown_table(header: list[str], rows: list[list[str]]) -> str:
@@ -44,18 +60,20 @@ def markdown_table(header: list[str], rows: list[list[str]]) -> str:
 def method_table(results: dict) -> str:
     """One row per method: exploration steps over ALL trials (an unreached trial counts at
     the step cap, and the mean is then marked as a lower bound ``≥``), its 95% CI, the
-    median with its 95% CI, improvement (with its design), greedy steps, total steps, and
-    how many trials reached the goal and converged."""
+    median with its CI (the header names its coverage), the mean improvement (with its
+    design), the mean greedy path and steps to converge, and how many trials reached the
+    goal and converged."""
+    median_header, median_cell = median_column(results.values())
     header = [
         "method",
-        "reached",
-        "exploration steps",
-        "95% CI",
-        "median [95% CI]",
-        "improvement %",
+        "reached goal",
+        "mean exploration steps",
+        "mean's 95% CI",
+        median_header,
+        "mean improvement %",
         "improvement 95% CI",
-        "greedy steps",
-        "steps to converge",
+        "mean greedy steps",
+        "mean steps to converge",
         "converged",
     ]
     rows = []
@@ -67,7 +85,7 @@ def method_table(results: dict) -> str:
                 fmt_reached(r),
                 fmt_mean(r),
                 fmt_ci(r["ci95"]),
-                fmt_median(r),
+                median_cell(r),
                 fmt_num(r.get("improvement_percent")),
                 fmt_ci(r.get("improvement_ci95")),
                 fmt_num(r.get("greedy_mean")),
@@ -83,3 +101,25 @@ def method_table(results: dict) -> str:
     if designs:
         table += "\n\nImprovement CIs: " + "; ".join(sorted(designs)) + "."
     return table
+
+
+def transfer_table(out: dict) -> str:
+    """A transfer's methods, then their control runs (``method [kind]``), as one Table II-style
+    table; ``out`` is ``TransferResult.to_json()``."""
+    rows = dict(out["results"])
+    for kind, by in out.get("controls", {}).items():
+        rows.update({f"{m} [{kind}]": entry for m, entry in by.items()})
+    return method_table(rows)
+
+
+CONTROLS_NOTE = ("[shuffled] and [random] are controls: the same method given the trajectory's cells in a "
+                 "random order, or a random walk of the source robot of the same length, a new draw each "
+                 "trial, neither ending at the task's goal.")
+
+
+def transfer_heading(out: dict) -> str:
+    """The line above a transfer's table: task, robots, distance, trials, seed (and wind)."""
+    t = out["task"]
+    return (f"{t['name']}: {tuple(t['start'])} -> {tuple(t['goal'])}, {out['source']} -> {out['target']}, "
+            f"target's optimal distance {out['distance']}, {out['trials']} trials, seed {out['seed']}"
+            + (f", wind {out['wind']}" if out["wind"] else ""))

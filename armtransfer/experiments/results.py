@@ -5,19 +5,27 @@ learner's settings and, per method, a :class:`~armtransfer.experiments.experimen
 with every trial (:class:`~armtransfer.learning.sarsa.TrialResult`). Control runs (a method
 given a shuffled or random trajectory) are kept apart, under ``controls[kind][method]``.
 
-``to_json()`` is exactly what ``armtransfer rooms --json`` and ``armtransfer arms`` write.
+``to_json()`` is exactly what ``armtransfer rooms --json`` and ``armtransfer arms`` write;
+``to_frame()`` is a tidy pandas DataFrame, one row per trial (``armtransfer.experiments.frames``).
+``repr()`` is a few lines (task, robots, each method's headline numbers), and in Jupyter the
+result shows the table ``armtransfer rooms`` prints.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
-from armtransfer.learning.config import LearnerConfig
+from armtransfer.experiments import frames, report
 from armtransfer.experiments.experiment import MethodResult, summary_of
+from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import ActionMapping
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.catalog import Task
 from armtransfer.tasks.robot import DiscreteRobot
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 @dataclass(frozen=True)
@@ -37,7 +45,7 @@ class MappingInfo:
                 "macro_states": self.macro_states, "saved": self.saved}
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class TransferResult:
     task: Task
     source: DiscreteRobot
@@ -69,6 +77,53 @@ class TransferResult:
         runs = [*self.methods.values(), *(r for by in self.controls.values() for r in by.values())]
         return summary_of(runs, self.target, self.start_cell, self.goal_cell)
 
+    def runs(self) -> list[MethodResult]:
+        """Every method's runs: on the real trajectory, then each control's."""
+        return [*self.methods.values(), *(r for by in self.controls.values() for r in by.values())]
+
+    def __repr__(self) -> str:
+        """A few lines: the task and robots, then per method (and control) its mean exploration
+        steps with their 95% CI, how many trials reached the goal, and the mean improvement."""
+        out = self.to_json()
+        rows = [["method", "mean exploration steps [95% CI]", "reached", "improvement"]]
+        for run, e in zip(self.runs(), self._entries(out)):
+            imp = e.get("improvement_percent")
+            rows.append([run.label, f"{report.fmt_mean(e)} {report.fmt_ci(e['ci95'])}", report.fmt_reached(e),
+                         "" if imp is None else f"{imp:+.1f}%"])
+        widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+        lines = ["  " + "  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
+        return f"<TransferResult {report.transfer_heading(out)}\n" + "\n".join(lines) + ">"
+
+    def _repr_markdown_(self) -> str:
+        """What Jupyter shows: the heading and table ``armtransfer rooms`` prints."""
+        out = self.to_json()
+        text = f"**{report.transfer_heading(out)}**\n\n{report.transfer_table(out)}"
+        return text + (f"\n\n{report.CONTROLS_NOTE}" if out["controls"] else "")
+
+    def _entries(self, out: dict) -> list[dict]:
+        """The summary entries of :meth:`runs`, in that order."""
+        return [*out["results"].values(), *(e for by in out["controls"].values() for e in by.values())]
+
+    def to_frame(self) -> "pd.DataFrame":
+        """A tidy pandas DataFrame: one row per trial of every method and control (``control``
+        names it, None for the real trajectory), every per-trial metric a column (exploration,
+        total and greedy steps, convergence, episodes, the K used, Taylor and Stone's transfer
+        metrics, the mapped share for ``mapping``), then the run's settings (task, robots,
+        seed, wind, trajectory length, every learner setting). A trial that never reached the
+        goal has ``reached`` False and ``exploration_steps`` missing, censored at ``step_cap``.
+        Needs pandas (``pip install 'armtransfer[frames]'``)."""
+        frames.pandas()
+        out = self.to_json()
+        t = self.task
+        settings = {"task": t.name, "start": list(t.start), "goal": list(t.goal), "source": self.source.name,
+                    "target": self.target.name, "distance": self.distance, "seed": self.seed,
+                    "trials": self.trials, "wind": self.wind, "trajectory_length": out["trajectory_length"],
+                    **self.config.to_dict()}
+        rows = []
+        for run, entry in zip(self.runs(), self._entries(out)):
+            rows += frames.trial_rows(run.method, run.control, _per_trial(entry, self.config.max_total_steps), settings)
+        return frames.frame(rows)
+
     def to_json(self) -> dict:
         summary = self._summary()
         t = self.task
@@ -88,3 +143,21 @@ class TransferResult:
             "results": {m: summary[r.label] for m, r in self.methods.items()},
             "controls": {kind: {m: summary[r.label] for m, r in by.items()} for kind, by in self.controls.items()},
         }
+
+
+PER_TRIAL = ("exploration_steps", "converged", "total_steps", "greedy_steps", "episodes", "mapped_fraction",
+             "macro_steps_first_episode")
+"""The per-trial lists of a summary entry that a frame takes as columns."""
+
+
+def _per_trial(entry: dict, cap: int) -> dict:
+    """A summary entry's per-trial metrics by column name (the K used, the step cap, ``cap``
+    where the entry names none, and the transfer metrics included)."""
+    out = {name: entry[name] for name in PER_TRIAL if name in entry}
+    if "K" in entry:
+        out["K_used"] = entry["K"]
+    out["step_cap"] = entry.get("cap") or cap
+    for name, block in entry.get("transfer_metrics", {}).items():
+        if isinstance(block, dict) and "per_trial" in block:
+            out[name] = block["per_trial"]
+    return out

@@ -15,10 +15,14 @@ import fcntl
 import os
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from armtransfer.errors import ArmTransferError
 from armtransfer.io import OutputError, parse_json_bytes, write_json_atomic
 from armtransfer.experiments.sweep import Sweep
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 STORE_FORMAT = "armtransfer-store/1"
 LOCK = ".lock"
@@ -167,6 +171,37 @@ class ResultStore:
             if rec is not None:
                 out.append(rec)
         return out
+
+    def to_frame(self) -> "pd.DataFrame":
+        """Every finished trial as a tidy pandas DataFrame (a matrix's store too): one row per
+        trial of each run, its per-trial metrics (exploration, total and greedy steps,
+        convergence, episodes, the K used, the step cap a trial that never reached the goal is
+        censored at), then the run's settings (``run`` is its key; task, start and goal cells,
+        source, target, method, seed, trials, wind, learner settings, the K asked for). The
+        runs that failed or are not done yet are named in ``df.attrs`` (``failed``, ``missing``),
+        so a partial store is never mistaken for a whole one. Needs pandas
+        (``pip install 'armtransfer[frames]'``)."""
+        from armtransfer.experiments import frames
+        from armtransfer.experiments.sweep import expand
+        from armtransfer.learning.config import LearnerConfig
+
+        frames.pandas()
+        rows, done = [], set()
+        for rec in self.records():
+            run, result = rec["config"], rec["result"]
+            done.add(run["key"])
+            settings = {("run" if k == "key" else k): v for k, v in run.items() if k != "format"}
+            per_trial = {name: result[name] for name in (*RESULT_LISTS, "episodes") if name in result}
+            per_trial["K_used"] = result.get("K")
+            per_trial["trajectory_length"] = result.get("trajectory_length")
+            per_trial["step_cap"] = int(run.get("max_total_steps", LearnerConfig.max_total_steps))
+            rows += frames.trial_rows(run["method"], None, per_trial, settings)
+        df = frames.frame(rows)
+        failed = sorted(f["key"] for f in self.failures() if f.get("key") not in done)
+        every = [run["key"] for run in expand(self.meta["spec"])]
+        df.attrs.update(runs=len(every), failed=failed,
+                        missing=[k for k in every if k not in done and k not in failed])
+        return df
 
     def failures(self) -> list[dict]:
         out = []

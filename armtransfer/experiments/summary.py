@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from armtransfer.experiments import metrics
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.experiments.report import fmt_ci, fmt_mean, fmt_median, fmt_num, markdown_table
+from armtransfer.experiments.report import fmt_ci, fmt_mean, fmt_num, markdown_table, median_column
 from armtransfer.experiments.sweep import group_key
 
 
@@ -100,12 +100,14 @@ def _task_name(row: dict) -> str:
 
 
 def summary_markdown(rows: list[dict]) -> str:
-    header = ["task", "source -> target", "wind", "eps", "lambda", "method", "reached",
-              "exploration steps [95% CI]", "median [95% CI]", "improvement % [95% CI]", "greedy", "converged"]
+    median_header, median_cell = median_column(rows)
+    header = ["task", "source -> target", "wind", "eps", "lambda", "method", "reached goal",
+              "mean exploration steps [95% CI]", median_header, "mean improvement % [95% CI]", "mean greedy steps",
+              "converged"]
     body = [[
         _task_name(r), f"{r['source']} -> {r['target']}", f"{r['wind']:g}", f"{r['epsilon']:g}", f"{r['lam']:g}",
         r["method"], f"{r['reached']}/{r['trials']}", f"{fmt_mean(r)} {fmt_ci(r['ci95'])}",
-        fmt_median(r),
+        median_cell(r),
         "" if r["method"] == "none" else f"{fmt_num(r['improvement_percent'])} {fmt_ci(r['improvement_ci95'])}",
         fmt_num(r["greedy_mean"]), f"{r['converged']}/{r['trials']}",
     ] for r in rows]

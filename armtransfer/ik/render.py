@@ -2,7 +2,10 @@
 
 Rendering is MuJoCo's offscreen OpenGL; ``MUJOCO_GL`` must name the backend before
 ``mujoco`` is first imported (this module sets ``egl`` unless the user chose one), which
-works without a display and without a GPU through Mesa's EGL (llvmpipe).
+works without a display and without a GPU through Mesa's EGL (llvmpipe). Every GL context
+is made by :func:`offscreen_renderer`, which first checks that the backend works
+(``armtransfer.ik.offscreen``): where none does, the caller gets an ``OffscreenError`` that
+names the system packages to install, never a PyOpenGL traceback.
 
 Each panel is one ``Replay`` (``armtransfer.ik.replay``) rendered with its own model and
 ``mujoco.Renderer`` from a fixed free camera that fits the whole scene: the table, its walls
@@ -27,26 +30,25 @@ Typical use (the ``armtransfer`` command does this)::
 
 from __future__ import annotations
 
+import copy
+import math
+import numbers
 import os
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Sequence
 
-os.environ.setdefault("MUJOCO_GL", "egl")
+import mujoco  # after armtransfer.ik named the backend
+import numpy as np
 
-import copy  # noqa: E402
-import math  # noqa: E402
-import numbers  # noqa: E402
-import tempfile  # noqa: E402
-import time  # noqa: E402
-from dataclasses import dataclass, field  # noqa: E402
-from pathlib import Path  # noqa: E402
-from typing import Sequence  # noqa: E402
-
-import mujoco  # noqa: E402
-import numpy as np  # noqa: E402
-
-from armtransfer.ik.replay import Replay, replay  # noqa: E402
-from armtransfer.errors import ArmTransferError  # noqa: E402
-from armtransfer.ik.workspace import WALL_HEIGHT  # noqa: E402
-from armtransfer.io import OutputError, check_writable  # noqa: E402
+from armtransfer.errors import ArmTransferError
+from armtransfer.ik import offscreen
+from armtransfer.ik.replay import Replay, replay
+from armtransfer.ik.workspace import WALL_HEIGHT
+from armtransfer.io import OutputError, check_writable
 
 FORMATS = {".mp4": "mp4", ".gif": "gif"}
 TRAJECTORY_RGBA = (1.0, 0.55, 0.1, 1.0)
@@ -58,8 +60,32 @@ TIP_PATH_POINTS = 40
 MAX_SIZE = 4096
 
 
+WITHOUT = "draw nothing (learning and replays need no OpenGL)"
+"""How a library user goes on where no backend works."""
+
+
 class RenderError(ArmTransferError):
     """A video cannot be made as asked (unknown format, bad size or fps)."""
+
+
+def gl_errors() -> tuple[type[BaseException], ...]:
+    """The exceptions by which MuJoCo and PyOpenGL say that OpenGL failed."""
+    errors: list[type[BaseException]] = [mujoco.FatalError]
+    pyopengl = sys.modules.get("OpenGL.error")  # imported by the GL backend, if any
+    if pyopengl is not None:
+        errors.append(pyopengl.Error)
+    return tuple(errors)
+
+
+def offscreen_renderer(model: mujoco.MjModel, height: int, width: int, max_geom: int,
+                       without: str = WITHOUT) -> mujoco.Renderer:
+    """A ``mujoco.Renderer`` for ``model``, once the backend is known to work here
+    (``offscreen.require``); an ``OffscreenError`` ending with ``without`` when it does not."""
+    offscreen.require(without)
+    try:
+        return mujoco.Renderer(model, height, width, max_geom=max_geom)
+    except Exception as err:  # noqa: BLE001 - a GL context that fails here fails for the machine's reasons
+        raise offscreen.broken(err, without) from None
 
 
 @dataclass
@@ -233,7 +259,7 @@ class PanelRenderer:
 
     def __init__(self, panel: RolloutPanel, width: int = 320, height: int = 240, *,
                  shadows: bool = False, samples: int = 4,
-                 camera: mujoco.MjvCamera | None = None) -> None:
+                 camera: mujoco.MjvCamera | None = None, without: str = WITHOUT) -> None:
         self.panel = panel
         rp = panel.replay
         self.model = offscreen_model(rp, width, height, samples)
@@ -241,8 +267,8 @@ class PanelRenderer:
         self.camera = camera or table_camera(rp, width, height)
         self.shadows = shadows
         self._markers = _markers(panel)
-        self.renderer = mujoco.Renderer(self.model, height, width,
-                                        max_geom=self.model.ngeom + len(self._markers) + 100)
+        self.renderer = offscreen_renderer(self.model, height, width, self.model.ngeom + len(self._markers) + 100,
+                                           without)
 
     def render(self, qpos: np.ndarray) -> np.ndarray:
         """[height, width, 3] uint8 image of the arm at ``qpos``."""
@@ -326,14 +352,15 @@ class _Writer:
 def render_rollouts(panels: Sequence[RolloutPanel] | RolloutPanel, path: str | os.PathLike, *,
                     width: int = 320, height: int = 240, fps: float = 30.0,
                     format: str | None = None, shadows: bool = False, samples: int = 4,
-                    quality: int | None = None) -> RenderStats:
+                    quality: int | None = None, without: str = WITHOUT) -> RenderStats:
     """Render the panels side by side into a video at ``path`` and return its stats.
 
     ``width`` x ``height`` is the size of one panel; the video is ``len(panels) * width``
     wide. Playback is real time: frame k shows simulation time k / ``fps``. The format
     comes from ``format`` or the suffix (.mp4, .gif). Bad format, size, fps or an
     unwritable path raise an ``ArmTransferError`` subclass before anything is rendered;
-    the file appears only complete (temporary file, then ``os.replace``).
+    the file appears only complete (temporary file, then ``os.replace``). Where OpenGL cannot
+    draw here, an ``OffscreenError`` names what to install and ends with ``without``.
     """
     if isinstance(panels, RolloutPanel):
         panels = [panels]
@@ -364,7 +391,7 @@ def render_rollouts(panels: Sequence[RolloutPanel] | RolloutPanel, path: str | o
         frames_q = [p.replay.frames_qpos(fps) for p in panels]
         n_frames = max(len(q) for q in frames_q)
         for p in panels:
-            renderers.append(PanelRenderer(p, width, height, shadows=shadows, samples=samples))
+            renderers.append(PanelRenderer(p, width, height, shadows=shadows, samples=samples, without=without))
         writer = _Writer(tmp, fmt, fps, quality)
         for k in range(n_frames):
             t0 = time.perf_counter()
@@ -380,6 +407,8 @@ def render_rollouts(panels: Sequence[RolloutPanel] | RolloutPanel, path: str | o
         encode_s += time.perf_counter() - t1
         os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, dest)
+    except gl_errors() as err:  # the context was made, then OpenGL failed drawing
+        raise offscreen.broken(err, without) from None
     except OSError as err:
         raise OutputError(f"cannot write {str(dest)!r}: {err.strerror or err}") from None
     finally:
@@ -407,17 +436,20 @@ def rollout_video(rollouts: Sequence[tuple[object, Sequence[int]]],
                   path: str | os.PathLike, *, trajectory_cells: Sequence[int] = (),
                   goal_cell: int | None = None, width: int = 320, height: int = 240,
                   fps: float = 30.0, format: str | None = None, shadows: bool = False,
-                  replay_options: dict | None = None, scenes: Sequence | None = None) -> dict:
+                  replay_options: dict | None = None, scenes: Sequence | None = None,
+                  without: str = WITHOUT) -> dict:
     """Replay each (robot, path states) in MuJoCo and render them side by side to ``path``.
 
     ``trajectory_cells`` (the transferred trajectory) and ``goal_cell`` are marked in every
     panel. ``scenes``, one per rollout (None: rebuilt), are the robots' own scenes, e.g. those
     ``check_replayable`` returned. Returns a JSON-able report: the video's stats and, per
     panel, the replay's ``max_deviation_cells``, ``reached_goal`` and friends
-    (``Replay.report()``).
+    (``Replay.report()``). A machine where OpenGL cannot draw is found out before the
+    replays: an ``OffscreenError`` names what to install and ends with ``without``.
     """
-    video_format(path, format)  # fail on bad input before the replays
+    video_format(path, format)  # fail on bad input, or a machine that cannot render, before the replays
     check_writable(path)
+    offscreen.require(without)
     scenes = list(scenes) if scenes is not None else [None] * len(rollouts)
     if len(scenes) != len(rollouts):
         raise RenderError(f"{len(scenes)} scenes for {len(rollouts)} rollouts")
@@ -425,7 +457,7 @@ def rollout_video(rollouts: Sequence[tuple[object, Sequence[int]]],
                for (robot, states), scene in zip(rollouts, scenes)]
     panels = [RolloutPanel(rp, trajectory_cells, goal_cell) for rp in replays]
     stats = render_rollouts(panels, path, width=width, height=height, fps=fps, format=format,
-                            shadows=shadows)
+                            shadows=shadows, without=without)
     return {**stats.report(), "replays": [rp.report() for rp in replays]}
 
 

@@ -8,21 +8,18 @@ tool tip as a blue tile. Close it (or use ``with``) to free the GL context.
 
 from __future__ import annotations
 
-import os
+import mujoco
+import numpy as np
 
-os.environ.setdefault("MUJOCO_GL", "egl")
-
-import mujoco  # noqa: E402
-import numpy as np  # noqa: E402
-
-from armtransfer.ik.render import (  # noqa: E402
+from armtransfer.ik.render import (
     GOAL_RGBA,
     START_RGBA,
     offscreen_model,
+    offscreen_renderer,
     render_with_markers,
     table_camera,
 )
-from armtransfer.ik.scene import ArmScene  # noqa: E402
+from armtransfer.ik.scene import ArmScene
 
 GRID_RGBA = (0.3, 0.25, 0.2, 0.5)
 
@@ -30,14 +27,15 @@ GRID_RGBA = (0.3, 0.25, 0.2, 0.5)
 class ArmSnapshot:
     """Renders ``scene``'s arm at any configuration, marking the goal and the tip's cell."""
 
-    def __init__(self, scene: ArmScene, width: int = 320, height: int = 240, samples: int = 4) -> None:
+    def __init__(self, scene: ArmScene, width: int = 320, height: int = 240, samples: int = 4,
+                 without: str = "draw nothing") -> None:
         self.scene = scene
         self.model = offscreen_model(scene, width, height, samples)
         self.data = mujoco.MjData(self.model)
         self.camera = table_camera(scene, width, height)
         self._grid = _grid_lines(scene)
-        self.renderer = mujoco.Renderer(self.model, height, width,
-                                        max_geom=self.model.ngeom + len(self._grid) + 16)
+        self.renderer = offscreen_renderer(self.model, height, width, self.model.ngeom + len(self._grid) + 16,
+                                           without)
 
     def render(self, qpos: np.ndarray, goal_cell: int, tip_cell: int | None = None) -> np.ndarray:
         """[height, width, 3] uint8: the arm at ``qpos``, the goal and the tip's cell."""

@@ -21,6 +21,10 @@ from armtransfer.registration import register_envs  # noqa: F401  (kept importab
 from armtransfer.tasks.robot import DiscreteRobot
 
 
+RGB_WITHOUT = "make the environment with render_mode='ansi' or none"
+"""How an arm environment goes on where no offscreen OpenGL backend works."""
+
+
 class RoomsRules:
     """The rules of a start/goal task for one discrete robot, shared by the Gymnasium
     environment and the dm_control task (``armtransfer.dmc.task``): an action moves the robot
@@ -72,6 +76,10 @@ class RobotRoomsEnv(RoomsRules, gym.Env):
             raise InvalidParameterError(
                 f"unknown render_mode {render_mode!r}; valid: {', '.join(self.metadata['render_modes'])}")
         self.render_mode = render_mode
+        if render_mode == "rgb_array" and robot.arm is not None:  # an arm is drawn by OpenGL: can it be here?
+            from armtransfer.ik import offscreen
+
+            offscreen.require(RGB_WITHOUT)
         self.observation_space = spaces.Discrete(robot.n_states)
         self.action_space = spaces.Discrete(robot.n_actions)
         self._snapshot = None
@@ -89,7 +97,8 @@ class RobotRoomsEnv(RoomsRules, gym.Env):
     def render(self):
         """``ansi``: a text map; ``rgb_array``: for an arm robot the arm drawn by MuJoCo
         offscreen at the current state's configuration with the cell grid, the goal and the
-        tip's cell; for a grid robot the layout drawn cell by cell."""
+        tip's cell (an ``OffscreenError`` naming what to install where OpenGL cannot draw it);
+        for a grid robot the layout drawn cell by cell."""
         label = int(self.robot.label[self.state])
         layout = self.robot.layout
         if self.render_mode == "ansi":
@@ -103,7 +112,7 @@ class RobotRoomsEnv(RoomsRules, gym.Env):
                 from armtransfer.ik.replay import robot_scene
                 from armtransfer.ik.snapshot import ArmSnapshot
 
-                self._snapshot = ArmSnapshot(robot_scene(self.robot))
+                self._snapshot = ArmSnapshot(robot_scene(self.robot), without=RGB_WITHOUT)
             return self._snapshot.render(self.robot.arm.qpos[self.state], self.goal_cell, label)
         return None
 
