@@ -1,2 +1,3 @@
 """Arm kinematics: scenes, mink labelling and IK, action models, and compiling arms into
-discrete robots. The public entry point is ``ik.robots.arm_robot``."""
+discrete robots. Arm robots are built by ``armtransfer.tasks.arms.arm_robot``, which drives
+this layer."""
