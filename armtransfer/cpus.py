@@ -1,5 +1,5 @@
 """How many CPUs one armtransfer process may use for its own parallel work: the trials of a
-method, on threads (``transfer.experiment.map_trials``). A sweep's workers set 1: there the
+method, on threads (``armtransfer.experiments.experiment.map_trials``). A sweep's workers set 1: there the
 workers are the parallelism. Results never depend on it.
 
 Threads, not processes: with the ``spawn`` start method a process pool re-imports the

@@ -1,4 +1,4 @@
-"""Issue 14's table: exploration steps until the goal is first reached, as a multiple of the
+"""The first-exposure table: exploration steps until the goal is first reached, as a multiple of the
 target's optimal distance, for every transfer method beside the new one (``guided``).
 
     python research/first_exposure.py --out runs/first_exposure      # 20 trials, every case
@@ -11,7 +11,7 @@ shaping from the true map distance, which no robot has) and ``guided``, and ``gu
 with the two control trajectories (its cells shuffled; a random walk of the source), which
 replace the trajectory's goal s_tg too (``armtransfer.learning.controls``). The same controls
 with the task's goal kept are run as an ablation: they show what the path's order adds to
-knowing the goal, and are not one of the issue's checks. Every
+knowing the goal, and are not one of its checks. Every
 trial counts: one that never reaches the goal counts at the step cap and its mean is marked
 as a lower bound (≥). Means and 95% CIs are ``experiment.summarize``'s (``metrics``).
 
@@ -49,7 +49,7 @@ COLUMNS = ("none", "pseudo", "dense", "oracle", NEW, f"{NEW} [shuffled]", f"{NEW
 ABLATION = tuple(f"{NEW} [{controls.label(k, keep_goal=True)}]" for k in CONTROLS)
 """The ablation's columns: the controls with the task's goal kept."""
 TARGET_RATIO = 3.0
-"""Issue 14: first-exposure exploration at most 3x the optimal distance..."""
+"""The first check: first-exposure exploration at most 3x the optimal distance..."""
 TARGET_GREEDY = 1.05
 """... a greedy path within 5% of optimal ..."""
 TARGET_CONTROL = 3.0
@@ -114,7 +114,7 @@ def total_cell(entry: dict) -> str:
 
 
 def verdict(entry: dict, controls: list[dict], optimal: int, ablation: list[dict]) -> dict:
-    """The issue's three checks on one case, from the measured means; and the same factor for
+    """The three checks on one case, from the measured means; and the same factor for
     the controls that keep the goal (the ablation, not a check)."""
     ratio = entry["mean"] / optimal
     greedy = None if entry["greedy_mean"] is None else entry["greedy_mean"] / optimal
@@ -158,7 +158,7 @@ def markdown(rows: list[dict], trials: int, seed: int, seconds: float) -> str:
         markdown_table(head, t1),
         "## Convergence: greedy path length / optimal (converged trials), and mean steps to converge",
         markdown_table(head2, t2),
-        f"## Issue 14's checks for `{NEW}` (✗: not met)",
+        f"## The checks for `{NEW}` (✗: not met)",
         markdown_table(head3, t3),
         "## Ablation: the controls with the task's goal kept (what the path's order adds to knowing "
         "the goal), exploration steps / optimal distance",

@@ -1,4 +1,4 @@
-"""How an arm file becomes a scene (issue 11): the tool point, the chain, held joints,
+"""How an arm file becomes a scene: the tool point, the chain, held joints,
 servos of the scene's own, the file's own compiler settings, the base on a wall, sweep
 files naming arms, the lattice guard and a camera that fits an arm mounted anywhere."""
 

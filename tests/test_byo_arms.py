@@ -1,4 +1,4 @@
-"""Bring-your-own arms written the way MuJoCo Menagerie writes them (issue 11): untouched
+"""Bring-your-own arms written the way MuJoCo Menagerie writes them: untouched
 files with ``/`` in class names, meshes in a meshdir, affine ``general`` actuators, a
 tendon-driven slide gripper, a flange site or no site, a tip given by body and offset,
 no keyframe, a singular qpos0, and an automatically chosen mount.

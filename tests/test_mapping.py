@@ -353,7 +353,7 @@ def test_reproduce_reports_the_mapping_columns_beside_the_papers(reproduce_fast)
 
 
 def test_macros_in_every_episode_keep_the_greedy_path_from_converging():
-    """Why macros are offered in the first episode only (see transfer.mapping)."""
+    """Why macros are offered in the first episode only (see armtransfer.learning.mapping)."""
     from armtransfer.tasks.catalog import TABLE_I
 
     coarse, fine = grid_robot("coarse"), grid_robot("fine")

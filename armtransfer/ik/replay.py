@@ -1,6 +1,6 @@
 """Physics replay of an arm robot's path: position actuators track the joint waypoints.
 
-A path of a discrete arm robot (``ik.robots``) is a list of its states; every state has a
+A path of a discrete arm robot (``armtransfer.tasks.arms.arm_robot``) is a list of its states; every state has a
 joint configuration (``robot.arm.qpos``). ``replay`` rebuilds the exact MuJoCo scene the
 robot was compiled in (arm on the table with the rooms walls, from ``robot.arm``), puts the
 arm at the first waypoint and then *simulates* the move: for each next waypoint the

@@ -26,7 +26,7 @@ kept (on equal length, the one seen first). A loop's empty sequence therefore al
 Reuse
 -----
 :class:`MacroTable` turns a mapping and a new task's transferred trajectory into the macros
-the learner's kernel runs (``transfer.sarsa``): for each trajectory position i, the keys
+the learner's kernel runs (``armtransfer.learning.sarsa``): for each trajectory position i, the keys
 ``a_ti .. a_t(i+L-1)`` for L = ``longest key`` down to 1 are looked up and the *longest key
 with a non-empty target sequence* is chosen (the longest key covers most of the path; an
 empty sequence cannot be run). Every target state labelled s_ti then has that target
@@ -43,7 +43,7 @@ the other actions along the mapped path, its greedy path keeps turning into them
 loops. On Table I tasks 2-4 (coarse -> fine, seed 0) none of 10 trials per task converged
 within 2000 episodes that way; with macros in the first episode only, every trial did.
 
-Across tasks and trials (``transfer.experiment.run_mapping``): every trial of a task uses
+Across tasks and trials (``armtransfer.experiments.experiment.run_mapping``): every trial of a task uses
 the mapping of the earlier tasks only, so trials stay independent and deterministic; the
 mapping is then updated from each converged trial's greedy path, in trial order.
 
