@@ -125,6 +125,9 @@ def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target
     out_json = result.to_json()
     out_json["arms"] = {label: arm_json(r) for label, r in (("source", source), ("target", target))
                         if r.arm is not None}
+    for label, r in (("source", source), ("target", target)):
+        if r.arm is not None and (note := r.arm.clearance_note()):
+            print(f"{label} {r.arm.name}: {note}")
     for label, arm in out_json["arms"].items():
         if arm["mount_source"] == "automatic":
             print(f"{label} {arm['name']}: automatic mount --base-pos={','.join(f'{v:.4g}' for v in arm['mount'])} "

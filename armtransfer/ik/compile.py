@@ -39,7 +39,7 @@ import numpy as np
 from armtransfer.errors import ArmModelError, UnreachableTableError
 from armtransfer.ik.labels import OFF_TABLE, cells_of_xy
 from armtransfer.ik.scene import ArmScene, ContactChecker
-from armtransfer.ik.solve import MAX_TIP_HEIGHT, TipIK
+from armtransfer.ik.solve import MAX_TIP_HEIGHT, TIP_HEIGHT, TipIK
 
 
 def _near_wall_mask(layout) -> np.ndarray:
@@ -74,18 +74,26 @@ def reach_bound(scene: ArmScene) -> tuple[np.ndarray, float]:
     return points[0].copy(), float(np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1)))
 
 
-def _check_tip_height(z: float) -> None:
-    """A planar arm's tip rides at one height: it must be on the table."""
-    if not -1e-3 <= z <= MAX_TIP_HEIGHT:
+def _check_tip_height(scene: ArmScene, z: float) -> None:
+    """A planar arm's tip rides at one height: its tool's lowest point must be on the table,
+    not in it."""
+    low = z - scene.clearance
+    if low < -1e-3 and scene.clearance > 0:
         raise UnreachableTableError(
-            f"the arm's tip cannot reach the table: it moves {z:.3f} m above the tabletop "
-            f"(at most {MAX_TIP_HEIGHT} m allowed)")
+            f"the arm's tool is in the table: its point rides {z * 1000:.1f} mm above the tabletop and its geom "
+            f"{scene.clearance_geom} reaches {scene.clearance * 1000:.1f} mm past the point; raise the base by "
+            f"{(TIP_HEIGHT - low) * 1000:.1f} mm")
+    if not -1e-3 <= low <= MAX_TIP_HEIGHT:
+        where = "" if scene.clearance == 0 else f" (its lowest point {low:.3f} m)"
+        raise UnreachableTableError(
+            f"the arm's tip cannot reach the table: it moves {z:.3f} m above the tabletop{where} "
+            f"(at most {MAX_TIP_HEIGHT} m allowed); move the base by {-(low - TIP_HEIGHT):+.3f} m in z")
 
 
 def _check_table_in_reach(scene: ArmScene, home_tip: np.ndarray) -> None:
     """Fail at once, not after thousands of IK solves, when the tip cannot reach the table."""
     if scene.planar:
-        _check_tip_height(float(home_tip[2]))
+        _check_tip_height(scene, float(home_tip[2]))
         return
     anchor, reach = reach_bound(scene)
     half = scene.layout.width * scene.cell / 2
@@ -332,7 +340,7 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
     contact = ContactChecker(scene)
     free = layout.free
     near = _near_wall_mask(layout)
-    _check_tip_height(fk.tip_z)
+    _check_tip_height(scene, fk.tip_z)
     home = _lattice_origin(scene, fk)
     dof = len(home)
     lo = np.where(np.isfinite(scene.lower), scene.lower, home - np.pi)

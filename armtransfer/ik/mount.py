@@ -4,7 +4,7 @@ An arm file says nothing of where it stands relative to the table. ``candidates`
 base poses worth trying:
 
 - an arm whose joint axes are all vertical (a SCARA-like arm, its tip riding at one height)
-  is hung at the height that puts its tip just above the tabletop, over points of a grid
+  is hung at the height that puts its tool's lowest point ``TIP_HEIGHT`` above the tabletop, over points of a grid
   across and around the table;
 - any other arm stands on the table's plane beside it, on the four sides and at the four
   corners, at a few distances, turned so that its home tip points at the table's centre;
@@ -110,7 +110,7 @@ def candidates(scene: ArmScene, table_half: float, yaw: float | None = None) -> 
     """Base poses to try for the arm of ``scene`` (built at the origin, yaw 0)."""
     place = _Placer(scene)
     if scene.planar:  # hung so that the tip rides just above the tabletop
-        z = TIP_HEIGHT / 2 - place.tip_z
+        z = TIP_HEIGHT + scene.clearance - place.tip_z  # the tool's lowest point 4 mm up
         return [place(x, y, z, 0.0 if yaw is None else yaw) for x in PLANAR_GRID for y in PLANAR_GRID]
     _, reach = reach_bound(scene)
     out = []

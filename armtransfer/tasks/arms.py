@@ -174,7 +174,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
         kind, tip_down = info.kind, info.tip_down
         step = joint_step or info.joint_step
     parts = {
-        "version": 5, "arm_xml": _sha(xml_bytes), "assets": _assets_sha(path), "tool": tool.key(),
+        "version": 6, "arm_xml": _sha(xml_bytes), "assets": _assets_sha(path), "tool": tool.key(),
         "mount": mount, "yaw": yaw, "actions": model.name, "cells": model.cells, "tip_down": tip_down,
         "joint_step": step if model.kind == "joint" else None, "cell": cell_size,
         "wall_height": WALL_HEIGHT, "layout": _layout_data(layout),
@@ -209,12 +209,15 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
     label = arrays["label"]
     reach = float(len(np.unique(label)) / layout.free.sum())
     chain, held = _chain_of(arrays)
+    clearance = float(arrays.get("clearance", 0.0))
+    clearance_geom = str(arrays.get("clearance_geom", ""))
     description = ArmDescription(
         name=name, actions=model.name, dof=dof, kind=kind, qpos=arrays["qpos"], tip=arrays["tip"],
         reach=reach, cache=status, key=key, seconds=seconds, cell_size=cell_size,
         mount=mount, yaw=yaw, xml_path=str(path), tool=tool,
         joint_step=step if model.kind == "joint" else None, layout=layout,
         lattice=arrays.get("lattice"), mount_source=source, chain=chain, held=held,
+        clearance=clearance, clearance_geom=clearance_geom,
     )
     return DiscreteRobot(
         name=robot_name,
@@ -318,7 +321,7 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
     from armtransfer.ik import mount as _mount
     from armtransfer.tasks.catalog import TABLE_I as _TABLE_I
 
-    parts = {"version": 9, "what": "mount", "covers": COVERS, "arm_xml": _sha(path.read_bytes()),
+    parts = {"version": 10, "what": "mount", "covers": COVERS, "arm_xml": _sha(path.read_bytes()),
              "assets": _assets_sha(path), "tool": tool.key(), "cell": cell_size, "yaw": yaw,
              "layout": _layout_data(layout), "stride": _mount.STRIDE, "gaps": _mount.GAPS,
              "grid": _mount.PLANAR_GRID, "lifts": _mount.LIFTS}
@@ -455,6 +458,8 @@ def _compile(scene, model, tip_down, step, progress) -> dict:
                                    progress)
     arrays["chain"] = np.array(list(scene.chain), dtype=str).reshape(-1)
     arrays["held"] = np.array([f"{n}={v!r}" for n, v in scene.held], dtype=str).reshape(-1)
+    arrays["clearance"] = np.array(scene.clearance)
+    arrays["clearance_geom"] = np.array(scene.clearance_geom)
     return arrays
 
 

@@ -1,0 +1,74 @@
+"""Wall time of the automatic mount search for the Menagerie-style test arms, from an empty cache.
+
+    MUJOCO_GL=egl python benchmarks/bench_mount.py [--runs 1] [ARM ...]
+
+Each run is a fresh Python process with a fresh empty cache directory that writes the arm
+files (``tests/menagerie_like.py``) and times ``automatic_mount`` alone (imports and
+writing the files excluded). ARM is a name of ``menagerie_like.ALL`` with its tool point
+from ``menagerie_like.SUGGESTED``; the default is every arm there.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+from armtransfer import script
+
+ROOT = Path(__file__).resolve().parent.parent
+
+CHILD = r"""
+import json, sys, time
+from pathlib import Path
+sys.path.insert(0, sys.argv[3])
+import menagerie_like as ml
+from armtransfer.errors import ArmTransferError
+from armtransfer.tasks.arms import automatic_mount, make_tool
+name = sys.argv[1]
+path = ml.ALL[name](Path(sys.argv[2]))
+tip = {k: v for k, v in ml.SUGGESTED[name].items() if k.startswith("tip")}
+tool = make_tool(tip.get("tip_site"), tip.get("tip_body"), tip.get("tip_offset"))
+t0 = time.perf_counter()
+try:
+    pose = automatic_mount(path, tool)
+    out = {"pose": pose.describe()}
+except ArmTransferError as err:
+    out = {"error": str(err)}
+out["seconds"] = time.perf_counter() - t0
+print(json.dumps(out))
+"""
+
+
+def _run(name: str) -> dict:
+    with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as files:
+        env = dict(os.environ, ARMTRANSFER_CACHE=cache, MUJOCO_GL=os.environ.get("MUJOCO_GL", "egl"))
+        out = subprocess.run([sys.executable, "-c", CHILD, name, files, str(ROOT / "tests")], env=env,
+                             check=True, cwd=ROOT, capture_output=True, text=True).stdout
+    return json.loads(out.strip().splitlines()[-1])
+
+
+def main() -> None:
+    sys.path.insert(0, str(ROOT / "tests"))
+    import menagerie_like as ml
+
+    parser = script.parser(__doc__)
+    parser.add_argument("arms", nargs="*", default=[n for n in ml.ALL if n in ml.SUGGESTED])
+    parser.add_argument("--runs", type=int, default=1)
+    args = parser.parse_args()
+    print("| arm | seconds (median) | runs | result |")
+    print("|---|---:|---|---|")
+    for name in args.arms:
+        runs = [_run(name) for _ in range(args.runs)]
+        seconds = [r["seconds"] for r in runs]
+        result = runs[0].get("pose") or runs[0].get("error")
+        print(f"| {name} | {statistics.median(seconds):.1f} | {', '.join(f'{s:.1f}' for s in seconds)} | {result} |",
+              flush=True)
+
+
+if __name__ == "__main__":
+    main()
