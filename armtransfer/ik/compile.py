@@ -149,11 +149,13 @@ def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = 
             if free[n] and n not in q_of and attempts[n] < 3 and try_cell(n, q_of[c]):
                 queue.append(n)
     if not q_of:
+        from armtransfer.ik.diagnose import why_unreachable  # it uses this module's seeds
+
+        cause = why_unreachable(scene, tip_down)
         hint = scene.tool.axis_hint() if tip_down else ""
-        axis = f"; {hint}" if hint else ""
         raise UnreachableTableError(
             "the arm's tip cannot reach the table: IK finds no configuration with the tip "
-            f"over a free cell, at most 1 cm above the tabletop{axis}")
+            "over a free cell, at most 1 cm above the tabletop" + "".join(f"; {t}" for t in (cause, hint) if t))
     _progress(progress, f"  IK: {len(q_of)} cells reached")
 
     cells = np.array(sorted(q_of), dtype=np.int64)

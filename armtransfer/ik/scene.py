@@ -538,6 +538,29 @@ class ContactChecker:
             names.add((pair[0], pair[1]))
         return sorted(names)
 
+    def contact_names(self, q: np.ndarray) -> list[str]:
+        """The contacts that ``touches`` counts at q, named: ``"left_finger with the table"``,
+        ``"wrist_3_link with wall wall_2"``, ``"link1 with link4"`` (arm bodies by name)."""
+        g1, g2 = self._contacts(q)
+        env = (self._env[g1] & self._moving[g2]) | (self._env[g2] & self._moving[g1])
+        counted = env | self._own(g1, g2)
+        out: list[str] = []
+        for a, b in zip(g1[counted], g2[counted]):
+            if self._env[a]:
+                a, b = b, a
+            text = f"{self._what(int(a))} with {self._what(int(b))}"
+            if text not in out:
+                out.append(text)
+        return out
+
+    def _what(self, g: int) -> str:
+        m = self.model
+        if self._env[g]:
+            name = _name(m, mujoco.mjtObj.mjOBJ_GEOM, g)
+            return f"wall {name}" if self._walls[g] else "the table"
+        body = int(m.geom_bodyid[g])
+        return (_name(m, mujoco.mjtObj.mjOBJ_BODY, body) or f"body {body}").removeprefix(PREFIX)
+
     def base_on_wall(self) -> bool:
         """Does the arm's fixed base (collision geoms that no joint moves) stand in a wall?
 

@@ -337,17 +337,25 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
             pass
     from armtransfer.errors import UnreachableTableError
 
-    hint = tool.axis_hint()
-    axis = f"; {hint}" if hint else ""
-    unreachable = UnreachableTableError(
-        f"the arm's tool ({tool.describe()}) cannot reach the table from any base pose tried; give "
-        f"--base-pos X,Y,Z and --base-yaw{axis}")
+    def unreachable(best) -> UnreachableTableError:
+        """The error, with the cause measured at the best pose tried (``ik.diagnose``)."""
+        from armtransfer.ik.diagnose import why_unreachable
+
+        cause, planar = "", False
+        if best is not None:
+            scene = _scene(path, tool, best.pos, best.yaw, cell_size, layout)
+            cause, planar = why_unreachable(scene, not scene.planar), scene.planar
+            cause = f" (at the best, {best.describe()}: {cause})" if cause else ""
+        hint = "" if planar else tool.axis_hint()
+        return UnreachableTableError(
+            f"the arm's tool ({tool.describe()}) cannot reach the table from any base pose tried{cause}; give "
+            f"--base-pos X,Y,Z and --base-yaw" + (f"; {hint}" if hint else ""))
     if progress:
         print(f"choosing a mount for {path.name}: estimating the reach of base poses (once; the choice is "
               "cached) ...", file=sys.stderr, flush=True)
     scored = mount_search(path, tool, cell_size=cell_size, layout=layout, yaw=yaw)
     if not scored or scored[0][1] == 0.0:
-        raise unreachable
+        raise unreachable(scored[0][2] if scored else None)
     best = None
     for hit, share, pose in compile_order(scored):
         if progress:
@@ -364,7 +372,7 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
         if rank == (len(_TABLE_I), 1.0):  # every task and every free cell: nothing can beat it
             break
     if best is None:
-        raise unreachable
+        raise unreachable(scored[0][2])
     pose = best[1]
     if cache:
         from armtransfer.io import write_json_atomic
