@@ -3,8 +3,8 @@
 The automatic mount (``armtransfer.tasks.arms.automatic_mount``) ranks its candidates by a
 quick IK estimate and compiles only the best few. This script shows all of them: the
 estimate for each, then a full compile of the poses the automatic mount compiles, in its
-order (``compile_order``: the best three by Table I cells reached then the estimate, then up
-to three more whose estimate beats one of those; ``--compile`` keeps the first N), with the
+order (``compile_order``: the best ``COMPILES`` by Table I cells reached then the estimate,
+then up to as many more whose estimate beats one of those; ``--compile`` keeps the first N), with the
 share of free cells reached and the Table I tasks solvable. Use it to see why a mount was
 chosen, or to pick one by hand for ``--base-pos``/``--base-yaw``.
 
