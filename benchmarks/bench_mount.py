@@ -8,7 +8,8 @@ writing the files excluded): wall seconds and the process's CPU seconds (on a ma
 other jobs share, wall time grows with their load; CPU time does not). ARM is a name of
 ``menagerie_like.ALL`` with its tool point from ``menagerie_like.SUGGESTED``; the default
 is every arm there. ``--baseline SRC`` also times the package at SRC (a checkout of
-another commit, its ``armtransfer`` first on ``PYTHONPATH``) in the same runs, alternating.
+another commit: ``armtransfer`` imported from there, not the installed one) in the same
+runs, alternating.
 """
 
 from __future__ import annotations
@@ -26,8 +27,14 @@ from armtransfer import script
 ROOT = Path(__file__).resolve().parent.parent
 
 CHILD = r"""
-import json, sys, time
+import json, os, sys, time
 from pathlib import Path
+source = os.environ.get("BENCH_SOURCE")
+if source:  # the baseline checkout, ahead of the installed (editable) package
+    sys.meta_path[:] = [f for f in sys.meta_path if not getattr(f, "__module__", "").startswith("__editable__")]
+    sys.path.insert(0, source)
+    import armtransfer
+    assert armtransfer.__file__.startswith(source), armtransfer.__file__
 sys.path.insert(0, sys.argv[3])
 import menagerie_like as ml
 from armtransfer.errors import ArmTransferError
@@ -52,7 +59,7 @@ def _run(name: str, source: str | None) -> dict:
     with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as files:
         env = dict(os.environ, ARMTRANSFER_CACHE=cache, MUJOCO_GL=os.environ.get("MUJOCO_GL", "egl"))
         if source:
-            env["PYTHONPATH"] = source
+            env["BENCH_SOURCE"] = source
         out = subprocess.run([sys.executable, "-c", CHILD, name, files, str(ROOT / "tests")], env=env,
                              check=True, cwd=ROOT, capture_output=True, text=True).stdout
     return json.loads(out.strip().splitlines()[-1])

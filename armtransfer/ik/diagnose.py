@@ -20,14 +20,14 @@ import math
 import mujoco
 import numpy as np
 
-from armtransfer.ik.compile import reach_bound, seed_cells
+from armtransfer.ik.seeds import reach_bound, seed_cells
 from armtransfer.ik.labels import cells_of_xy
 from armtransfer.ik.scene import PREFIX, ArmScene, ContactChecker
 from armtransfer.ik.solve import MAX_TIP_HEIGHT, TipIK
 
 TRIES = 10
 """Cells tried: the one nearest the tip at home, the one halfway from the base to the table's
-centre, and one at each of ``compile.RING`` points around the base (``seed_cells`` with one
+centre, and one at each of ``seeds.RING`` points around the base (``seed_cells`` with one
 cell per point)."""
 RESTARTS = 2
 """Random starting configurations per cell, after home."""

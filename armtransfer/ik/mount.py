@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from armtransfer.ik.compile import reach_bound, seed_cells
+from armtransfer.ik.seeds import reach_bound, seed_cells
 from armtransfer.ik.labels import cells_of_xy
 from armtransfer.ik.scene import ArmScene, ContactChecker, base_footing, build_scene
 from armtransfer.ik.quick import QuickIK
@@ -45,7 +45,7 @@ STRIDE = 4
 """Cells between the lattice points the estimate tries (every 4th cell each way)."""
 SEEDS = 2
 """Cells nearest the home tip and nearest the point halfway to the table's centre that the
-estimate tries first (``compile.seed_cells``; then one at each point around the base)."""
+estimate tries first (``seeds.seed_cells``; then one at each point around the base)."""
 RESTARTS = 4
 """Random configurations the estimate tries for a first cell, after home."""
 LIGHT_RESTARTS = 1
