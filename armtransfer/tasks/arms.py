@@ -332,9 +332,11 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
     import json
 
     from armtransfer.ik import mount as _mount
-    parts = {"version": 11, "what": "mount", "compiles": COMPILES, "covers": COVERS, "arm_xml": _sha(path.read_bytes()),
-             "assets": _assets_sha(path), "tool": tool.key(), "cell": cell_size, "yaw": yaw,
-             "layout": _layout_data(layout), "stride": _mount.STRIDE, "seeds": [_mount.SEEDS, _mount.RESTARTS, RETRIES], "gaps": _mount.GAPS,
+
+    parts = {"version": 11, "what": "mount", "compiles": COMPILES, "covers": COVERS,
+             "arm_xml": _sha(path.read_bytes()), "assets": _assets_sha(path), "tool": tool.key(),
+             "cell": cell_size, "yaw": yaw, "layout": _layout_data(layout), "stride": _mount.STRIDE,
+             "seeds": [_mount.SEEDS, _mount.RESTARTS, RETRIES], "gaps": _mount.GAPS,
              "grid": _mount.PLANAR_GRID, "lifts": _mount.LIFTS}
     key = _cache.cache_key(parts)
     entry = _cache.cache_dir() / f"mount-{key[:16]}.json"
