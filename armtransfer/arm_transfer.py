@@ -158,6 +158,9 @@ def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target
     out_json = result.to_json()
     out_json["arms"] = {label: arm_json(r) for label, r in (("source", source), ("target", target))
                         if r.arm is not None}
+    for label, r in (("source", source), ("target", target)):
+        if r.arm is not None and (note := r.arm.clearance_note()):
+            print(f"{label} {r.arm.name}: {note}")
     for label, arm in out_json["arms"].items():
         if arm["mount_source"] == "automatic":
             print(f"{label} {arm['name']}: automatic mount --base-pos={','.join(f'{v:.4g}' for v in arm['mount'])} "
@@ -184,8 +187,11 @@ def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target
         write_json_atomic(tmp / "timings.json", {"rollout": {k: stats[k] for k in TIMINGS if k in stats}})
         write_json_atomic(tmp / "results.json", out_json)
         for label, rp in zip(("source", "target"), stats["replays"]):
+            own = rp.get("file_servos")
+            servos = (f" (the scene's own servos: the file's tracked {own['max_tracking_error_cells']:.2f} cell off"
+                      f"{'' if own['reached_goal'] else ' and missed the goal'})" if own else "")
             print(f"replay {label}: largest tip deviation {rp['max_deviation_cells']:.2f} cell, "
-                  f"reached the goal cell: {'yes' if rp['reached_goal'] else 'no'}")
+                  f"reached the goal cell: {'yes' if rp['reached_goal'] else 'no'}{servos}")
     return {"json": out_json, "video": video, "paths": paths, "source": source, "target": target,
             "no_video": no_video}
 

@@ -1,12 +1,12 @@
 """Every base pose the automatic mount tries for an arm file, with its reach.
 
 The automatic mount (``armtransfer.tasks.arms.automatic_mount``) ranks its candidates by a
-quick IK estimate and compiles only the best few. This script shows all of them: the
-estimate for each, then a full compile of the poses the automatic mount compiles, in its
-order (``compile_order``: the best three by Table I cells reached then the estimate, then up
-to three more whose estimate beats one of those; ``--compile`` keeps the first N), with the
-share of free cells reached and the Table I tasks solvable. Use it to see why a mount was
-chosen, or to pick one by hand for ``--base-pos``/``--base-yaw``.
+quick IK estimate and compiles only the winner (the next only when a compile fails). This
+script shows all of them: the estimate for each, then a full compile of the first poses of
+``compile_order`` (the best ``COMPILES`` by Table I cells reached then the estimate, then
+up to as many more whose estimate beats one of those; ``--compile`` keeps the first N),
+with the share of free cells reached and the Table I tasks solvable. Use it to see why a
+mount was chosen, or to pick one by hand for ``--base-pos``/``--base-yaw``.
 
     python research/mount_candidates.py PATH.xml --tip-body Fixed_Jaw --tip-offset=-0.015,-0.13,0
 """

@@ -191,7 +191,7 @@ UR5E_HOME = (-1.5708, -1.5708, 1.5708, -1.5708, -1.5708, 0.0)
 """The UR5e's ready pose (upper arm up, forearm level, tool down) in the standard DH zero."""
 
 
-def ur5e_style(directory) -> Path:
+def ur5e_style(directory, *, scale: float = 1.0, gripper: bool = False) -> Path:
     """A 6-joint UR5e-style arm in ``directory/universal_robots_ur5e/ur5e.xml``.
 
     UR5e standard DH geometry; classes ``ur5e``, ``ur5e/size3``, ``ur5e/size3_limited``,
@@ -200,47 +200,69 @@ def ur5e_style(directory) -> Path:
     joints ``shoulder_pan_joint`` ...; the base turned half a turn about z, as Menagerie's
     is; the flange site ``attachment_site`` (z out of the flange) on ``wrist_3_link``; a
     ``home`` keyframe with ctrl. A 0.12 m tool is ``tip_offset=(0, 0, 0.12)`` from the site.
+
+    ``scale``: the whole arm that many times its size (masses with the volume, servo gains
+    and force limits with the fourth power: a small arm has weak servos), written as
+    ``small_ur/small_ur.xml`` (model ``small_ur``) when it is not 1. ``gripper``: a parallel
+    gripper on the flange (``ur5e_gripper.xml``, model ``ur5e_gripper``): a palm body
+    ``gripper_base``, fingers ``left_pad``/``right_pad`` on slide joints each driven by its
+    own ``position`` actuator, and a TCP site ``pinch`` between the fingers that the
+    fingertips reach ``GRIPPER_PAST`` past (see ``_gripper``).
     """
-    folder = Path(directory) / "universal_robots_ur5e"
+    k = float(scale)
+    model = "ur5e" if k == 1.0 else "small_ur"
+    folder = Path(directory) / ("universal_robots_ur5e" if k == 1.0 else "small_ur")
     meshes = _Meshes(folder / "assets", "obj")
-    frames = ur5e_frames()
+    frames = [(tuple(k * np.asarray(pos)), alpha) for pos, alpha in ur5e_frames()]
     n = len(frames)
-    meshes.add("base_0", *box_mesh((0, 0, 0), (0, 0, UR5E_PEDESTAL), 0.07))
+    radii = tuple(k * r for r in UR5E_RADII)
+    pedestal = k * UR5E_PEDESTAL
+    meshes.add("base_0", *box_mesh((0, 0, 0), (0, 0, pedestal), 0.07 * k))
     body_xml = []
     indent = "    "
     for i in range(n):
         pos, alpha = frames[i]
-        child = np.array(frames[i + 1][0]) if i + 1 < n else np.array((0.0, 0.0, UR5E_DH["d"][5]))
-        r = UR5E_RADII[i]
+        child = np.array(frames[i + 1][0]) if i + 1 < n else np.array((0.0, 0.0, k * UR5E_DH["d"][5]))
+        r = radii[i]
         cls = "ur5e/size1" if i >= 3 else ("ur5e/size3_limited" if i == 2 else "ur5e/size3")
         pad = indent + "  " * (i + 1)
         body_xml.append(f'{pad}<body name="{UR5E_BODIES[i]}" pos="{_v(pos)}" quat="{_v(_quat_rx(alpha))}">')
-        body_xml.append(f"{pad}  {cylinder_inertial(UR5E_MASSES[i], r * 0.8, (0, 0, 0), child)}")
+        body_xml.append(f"{pad}  {cylinder_inertial(UR5E_MASSES[i] * k ** 3, r * 0.8, (0, 0, 0), child)}")
         body_xml.append(f'{pad}  <joint name="{UR5E_JOINTS[i]}" class="{cls}"/>')
         hub = meshes.add(f"{UR5E_BODIES[i].replace('_link', '')}_0", *prism_mesh(r, r))
         body_xml.append(f'{pad}  <geom mesh="{hub}" material="urblue" class="ur5e/visual"/>')
         start = np.zeros(3)
         if i == 0:  # the shoulder column stands on the base's pedestal
-            start = np.array((0.0, 0.0, UR5E_PEDESTAL + 0.01 + r * 0.7))
+            start = np.array((0.0, 0.0, pedestal + 0.01 * k + r * 0.7))
         else:
             body_xml.append(f'{pad}  <geom class="ur5e/collision" type="cylinder" size="{_f(r)} {_f(r * 0.8)}"/>')
         if np.linalg.norm(child) > 1e-9:
             bar = meshes.add(f"{UR5E_BODIES[i].replace('_link', '')}_1", *box_mesh(start, child, r * 0.7))
             body_xml.append(f'{pad}  <geom mesh="{bar}" material="linkgray" class="ur5e/visual"/>')
             cls_col = "ur5e/eef_collision" if i == n - 1 else "ur5e/collision"
-            end = _shorten(start, child, UR5E_RADII[i + 1] + r * 0.7 if i + 1 < n else 0.0)
+            end = _shorten(start, child, radii[i + 1] + r * 0.7 if i + 1 < n else 0.0)
             body_xml.append(f'{pad}  <geom class="{cls_col}" size="{_f(r * 0.7)}" '
                             f'fromto="{_v(start)} {_v(end)}"/>')
-    flange = UR5E_DH["d"][5]
+    flange = k * UR5E_DH["d"][5]
     pad = indent + "  " * n
     body_xml.append(f'{pad}  <site name="attachment_site" pos="0 0 {_f(flange)}"/>')
+    if gripper:
+        model = "ur5e_gripper"
+        body_xml += _gripper(pad + "  ", flange)
     for i in range(n, 0, -1):
         body_xml.append(f"{indent + '  ' * i}</body>")
     actuators = []
     for i, (act, joint) in enumerate(zip(UR5E_ACTUATORS, UR5E_JOINTS)):
         cls = "ur5e/size1" if i >= 3 else ("ur5e/size3_limited" if i == 2 else "ur5e/size3")
         actuators.append(f'    <general class="{cls}" name="{act}" joint="{joint}"/>')
-    text = f"""<mujoco model="ur5e">
+    home = list(UR5E_HOME)
+    if gripper:
+        actuators += [f'    <position class="gripper/finger" name="{side}_finger" joint="{side}_finger_joint"/>'
+                      for side in ("left", "right")]
+        home += [0.0, 0.0]
+    g3, g1 = 2000 * k ** 4, 500 * k ** 4  # servo gains and force limits of a smaller arm
+    f3, f1 = 150 * k ** 4, 28 * k ** 4
+    text = f"""<mujoco model="{model}">
   <compiler angle="radian" meshdir="assets" autolimits="true"/>
 
   <option integrator="implicitfast"/>
@@ -249,8 +271,8 @@ def ur5e_style(directory) -> Path:
     <default class="ur5e">
       <material specular="0.5" shininess="0.25"/>
       <joint axis="0 0 1" range="-6.28319 6.28319" armature="0.1"/>
-      <general gaintype="fixed" biastype="affine" ctrlrange="-6.2831 6.2831" gainprm="2000"
-        biasprm="0 -2000 -400" forcerange="-150 150"/>
+      <general gaintype="fixed" biastype="affine" ctrlrange="-6.2831 6.2831" gainprm="{_f(g3)}"
+        biasprm="0 -{_f(g3)} -{_f(g3 / 5)}" forcerange="-{_f(f3)} {_f(f3)}"/>
       <default class="ur5e/size3">
         <default class="ur5e/size3_limited">
           <joint range="-3.1415 3.1415"/>
@@ -258,7 +280,7 @@ def ur5e_style(directory) -> Path:
         </default>
       </default>
       <default class="ur5e/size1">
-        <general gainprm="500" biasprm="0 -500 -100" forcerange="-28 28"/>
+        <general gainprm="{_f(g1)}" biasprm="0 -{_f(g1)} -{_f(g1 / 5)}" forcerange="-{_f(f1)} {_f(f1)}"/>
       </default>
       <default class="ur5e/visual">
         <geom type="mesh" contype="0" conaffinity="0" group="2"/>
@@ -270,7 +292,7 @@ def ur5e_style(directory) -> Path:
         </default>
       </default>
       <site size="0.001" rgba="0.5 0.5 0.5 0.3" group="4"/>
-    </default>
+    </default>{GRIPPER_DEFAULTS if gripper else ""}
   </default>
 
   <asset>
@@ -283,10 +305,10 @@ def ur5e_style(directory) -> Path:
   <worldbody>
     <light name="spotlight" mode="targetbodycom" target="wrist_2_link" pos="0 -1 2"/>
     <body name="base" quat="0 0 0 1" childclass="ur5e">
-      <inertial mass="4.0" pos="0 0 0.02" diaginertia="0.00443 0.00443 0.0072"/>
+      <inertial mass="{_f(4.0 * k ** 3)}" pos="0 0 {_f(0.02 * k)}" diaginertia="0.00443 0.00443 0.0072"/>
       <geom mesh="base_0" material="black" class="ur5e/visual"/>
-      <geom class="ur5e/collision" type="cylinder" size="0.075 {_f(UR5E_PEDESTAL / 2)}"
-        pos="0 0 {_f(UR5E_PEDESTAL / 2)}"/>
+      <geom class="ur5e/collision" type="cylinder" size="{_f(0.075 * k)} {_f(pedestal / 2)}"
+        pos="0 0 {_f(pedestal / 2)}"/>
 {chr(10).join(body_xml)}
     </body>
   </worldbody>
@@ -296,11 +318,54 @@ def ur5e_style(directory) -> Path:
   </actuator>
 
   <keyframe>
-    <key name="home" qpos="{_v(UR5E_HOME)}" ctrl="{_v(UR5E_HOME)}"/>
+    <key name="home" qpos="{_v(home)}" ctrl="{_v(home)}"/>
   </keyframe>
 </mujoco>
 """
-    return _write(folder, "ur5e", text)
+    return _write(folder, model, text)
+
+
+GRIPPER_FINGER = 0.06
+"""Length of each gripper finger below the palm (m); its last ``GRIPPER_TIP`` is narrow."""
+GRIPPER_TIP = 0.022
+GRIPPER_PALM = 0.04
+"""The palm's depth (m) from the flange to where the fingers start."""
+GRIPPER_PAST = 0.015
+"""How far the fingertips reach past the TCP site ``pinch`` (m)."""
+GRIPPER_TCP = GRIPPER_PALM + GRIPPER_FINGER - GRIPPER_PAST
+"""The TCP site's depth below the flange (m)."""
+GRIPPER_DEFAULTS = """
+    <default class="gripper">
+      <default class="gripper/finger">
+        <joint type="slide" axis="0 1 0" range="0 0.03" armature="0.001" damping="1"/>
+        <position kp="100" ctrlrange="0 0.03" forcerange="-20 20"/>
+        <geom type="box" group="3" friction="1 0.005 0.0001"/>
+      </default>
+    </default>"""
+
+
+def _gripper(pad: str, flange: float) -> list[str]:
+    """A parallel gripper on a flange ``flange`` along z from the last body's origin: a palm,
+    two fingers on slides (closed at 0), narrow for their last ``GRIPPER_TIP`` (a closed
+    gripper is 7 mm by 6 mm there), and the TCP site ``pinch`` ``GRIPPER_PAST`` short of the
+    fingertips."""
+    upper = GRIPPER_FINGER - GRIPPER_TIP
+    out = [f'{pad}<body name="gripper_base" pos="0 0 {_f(flange)}" childclass="gripper">',
+           f'{pad}  <inertial mass="0.5" pos="0 0 0.02" diaginertia="0.0004 0.0004 0.0003"/>',
+           f'{pad}  <geom class="ur5e/collision" type="box" size="0.035 0.03 {_f(GRIPPER_PALM / 2)}" '
+           f'pos="0 0 {_f(GRIPPER_PALM / 2)}"/>',
+           f'{pad}  <site name="pinch" pos="0 0 {_f(GRIPPER_TCP)}"/>']
+    for side, sign in (("left", 1), ("right", -1)):
+        out += [f'{pad}  <body name="{side}_pad" pos="0 0 {_f(GRIPPER_PALM)}">',
+                f'{pad}    <inertial mass="0.03" pos="0 {_f(sign * 0.006)} 0.03" diaginertia="1e-5 1e-5 2e-6"/>',
+                f'{pad}    <joint name="{side}_finger_joint" class="gripper/finger"'
+                f'{"" if sign > 0 else chr(32) + "axis=" + chr(34) + "0 -1 0" + chr(34)}/>',
+                f'{pad}    <geom class="gripper/finger" size="0.008 0.004 {_f(upper / 2)}" '
+                f'pos="0 {_f(sign * 0.006)} {_f(upper / 2)}"/>',
+                f'{pad}    <geom class="gripper/finger" size="0.003 0.0015 {_f(GRIPPER_TIP / 2)}" '
+                f'pos="0 {_f(sign * 0.002)} {_f(upper + GRIPPER_TIP / 2)}"/>',
+                f"{pad}  </body>"]
+    return out + [f"{pad}</body>"]
 
 
 # --------------------------------------------------------------------------- Panda style
@@ -321,7 +386,7 @@ the walls when the fingertips are at the tip height."""
 FINGER_UPPER = FINGER_LENGTH - FINGERTIP
 
 
-def panda_style(directory, hand: bool = True) -> Path:
+def panda_style(directory, hand: bool = True, tcp: bool = False) -> Path:
     """A 7-joint Panda-style arm: ``directory/franka_emika_panda/panda.xml`` (with hand) or
     ``panda_nohand.xml`` (without).
 
@@ -333,7 +398,9 @@ def panda_style(directory, hand: bool = True) -> Path:
     ``finger_joint1``/``finger_joint2`` coupled by the fixed tendon ``split`` (driven by
     ``actuator8``) and an equality constraint; no site at all; keyframe ``home`` with 9
     values, the gripper closed. The fingertips are ``tip_body="hand",
-    tip_offset=(0, 0, 0.1034)``. Without ``hand``: the flange site ``attachment_site`` and a
+    tip_offset=(0, 0, 0.1034)``. With ``tcp`` (and ``hand``): ``panda_tcp.xml``, the same with a
+    TCP site ``tcp`` on the hand between the fingers, which reach ``FINGERTIP`` (2 cm) past
+    it, as some files put their TCP. Without ``hand``: the flange site ``attachment_site`` and a
     7-value ``home``; a 0.1 m tool is ``tip_offset=(0, 0, 0.1)`` from the site.
     """
     folder = Path(directory) / "franka_emika_panda"
@@ -378,6 +445,8 @@ def panda_style(directory, hand: bool = True) -> Path:
             f'{pad}    <geom mesh="hand_c" material="white" class="panda/visual"/>',
             f'{pad}    <geom class="panda/collision" type="box" size="0.03 0.1 0.028" pos="0 0 0.03"/>',
         ]
+        if tcp:
+            body_xml.append(f'{pad}    <site name="tcp" pos="0 0 {_f(PANDA_TCP - FINGERTIP)}"/>')
         for side, quat, joint in (("left", None, 1), ("right", (0, 0, 0, 1), 2)):
             q = f' quat="{_v(quat)}"' if quat else ""
             body_xml += [
@@ -476,7 +545,7 @@ def panda_style(directory, hand: bool = True) -> Path:
   </keyframe>
 </mujoco>
 """
-    return _write(folder, "panda" if hand else "panda_nohand", text)
+    return _write(folder, ("panda_tcp" if tcp else "panda") if hand else "panda_nohand", text)
 
 
 # --------------------------------------------------------------------------- SO100 style
@@ -648,7 +717,13 @@ PLANAR5_DROP = 0.02
 PLANAR5_TIP_CLEARANCE = 0.004
 
 
-def planar5_straight(directory) -> Path:
+PEN_RADIUS = 0.003
+"""The round pen's radius (m): its round end reaches this far past the site at the end of its axis."""
+PEN_SITE = 0.001
+"""The pen's site is this far above the base frame's z = 0 (m): its round end 2 mm below it."""
+
+
+def planar5_straight(directory, pen: bool = False) -> Path:
     """A planar 5-joint arm (every joint axis vertical): ``directory/planar5/planar5.xml``.
 
     Links ``link1..link5`` (0.09, 0.075, 0.06, 0.045, 0.03 m; 0.30 m in all) stacked
@@ -658,6 +733,11 @@ def planar5_straight(directory) -> Path:
     ``position`` actuators named ``servo1..servo5``; OBJ meshes in ``meshes/``.
     With the base frame on the tabletop (z = 0) the stylus hovers 4 mm above the table;
     hang it over the table anywhere its 0.30 m reach covers.
+
+    ``pen``: ``planar5_pen.xml`` (model ``planar5_pen``), the same arm holding a pen, a
+    capsule of radius ``PEN_RADIUS`` whose axis ends at the site ``pen_tip`` ``PEN_SITE`` above
+    the base frame's z = 0: its round end reaches ``PEN_RADIUS`` past the site, into the table
+    with the base frame on the tabletop (and with the site 2 mm above it).
     """
     folder = Path(directory) / "planar5"
     meshes = _Meshes(folder / "meshes", "obj")
@@ -682,19 +762,20 @@ def planar5_straight(directory) -> Path:
         if i > 1:
             xml.append(f'{pad}  <geom class="planar5/collision" type="cylinder" size="0.016 0.02" '
                        f'pos="0 0 {_f(PLANAR5_DROP / 2)}"/>')
-    stylus = z - PLANAR5_TIP_CLEARANCE
-    xml += [f'{pad}  <body name="stylus" pos="{_f(PLANAR5_LINKS[-1])} 0 {_f(-stylus)}">',
+    stylus = z - (PEN_SITE if pen else PLANAR5_TIP_CLEARANCE)
+    tool = (f'{pad}    <geom class="planar5/collision" size="{_f(PEN_RADIUS)}" fromto="0 0 0 0 0 {_f(stylus)}"/>',
+            f'{pad}    <site name="pen_tip"/>') if pen else (
+            f'{pad}    <geom class="planar5/collision" type="cylinder" size="0.0015" fromto="0 0 0 0 0 {_f(stylus)}"/>',)
+    xml += [f'{pad}  <body name="{"pen" if pen else "stylus"}" pos="{_f(PLANAR5_LINKS[-1])} 0 {_f(-stylus)}">',
             f'{pad}    <inertial pos="0 0 {_f(stylus / 2)}" mass="0.01" diaginertia="2e-5 2e-5 1e-7"/>',
-            f'{pad}    <geom class="planar5/collision" type="cylinder" size="0.0015" '
-            f'fromto="0 0 0 0 0 {_f(stylus)}"/>',
-            f"{pad}  </body>"]
+            *tool, f"{pad}  </body>"]
     for _ in range(n):
         xml.append(f"{pad}</body>")
         pad = pad[:-2]
     xml.append("    </body>")
     actuators = [f'    <position name="servo{i}" joint="j{i}" class="planar5" '
                  f'ctrlrange="{_f(-lim)} {_f(lim)}"/>' for i, lim in enumerate(PLANAR5_LIMITS, start=1)]
-    text = f"""<mujoco model="planar5">
+    text = f"""<mujoco model="{"planar5_pen" if pen else "planar5"}">
   <compiler angle="radian" meshdir="meshes" autolimits="true"/>
   <option integrator="implicitfast"/>
   <default>
@@ -720,8 +801,11 @@ def planar5_straight(directory) -> Path:
   </actuator>
 </mujoco>
 """
-    return _write(folder, "planar5", text)
+    return _write(folder, "planar5_pen" if pen else "planar5", text)
 
+
+SMALL_UR_SCALE = 0.5
+"""The small 6-joint arm: the UR5e-style arm at half its size (0.42 m of reach, servos 16 times weaker)."""
 
 SUGGESTED = {
     "ur5e": dict(tip_site="attachment_site", tip_offset=(0.0, 0.0, 0.12), base_pos=(0.0, -0.42, 0.0),
@@ -734,6 +818,11 @@ SUGGESTED = {
     "so100": dict(tip_body="Fixed_Jaw", tip_offset=(0.0, 0.0, SO100_JAW), base_pos=(0.92, -0.8, -0.75),
                   base_yaw=-math.pi),
     "planar5": dict(tip_body="stylus", tip_offset=(0.0, 0.0, 0.0), base_pos=(-0.03, 0.03, 0.0), base_yaw=0.0),
+    # the tool points these files offer, with no mount: the fingers or the pen reach past them
+    "panda_tcp": dict(tip_site="tcp"),
+    "ur5e_gripper": dict(tip_site="pinch"),
+    "small_ur": dict(tip_site="attachment_site", tip_offset=(0.0, 0.0, 0.06)),
+    "planar5_pen": dict(tip_site="pen_tip"),
 }
 """A tip and a mount that work for each arm (cartesian, tool pointing down; planar5 also
 joint). Measured with the project's compiler on copies of these files with the classes'
@@ -743,7 +832,9 @@ cartesian 77%, 3/4, and joint with a 0.35 rad step 92%, 4/4 (494,461 states, 51 
 
 
 ALL = {"ur5e": ur5e_style, "panda": panda_style, "panda_nohand": lambda d: panda_style(d, hand=False),
-       "so100": so100_style, "planar5": planar5_straight}
+       "so100": so100_style, "planar5": planar5_straight,
+       "panda_tcp": lambda d: panda_style(d, tcp=True), "ur5e_gripper": lambda d: ur5e_style(d, gripper=True),
+       "small_ur": lambda d: ur5e_style(d, scale=SMALL_UR_SCALE), "planar5_pen": lambda d: planar5_straight(d, pen=True)}
 """Every fixture by a short name."""
 
 

@@ -106,7 +106,8 @@ def mount_line(arm) -> str:
     x, y, z = arm.mount
     return (f"tool {arm.tool.describe()}; {arm.dof} joints {'-'.join(arm.chain)}"
             + (f" (held: {held})" if held else "")
-            + f"; {arm.mount_source} mount --base-pos={x:.4g},{y:.4g},{z:.4g} --base-yaw={arm.yaw:.4g}")
+            + f"; {arm.mount_source} mount --base-pos={x:.4g},{y:.4g},{z:.4g} --base-yaw={arm.yaw:.4g}"
+            + (f"; {note}" if (note := arm.clearance_note()) else ""))
 
 
 def generate(args: argparse.Namespace) -> int:

@@ -25,7 +25,8 @@ from pathlib import Path
 import numpy as np
 
 # the compiling modules, beside this one: a change to any of them is a new key
-_SOURCES = ("compile.py", "solve.py", "scene.py", "labels.py", "workspace.py", "tool.py")
+_SOURCES = ("compile.py", "seeds.py", "solve.py", "scene.py", "labels.py", "workspace.py", "tool.py", "mount.py",
+            "quick.py")
 _HERE = Path(__file__).resolve().parent
 
 

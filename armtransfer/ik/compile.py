@@ -39,7 +39,9 @@ import numpy as np
 from armtransfer.errors import ArmModelError, UnreachableTableError
 from armtransfer.ik.labels import OFF_TABLE, cells_of_xy
 from armtransfer.ik.scene import ArmScene, ContactChecker
-from armtransfer.ik.solve import MAX_TIP_HEIGHT, TipIK
+from armtransfer.ik.diagnose import why_unreachable
+from armtransfer.ik.seeds import RING, SEED_RESTARTS, _cells_by_distance, reach_bound, seed_cells  # noqa: F401
+from armtransfer.ik.solve import MAX_TIP_HEIGHT, TIP_HEIGHT, TipIK
 
 
 def _near_wall_mask(layout) -> np.ndarray:
@@ -63,29 +65,26 @@ def _progress(enabled: bool, text: str) -> None:
 # --------------------------------------------------------------------------- cartesian
 
 
-def reach_bound(scene: ArmScene) -> tuple[np.ndarray, float]:
-    """The first joint's anchor and the sum of the distances from joint to joint to the tip
-    at home: no tip position lies farther from the anchor than that."""
-    data = mujoco.MjData(scene.model)
-    data.qpos[:] = scene.home
-    mujoco.mj_kinematics(scene.model, data)
-    tip = data.site_xpos[mujoco.mj_name2id(scene.model, mujoco.mjtObj.mjOBJ_SITE, scene.tip)]
-    points = np.vstack([data.xanchor[np.argsort(scene.model.jnt_qposadr)], tip])
-    return points[0].copy(), float(np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1)))
-
-
-def _check_tip_height(z: float) -> None:
-    """A planar arm's tip rides at one height: it must be on the table."""
-    if not -1e-3 <= z <= MAX_TIP_HEIGHT:
+def _check_tip_height(scene: ArmScene, z: float) -> None:
+    """A planar arm's tip rides at one height: its tool's lowest point must be on the table,
+    not in it."""
+    low = z - scene.clearance
+    if low < -1e-3 and scene.clearance > 0:
         raise UnreachableTableError(
-            f"the arm's tip cannot reach the table: it moves {z:.3f} m above the tabletop "
-            f"(at most {MAX_TIP_HEIGHT} m allowed)")
+            f"the arm's tool is in the table: its point rides {z * 1000:.1f} mm above the tabletop and its geom "
+            f"{scene.clearance_geom} reaches {scene.clearance * 1000:.1f} mm past the point; raise the base by "
+            f"{(TIP_HEIGHT - low) * 1000:.1f} mm")
+    if not -1e-3 <= low <= MAX_TIP_HEIGHT:
+        where = "" if scene.clearance == 0 else f" (its lowest point {low:.3f} m)"
+        raise UnreachableTableError(
+            f"the arm's tip cannot reach the table: it moves {z:.3f} m above the tabletop{where} "
+            f"(at most {MAX_TIP_HEIGHT} m allowed); move the base by {-(low - TIP_HEIGHT):+.3f} m in z")
 
 
 def _check_table_in_reach(scene: ArmScene, home_tip: np.ndarray) -> None:
     """Fail at once, not after thousands of IK solves, when the tip cannot reach the table."""
     if scene.planar:
-        _check_tip_height(float(home_tip[2]))
+        _check_tip_height(scene, float(home_tip[2]))
         return
     anchor, reach = reach_bound(scene)
     half = scene.layout.width * scene.cell / 2
@@ -141,11 +140,11 @@ def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = 
             if free[n] and n not in q_of and attempts[n] < 3 and try_cell(n, q_of[c]):
                 queue.append(n)
     if not q_of:
+        cause = why_unreachable(scene, tip_down)
         hint = scene.tool.axis_hint() if tip_down else ""
-        axis = f"; {hint}" if hint else ""
         raise UnreachableTableError(
             "the arm's tip cannot reach the table: IK finds no configuration with the tip "
-            f"over a free cell, at most 1 cm above the tabletop{axis}")
+            "over a free cell, at most 1 cm above the tabletop" + "".join(f"; {t}" for t in (cause, hint) if t))
     _progress(progress, f"  IK: {len(q_of)} cells reached")
 
     cells = np.array(sorted(q_of), dtype=np.int64)
@@ -184,34 +183,6 @@ def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = 
                 canonical=canonical, qpos=qpos, tip=tips)
 
 
-SEED_RESTARTS = 8
-"""Random configurations (inside the joint limits) IK tries for a first cell, after home."""
-
-
-def seed_cells(scene: ArmScene, home_tip: np.ndarray, n: int = 6) -> list[int]:
-    """Cells to try first: those nearest the tip at home, then those nearest the point halfway
-    from the arm's base to the table's centre (a straight or folded home may put the tip
-    far off the table, or at a singular pose, where IK from home cannot start), then the
-    cell nearest each of 8 points around the base at half its reach (a base standing on the
-    table near its centre: the halfway point is then inside the circle no tool-down pose
-    reaches)."""
-    layout, cell = scene.layout, scene.cell
-    anchor, reach = reach_bound(scene)  # the first joint's anchor at home: the base
-    base = anchor[:2]
-    ring = [(base + 0.5 * reach * np.array([np.cos(t), np.sin(t)]), 1)
-            for t in np.arange(RING) * 2 * np.pi / RING]
-    out: list[int] = []
-    for point, k in [(home_tip[:2], n), (base / 2, n), *ring]:
-        for c in _cells_by_distance(point, cell, layout)[:k]:
-            if int(c) not in out:
-                out.append(int(c))
-    return out
-
-
-RING = 8
-"""Points around the base, at half its reach, that ``seed_cells`` also tries."""
-
-
 def _segment_clear(contact: ContactChecker, qa, qb, pa, pb, n_points: int, cell, layout) -> bool:
     d = pb - pa
     length2 = float(d @ d)
@@ -226,12 +197,6 @@ def _segment_clear(contact: ContactChecker, qa, qb, pa, pb, n_points: int, cell,
         if np.linalg.norm(tip[:2] - (pa + u * d)) > 0.75 * cell:
             return False
     return True
-
-
-def _cells_by_distance(xy, cell, layout) -> np.ndarray:
-    ids = np.flatnonzero(layout.free)
-    centres = layout.xy_of(ids) * cell
-    return ids[np.argsort(np.linalg.norm(centres - np.asarray(xy)[:2], axis=1), kind="stable")]
 
 
 # --------------------------------------------------------------------------- joint lattice
@@ -332,7 +297,7 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
     contact = ContactChecker(scene)
     free = layout.free
     near = _near_wall_mask(layout)
-    _check_tip_height(fk.tip_z)
+    _check_tip_height(scene, fk.tip_z)
     home = _lattice_origin(scene, fk)
     dof = len(home)
     lo = np.where(np.isfinite(scene.lower), scene.lower, home - np.pi)

@@ -58,6 +58,18 @@ class ArmDescription:
     """The arm's joints from the base to the tool, as named in the arm file."""
     held: tuple[tuple[str, float], ...] = ()
     """Joints off that chain (fingers, jaws) and the home value each is held at."""
+    clearance: float = 0.0
+    """How far the tool's own geometry reaches past the tool point along its axis (m): the
+    point rides that much higher than ``ik.solve.TIP_HEIGHT``, cells are read at the point."""
+    clearance_geom: str = ""
+    """The geom that reaches farthest past the point ("" when none does)."""
+
+    def clearance_note(self) -> str:
+        """One line when the tool's geometry reaches past the tool point, else ""."""
+        if self.clearance <= 0:
+            return ""
+        return (f"the tool's geometry ({self.clearance_geom}) reaches {self.clearance * 1000:.1f} mm past its point: "
+                "the lowest point rides 4 mm above the table, the cell is read at the point")
 
     @property
     def tip_site(self) -> str | None:

@@ -4,7 +4,7 @@ An arm file says nothing of where it stands relative to the table. ``candidates`
 base poses worth trying:
 
 - an arm whose joint axes are all vertical (a SCARA-like arm, its tip riding at one height)
-  is hung at the height that puts its tip just above the tabletop, over points of a grid
+  is hung at the height that puts its tool's lowest point ``TIP_HEIGHT`` above the tabletop, over points of a grid
   across and around the table;
 - any other arm stands on the table's plane beside it, on the four sides and at the four
   corners, at a few distances, turned so that its home tip points at the table's centre;
@@ -14,10 +14,10 @@ base poses worth trying:
   the pedestal lifts them clear); and its best few poses are also tried on each pedestal
   of ``LIFTS``.
 
-``estimate_reach`` scores one pose: inverse kinematics (the compile's own ``TipIK``, tool
-pointing down for spatial arms) over a sparse lattice of free cells, warm-started from
-neighbour to neighbour as the compile does, and contact-checked; the score is the share of
-those cells reached. The caller (``armtransfer.tasks.arms``) compiles the best few poses in
+``estimate_reach`` scores one pose: inverse kinematics (``ik.quick.QuickIK``, the compile's
+acceptance rule at a fraction of its cost; tool pointing down for spatial arms) over a
+sparse lattice of free cells, warm-started from neighbour to neighbour as the compile does,
+and contact-checked; the score is the share of those cells reached. The caller (``armtransfer.tasks.arms``) compiles the best few poses in
 full and keeps the one that reaches the most free cells with the tasks solvable.
 """
 
@@ -31,10 +31,11 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from armtransfer.ik.compile import SEED_RESTARTS, reach_bound, seed_cells
+from armtransfer.ik.seeds import reach_bound, seed_cells
 from armtransfer.ik.labels import cells_of_xy
 from armtransfer.ik.scene import ArmScene, ContactChecker, base_footing, build_scene
-from armtransfer.ik.solve import TIP_HEIGHT, TipIK
+from armtransfer.ik.quick import QuickIK
+from armtransfer.ik.solve import TIP_HEIGHT
 from armtransfer.ik.tool import Tool
 
 if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never imported
@@ -42,6 +43,13 @@ if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never impor
 
 STRIDE = 4
 """Cells between the lattice points the estimate tries (every 4th cell each way)."""
+SEEDS = 2
+"""Cells nearest the home tip and nearest the point halfway to the table's centre that the
+estimate tries first (``seeds.seed_cells``; then one at each point around the base)."""
+RESTARTS = 4
+"""Random configurations the estimate tries for a first cell, after home."""
+LIGHT_RESTARTS = 1
+"""The same, for a light estimate."""
 PLANAR_GRID = (-0.2, -0.1, 0.0, 0.1, 0.2)
 """Base positions (m, each axis) tried for an arm with vertical joint axes."""
 GAPS = (-0.04, 0.0, 0.05, 0.15, 0.3)
@@ -110,7 +118,7 @@ def candidates(scene: ArmScene, table_half: float, yaw: float | None = None) -> 
     """Base poses to try for the arm of ``scene`` (built at the origin, yaw 0)."""
     place = _Placer(scene)
     if scene.planar:  # hung so that the tip rides just above the tabletop
-        z = TIP_HEIGHT / 2 - place.tip_z
+        z = TIP_HEIGHT + scene.clearance - place.tip_z  # the tool's lowest point 4 mm up
         return [place(x, y, z, 0.0 if yaw is None else yaw) for x in PLANAR_GRID for y in PLANAR_GRID]
     _, reach = reach_bound(scene)
     out = []
@@ -132,10 +140,15 @@ def _lattice(layout: Layout, extra: list[int]) -> list[int]:
 
 
 def estimate_reach(xml_path, tool: Tool, pose: Pose, layout: Layout, cell: float, *,
-                   must: list[int] = (), rng: np.random.Generator | None = None) -> tuple[float, int]:
-    """(share of the sparse lattice's free cells reached, how many of ``must`` were reached)."""
+                   must: list[int] = (), rng: np.random.Generator | None = None,
+                   light: bool = False) -> tuple[float, int]:
+    """(share of the sparse lattice's free cells reached, how many of ``must`` were reached),
+    with the quick IK (``ik.quick.QuickIK``) and the compile's contact check. The first cell
+    is sought from the seeds of ``SEEDS`` and ``RESTARTS``, or with ``light`` from one cell
+    per seed point and one random configuration (a pose that reaches much of the table
+    finds it at once)."""
     scene = build_scene(xml_path, tool, pose.pos, pose.yaw, cell, layout=layout)
-    ik = TipIK(scene, tip_down=not scene.planar)
+    ik = QuickIK(scene, tip_down=not scene.planar)
     contact = ContactChecker(scene)
     if contact.base_on_wall():
         return 0.0, 0
@@ -145,21 +158,22 @@ def estimate_reach(xml_path, tool: Tool, pose: Pose, layout: Layout, cell: float
     found: dict[int, np.ndarray] = {}
 
     def attempt(i: int, q0: np.ndarray, restarts: int = 0) -> bool:
-        res = ik.solve_any(xy[i], q0, rng, restarts=restarts) if restarts else ik.solve(xy[i], q0)
-        if not ik.ok(res) or contact.touches(res.q):
+        q, ok = ik.solve_any(xy[i], q0, rng, restarts=restarts) if restarts else ik.solve(xy[i], q0)
+        if not ok or contact.touches(q):
             return False
-        if int(cells_of_xy(contact.tip(res.q), cell, layout)) != cells[i]:
+        if int(cells_of_xy(contact.tip(q), cell, layout)) != cells[i]:
             return False
-        found[i] = res.q
+        found[i] = q
         return True
 
     queue: deque[int] = deque()
     index = {c: i for i, c in enumerate(cells)}
-    for c in seed_cells(scene, _tip_at(scene, scene.home)):  # from home or random configurations
+    n, restarts = (1, LIGHT_RESTARTS) if light else (SEEDS, RESTARTS)
+    for c in seed_cells(scene, _tip_at(scene, scene.home), n=n):  # from home or random configurations
         i = index.get(c)
         if i is None:
             i = int(np.argmin(np.linalg.norm(xy - np.array(layout.xy(c)) * cell, axis=1)))
-        if i not in found and attempt(i, scene.home, restarts=SEED_RESTARTS):
+        if i not in found and attempt(i, scene.home, restarts=restarts):
             queue.append(i)
             break
     spacing = STRIDE * cell * 1.5

@@ -22,6 +22,14 @@ own gains):
   steady lag of a PD servo on a ramp. A real arm controller does the same; without it a
   UR5e-like arm sags by several cells under gravity.
 
+Servos. A replay first drives the joints with the file's own servos (their gains retuned as
+above, their force and control ranges kept). When those cannot track the path (too weak
+against gravity or the ramp, a control range narrower than the path: the tip ends off the
+goal cell or strays more than ``TRACKING_LIMIT`` cell from the planned tips) it is run
+again with the scene's own servos: the same retuned position servos with no force or
+control limit. ``Replay.settings["servos"]`` says which were used (``file`` or ``scene``),
+and when it is ``scene``, ``file_servos`` says how the file's did.
+
 The report (``Replay.report()``) gives the largest distance of the tip from the polyline
 through the planned cells' centres, in cells, and whether the tip ends in the goal cell.
 """
@@ -43,6 +51,12 @@ from armtransfer.ik.description import ArmDescription
 SEGMENT_SECONDS = 0.1
 SETTLE_SECONDS = 0.3
 BANDWIDTH_HZ = 8.0
+TRACKING_LIMIT = 0.5
+"""Largest distance (cells) of the tip from the planned tips that the file's servos may
+leave before a replay uses the scene's own servos instead."""
+SERVOS = ("auto", "file", "scene")
+"""Which servos a replay drives the joints with: the file's, falling back to the scene's
+(``auto``), or one of them."""
 
 
 class ReplayError(ArmTransferError):
@@ -204,15 +218,36 @@ def _dedupe(cells: Sequence[int]) -> list[int]:
 def replay(robot, path_states: Sequence[int], *, goal_cell: int | None = None,
            segment_seconds: float = SEGMENT_SECONDS, settle_seconds: float = SETTLE_SECONDS,
            bandwidth_hz: float = BANDWIDTH_HZ, feedforward: bool = True,
-           scene: ArmScene | None = None) -> Replay:
+           scene: ArmScene | None = None, servos: str = "auto") -> Replay:
     """Simulate the arm of ``robot`` following ``path_states`` with its position actuators.
 
     ``path_states``: the robot's states in order (e.g. ``[s for s, _ in
     robot.shortest_path(start, goal)]``). ``goal_cell`` defaults to the last state's label.
     Each segment between waypoints lasts ``segment_seconds``; the goal is then held for
     ``settle_seconds``. ``scene`` may be passed to skip rebuilding it (it must be the
-    robot's own scene). Deterministic: no randomness anywhere.
+    robot's own scene). ``servos``: one of ``SERVOS`` (see the module docstring).
+    Deterministic: no randomness anywhere.
     """
+    if servos not in SERVOS:
+        raise ReplayError(f"unknown servos {servos!r}; valid: {', '.join(SERVOS)}")
+    options = dict(goal_cell=goal_cell, segment_seconds=segment_seconds, settle_seconds=settle_seconds,
+                   bandwidth_hz=bandwidth_hz, feedforward=feedforward, scene=scene)
+    if servos == "scene":
+        return _simulate(robot, path_states, own_servos=True, **options)
+    first = _simulate(robot, path_states, own_servos=False, **options)
+    if servos == "file" or (first.reached_goal and first.max_tracking_error_cells <= TRACKING_LIMIT):
+        return first
+    options["scene"] = first.scene
+    second = _simulate(robot, path_states, own_servos=True, **options)
+    second.settings["file_servos"] = {"reached_goal": first.reached_goal,
+                                      "max_tracking_error_cells": round(first.max_tracking_error_cells, 4)}
+    return second
+
+
+def _simulate(robot, path_states: Sequence[int], *, goal_cell: int | None, segment_seconds: float,
+              settle_seconds: float, bandwidth_hz: float, feedforward: bool, scene: ArmScene | None,
+              own_servos: bool) -> Replay:
+    """One replay, with the file's servos or (``own_servos``) the scene's."""
     states = [int(s) for s in path_states]
     if not states:
         raise ReplayError("a replay needs at least one path state")
@@ -227,6 +262,11 @@ def replay(robot, path_states: Sequence[int], *, goal_cell: int | None = None,
     goal = int(robot.label[states[-1]]) if goal_cell is None else int(goal_cell)
 
     model = copy.copy(scene.model)  # the gains are retuned on this copy only
+    if own_servos:  # position servos with no force or control limit
+        model.actuator_forcelimited[:] = 0
+        model.actuator_ctrllimited[:] = 0
+        model.actuator_gaintype[:] = mujoco.mjtGain.mjGAIN_FIXED
+        model.actuator_biastype[:] = mujoco.mjtBias.mjBIAS_AFFINE
     data = mujoco.MjData(model)
     tip_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, scene.tip)
     way = np.asarray(qtable[states], dtype=float)
@@ -290,7 +330,8 @@ def replay(robot, path_states: Sequence[int], *, goal_cell: int | None = None,
     planned_cells = _dedupe(robot.label[states].tolist())
     planned_xy = np.array([np.array(layout.xy(c), dtype=float) * scene.cell for c in planned_cells])
     settings = {"segment_seconds": seg_steps * dt, "settle_seconds": settle_steps * dt,
-                "bandwidth_hz": bandwidth_hz, "feedforward": feedforward, "timestep": dt}
+                "bandwidth_hz": bandwidth_hz, "feedforward": feedforward, "timestep": dt,
+                "servos": "scene" if own_servos else "file"}
     return Replay(robot=robot.name, scene=scene, path_states=tuple(states), goal_cell=goal,
                   planned_xy=planned_xy, planned_tip=planned_tip, time=np.arange(k + 1) * dt,
                   qpos=qpos, tip=tip, waypoint_index=waypoint_index, settings=settings)
@@ -332,4 +373,4 @@ def _tune_gains(model: mujoco.MjModel, data: mujoco.MjData, bandwidth_hz: float)
     return kv
 
 
-__all__ = ["Replay", "ReplayError", "check_replayable", "polyline_distance", "replay", "robot_scene"]
+__all__ = ["SERVOS", "Replay", "ReplayError", "check_replayable", "polyline_distance", "replay", "robot_scene"]

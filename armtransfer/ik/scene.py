@@ -77,6 +77,12 @@ class ArmScene:
     held: tuple[tuple[str, float], ...] = ()
     """Joints off the chain and the home value each is held at."""
     tool: Tool = Tool()
+    clearance: float = 0.0
+    """How far the tool's own geometry reaches past the tool point along the tool axis (m,
+    at least 0): the point rides this much higher so that the lowest point clears the table
+    as a bare point would (``tool_reach``)."""
+    clearance_geom: str = ""
+    """The geom that reaches farthest past the point ("" when none does)."""
 
     @property
     def nq(self) -> int:
@@ -109,6 +115,67 @@ def base_footing(model: mujoco.MjModel, qpos: np.ndarray) -> tuple[np.ndarray, f
             points = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half + centre
         bottom = min(bottom, float(np.min(data.geom_xpos[g][2] + points @ data.geom_xmat[g].reshape(3, 3)[2])))
     return anchor, bottom
+
+
+CLEARANCE_MIN = 5e-4
+"""Tool geometry reaching less than this past the tool point (m) is taken as ending at it."""
+
+
+def _support(model: mujoco.MjModel, data: mujoco.MjData, g: int, direction: np.ndarray) -> float:
+    """How far geom ``g`` reaches along the unit ``direction`` (world) from its centre."""
+    u = data.geom_xmat[g].reshape(3, 3).T @ direction  # the direction in the geom's frame
+    size = model.geom_size[g]
+    kind = model.geom_type[g]
+    if kind == mujoco.mjtGeom.mjGEOM_SPHERE:
+        return float(size[0])
+    if kind == mujoco.mjtGeom.mjGEOM_CAPSULE:
+        return float(abs(u[2]) * size[1] + size[0])
+    if kind == mujoco.mjtGeom.mjGEOM_CYLINDER:
+        return float(abs(u[2]) * size[1] + size[0] * math.hypot(u[0], u[1]))
+    if kind == mujoco.mjtGeom.mjGEOM_BOX:
+        return float(np.abs(u) @ size)
+    if kind == mujoco.mjtGeom.mjGEOM_ELLIPSOID:
+        return float(np.linalg.norm(size * u))
+    if kind == mujoco.mjtGeom.mjGEOM_MESH:
+        m = model.geom_dataid[g]
+        verts = model.mesh_vert[model.mesh_vertadr[m]:model.mesh_vertadr[m] + model.mesh_vertnum[m]]
+        return float(np.max(verts @ u))
+    centre, half = model.geom_aabb[g, :3], model.geom_aabb[g, 3:]  # anything else: its box
+    return float(centre @ u + np.abs(u) @ half)
+
+
+def tool_reach(model: mujoco.MjModel, qpos: np.ndarray, tip_site: int, direction: np.ndarray | None = None,
+               solid: np.ndarray | None = None) -> tuple[float, int]:
+    """(how far the tool's own geometry reaches past the tool point along the tool axis, m;
+    the geom that reaches farthest, -1 when none reaches past it).
+
+    The tool's geometry is that of the body carrying the tool site and of the bodies that
+    hang from it without a joint (held fingers, a pen), counting the geoms that ``solid``
+    marks (default: every geom that collides with anything). The axis is the site's z axis,
+    or ``direction`` (world) when given."""
+    data = mujoco.MjData(model)
+    data.qpos[:] = qpos
+    mujoco.mj_kinematics(model, data)
+    body = int(model.site_bodyid[tip_site])
+    weld = model.body_weldid[body]
+    axis = data.site_xmat[tip_site].reshape(3, 3)[:, 2] if direction is None else np.asarray(direction, float)
+    axis = axis / np.linalg.norm(axis)
+    point = data.site_xpos[tip_site]
+    if solid is None:
+        solid = (model.geom_contype != 0) | (model.geom_conaffinity != 0)
+    best, which = 0.0, -1
+    for g in range(model.ngeom):
+        b = int(model.geom_bodyid[g])
+        if not solid[g] or model.body_weldid[b] != weld:
+            continue
+        while b > body:  # hangs from the tool's body?
+            b = int(model.body_parentid[b])
+        if b != body:
+            continue
+        reach = float((data.geom_xpos[g] - point) @ axis) + _support(model, data, g, axis)
+        if reach > best:
+            best, which = reach, g
+    return (best, which) if best >= CLEARANCE_MIN else (0.0, -1)
 
 
 def _first_line(err: BaseException) -> str:
@@ -385,10 +452,20 @@ def build_scene(xml_path: Path, tool: Tool | str = "tip", mount_pos=(0.0, 0.0, 0
     data.qpos[:] = home
     mujoco.mj_kinematics(scene, data)
     planar = bool(np.all(np.abs(np.abs(data.xaxis[:, 2]) - 1.0) < 1e-6))
+    tip_id = mujoco.mj_name2id(scene, mujoco.mjtObj.mjOBJ_SITE, PREFIX + tip_name)
+    table_geoms = np.flatnonzero(env)
+    hits_table = np.zeros(scene.ngeom, dtype=bool)
+    for t in table_geoms:
+        hits_table |= ((scene.geom_contype & scene.geom_conaffinity[t]) | (scene.geom_conaffinity & scene.geom_contype[t])) != 0
+    clearance, geom = tool_reach(scene, home, tip_id, np.array([0.0, 0.0, -1.0]) if planar else None,
+                                 hits_table & arm_geoms)
     return ArmScene(model=scene, xml=xml, tip=PREFIX + tip_name, home=home, lower=lower,
                     upper=upper, env_geoms=env, arm_geoms=arm_geoms, cell=cell, layout=layout,
                     planar=planar, name=arm_name, chain=tuple(joint_name(j) for j in chain), held=held,
-                    tool=tool)
+                    tool=tool, clearance=round(clearance, 6),
+                    clearance_geom=(_name(scene, mujoco.mjtObj.mjOBJ_GEOM, geom).removeprefix(PREFIX) or
+                                    f"a geom of body {_name(scene, mujoco.mjtObj.mjOBJ_BODY, int(scene.geom_bodyid[geom])).removeprefix(PREFIX)}")
+                    if geom >= 0 else "")
 
 
 class ContactChecker:
@@ -460,6 +537,29 @@ class ContactChecker:
             pair = sorted(_name(self.model, mujoco.mjtObj.mjOBJ_BODY, i) or f"body {i}" for i in bodies)
             names.add((pair[0], pair[1]))
         return sorted(names)
+
+    def contact_names(self, q: np.ndarray) -> list[str]:
+        """The contacts that ``touches`` counts at q, named: ``"left_finger with the table"``,
+        ``"wrist_3_link with wall wall_2"``, ``"link1 with link4"`` (arm bodies by name)."""
+        g1, g2 = self._contacts(q)
+        env = (self._env[g1] & self._moving[g2]) | (self._env[g2] & self._moving[g1])
+        counted = env | self._own(g1, g2)
+        out: list[str] = []
+        for a, b in zip(g1[counted], g2[counted]):
+            if self._env[a]:
+                a, b = b, a
+            text = f"{self._what(int(a))} with {self._what(int(b))}"
+            if text not in out:
+                out.append(text)
+        return out
+
+    def _what(self, g: int) -> str:
+        m = self.model
+        if self._env[g]:
+            name = _name(m, mujoco.mjtObj.mjOBJ_GEOM, g)
+            return f"wall {name}" if self._walls[g] else "the table"
+        body = int(m.geom_bodyid[g])
+        return (_name(m, mujoco.mjtObj.mjOBJ_BODY, body) or f"body {body}").removeprefix(PREFIX)
 
     def base_on_wall(self) -> bool:
         """Does the arm's fixed base (collision geoms that no joint moves) stand in a wall?

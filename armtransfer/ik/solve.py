@@ -24,9 +24,11 @@ import numpy as np
 from armtransfer.ik.scene import ArmScene
 
 TIP_HEIGHT = 0.004
-"""Height IK puts the tool tip at above the tabletop (m). Planar arms keep their own."""
+"""Height IK puts the tool's lowest point at above the tabletop (m): the tool point itself,
+or higher by ``ArmScene.clearance`` when the tool's geometry reaches past the point. Planar
+arms keep their own."""
 MAX_TIP_HEIGHT = 0.01
-"""A tip higher than this above the tabletop (m) is not on the table."""
+"""A tool whose lowest point is higher than this above the tabletop (m) is not on the table."""
 
 TILT_TOL = 0.05
 """Largest tilt (rad) of the tool axis from straight down, for an arm of six joints or more."""
@@ -58,7 +60,7 @@ class IKResult:
     """Angle between the tool axis and straight down (rad; 0 for planar arms)."""
     iterations: int
     height: float = TIP_HEIGHT
-    """Height of the tip above the tabletop (m)."""
+    """Height of the tool point above the tabletop (m)."""
 
 
 class TipIK:
@@ -90,7 +92,7 @@ class TipIK:
 
     def target_height(self, q: np.ndarray) -> float:
         if not self.scene.planar:
-            return TIP_HEIGHT
+            return TIP_HEIGHT + self.scene.clearance
         self.configuration.update(q)
         return float(self.configuration.get_transform_frame_to_world(self.scene.tip, "site").translation()[2])
 
@@ -155,5 +157,5 @@ class TipIK:
         return err, float(np.arccos(np.clip(-z[2], -1.0, 1.0)))
 
     def ok(self, result: IKResult) -> bool:
-        return (result.error <= self.tol and result.tilt <= self.tilt_tol
-                and -1e-3 <= result.height <= MAX_TIP_HEIGHT)
+        low = result.height - self.scene.clearance  # the tool's lowest point
+        return result.error <= self.tol and result.tilt <= self.tilt_tol and -1e-3 <= low <= MAX_TIP_HEIGHT

@@ -174,7 +174,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
         kind, tip_down = info.kind, info.tip_down
         step = joint_step or info.joint_step
     parts = {
-        "version": 5, "arm_xml": _sha(xml_bytes), "assets": _assets_sha(path), "tool": tool.key(),
+        "version": 6, "arm_xml": _sha(xml_bytes), "assets": _assets_sha(path), "tool": tool.key(),
         "mount": mount, "yaw": yaw, "actions": model.name, "cells": model.cells, "tip_down": tip_down,
         "joint_step": step if model.kind == "joint" else None, "cell": cell_size,
         "wall_height": WALL_HEIGHT, "layout": _layout_data(layout),
@@ -209,12 +209,15 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
     label = arrays["label"]
     reach = float(len(np.unique(label)) / layout.free.sum())
     chain, held = _chain_of(arrays)
+    clearance = float(arrays.get("clearance", 0.0))
+    clearance_geom = str(arrays.get("clearance_geom", ""))
     description = ArmDescription(
         name=name, actions=model.name, dof=dof, kind=kind, qpos=arrays["qpos"], tip=arrays["tip"],
         reach=reach, cache=status, key=key, seconds=seconds, cell_size=cell_size,
         mount=mount, yaw=yaw, xml_path=str(path), tool=tool,
         joint_step=step if model.kind == "joint" else None, layout=layout,
         lattice=arrays.get("lattice"), mount_source=source, chain=chain, held=held,
+        clearance=clearance, clearance_geom=clearance_geom,
     )
     return DiscreteRobot(
         name=robot_name,
@@ -253,7 +256,10 @@ def mount_search(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, lay
     of at least ``COVERS`` with every Table I cell) also tries ``ik.mount.on_table``, each
     pose standing on the tabletop and on the lowest pedestal of ``ik.mount.LIFTS`` (on the
     table its turning links pass a few centimetres from the 2 cm walls; the pedestal lifts
-    them clear), and the best five poses standing on the tabletop on each pedestal.
+    them clear), and the best five poses standing on the tabletop on each pedestal. Each pose
+    is estimated with light seeds (``ik.mount.estimate_reach``); when no pose reaches a
+    cell, the first ``RETRIES`` are estimated again with the full seeds, so that a search
+    that cannot succeed ends soon.
     """
     from armtransfer.ik import mount as _mount
     from armtransfer.tasks.catalog import TABLE_I
@@ -266,7 +272,7 @@ def mount_search(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, lay
         for pose in batch:
             i = len(scored)
             share, hit = _mount.estimate_reach(path, tool, pose, layout, cell_size, must=must,
-                                               rng=np.random.default_rng(i))
+                                               rng=np.random.default_rng(i), light=True)
             scored.append((hit, share, -i, pose))
         scored.sort(key=lambda t: (t[0], t[1], t[2]), reverse=True)
 
@@ -280,11 +286,23 @@ def mount_search(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, lay
         best = [pose for *_, pose in scored if pose in standing][:5]
         score([lifted for pose in best for h in _mount.LIFTS  # on a pedestal
                if (lifted := pose.lifted(h)) not in tried])
+    if scored and scored[0][1] == 0.0:  # nothing found with the light seeds: look harder at a few
+        for k, (_, _, i, pose) in enumerate(scored[:RETRIES]):
+            share, hit = _mount.estimate_reach(path, tool, pose, layout, cell_size, must=must,
+                                               rng=np.random.default_rng(-i))
+            scored[k] = (hit, share, i, pose)
+        scored.sort(key=lambda t: (t[0], t[1], t[2]), reverse=True)
     return [(hit, share, pose) for hit, share, _, pose in scored]
 
 
-COMPILES = 3
-"""Poses the automatic mount compiles in full from each of its two rankings."""
+RETRIES = 8
+"""Poses a mount search estimates again with the full seeds (``ik.mount.SEEDS``,
+``ik.mount.RESTARTS``) when the light seeds found no cell from any pose."""
+
+
+COMPILES = 2
+"""Poses ``compile_order`` takes from each of its two rankings; the automatic mount compiles
+the first of them, and the next only when a compile fails, this many in all."""
 
 
 def compile_order(scored: list, n: int = COMPILES) -> list:
@@ -303,24 +321,22 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
                     yaw: float | None = None, cache: bool = True, progress: bool = False):
     """A base pose for an arm that came without one (``ik.mount.Pose``).
 
-    The poses of :func:`mount_search` are ranked by their quick estimate. The best three (by
-    Table I cells reached, then the estimate), and up to three more whose estimate beats
-    one of those (:func:`compile_order`), are compiled in full (the 1-cell cartesian model:
-    reach is the tool's workspace, whatever the action model), and the one with the most
-    Table I tasks solvable, then the most free cells reached, wins; a pose that solves every
-    task and reaches every free cell ends the compiles. (The estimate is a sparse lattice:
-    for a small arm it can put a pose that reaches more below one that reaches less.) The
-    choice is cached under the arm file's content (meshes included), tool, cell size and
-    layout, so it is made once.
+    The poses of :func:`mount_search` are ranked by their quick estimate (Table I cells
+    reached, then the share of the lattice). Only the winner is compiled in full (the 1-cell
+    cartesian model: reach is the tool's workspace, whatever the action model); the next of
+    :func:`compile_order` only when a compile fails, ``COMPILES`` in all. When no pose
+    reaches a cell, or none compiles, the error names the cause measured at the best pose
+    (``ik.diagnose``). The choice is cached under the arm file's content (meshes included),
+    tool, cell size and layout, so it is made once.
     """
     import json
 
     from armtransfer.ik import mount as _mount
-    from armtransfer.tasks.catalog import TABLE_I as _TABLE_I
 
-    parts = {"version": 9, "what": "mount", "covers": COVERS, "arm_xml": _sha(path.read_bytes()),
-             "assets": _assets_sha(path), "tool": tool.key(), "cell": cell_size, "yaw": yaw,
-             "layout": _layout_data(layout), "stride": _mount.STRIDE, "gaps": _mount.GAPS,
+    parts = {"version": 11, "what": "mount", "compiles": COMPILES, "covers": COVERS,
+             "arm_xml": _sha(path.read_bytes()), "assets": _assets_sha(path), "tool": tool.key(),
+             "cell": cell_size, "yaw": yaw, "layout": _layout_data(layout), "stride": _mount.STRIDE,
+             "seeds": [_mount.SEEDS, _mount.RESTARTS, RETRIES], "gaps": _mount.GAPS,
              "grid": _mount.PLANAR_GRID, "lifts": _mount.LIFTS}
     key = _cache.cache_key(parts)
     entry = _cache.cache_dir() / f"mount-{key[:16]}.json"
@@ -334,19 +350,27 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
             pass
     from armtransfer.errors import UnreachableTableError
 
-    hint = tool.axis_hint()
-    axis = f"; {hint}" if hint else ""
-    unreachable = UnreachableTableError(
-        f"the arm's tool ({tool.describe()}) cannot reach the table from any base pose tried; give "
-        f"--base-pos X,Y,Z and --base-yaw{axis}")
+    def unreachable(best) -> UnreachableTableError:
+        """The error, with the cause measured at the best pose tried (``ik.diagnose``)."""
+        from armtransfer.ik.diagnose import why_unreachable
+
+        cause, planar = "", False
+        if best is not None:
+            scene = _scene(path, tool, best.pos, best.yaw, cell_size, layout)
+            cause, planar = why_unreachable(scene, not scene.planar), scene.planar
+            cause = f" (at the best, {best.describe()}: {cause})" if cause else ""
+        hint = "" if planar else tool.axis_hint()
+        return UnreachableTableError(
+            f"the arm's tool ({tool.describe()}) cannot reach the table from any base pose tried{cause}; give "
+            f"--base-pos X,Y,Z and --base-yaw" + (f"; {hint}" if hint else ""))
     if progress:
         print(f"choosing a mount for {path.name}: estimating the reach of base poses (once; the choice is "
               "cached) ...", file=sys.stderr, flush=True)
     scored = mount_search(path, tool, cell_size=cell_size, layout=layout, yaw=yaw)
     if not scored or scored[0][1] == 0.0:
-        raise unreachable
+        raise unreachable(scored[0][2] if scored else None)
     best = None
-    for hit, share, pose in compile_order(scored):
+    for hit, share, pose in compile_order(scored)[:COMPILES]:
         if progress:
             print(f"  mount candidate: {pose.describe()} (estimated reach {share:.0%})", file=sys.stderr, flush=True)
         try:
@@ -355,13 +379,10 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
                               base_yaw=pose.yaw, layout=layout, cache=cache)
         except ArmModelError:
             continue
-        rank = (tasks_solvable(robot), robot.arm.reach)
-        if best is None or rank > best[0]:
-            best = (rank, pose)
-        if rank == (len(_TABLE_I), 1.0):  # every task and every free cell: nothing can beat it
-            break
+        best = ((tasks_solvable(robot), robot.arm.reach), pose)
+        break
     if best is None:
-        raise unreachable
+        raise unreachable(scored[0][2])
     pose = best[1]
     if cache:
         from armtransfer.io import write_json_atomic
@@ -455,6 +476,8 @@ def _compile(scene, model, tip_down, step, progress) -> dict:
                                    progress)
     arrays["chain"] = np.array(list(scene.chain), dtype=str).reshape(-1)
     arrays["held"] = np.array([f"{n}={v!r}" for n, v in scene.held], dtype=str).reshape(-1)
+    arrays["clearance"] = np.array(scene.clearance)
+    arrays["clearance_geom"] = np.array(scene.clearance_geom)
     return arrays
 
 

@@ -1,0 +1,95 @@
+"""Wall time of the automatic mount search for the Menagerie-style test arms, from an empty cache.
+
+    MUJOCO_GL=egl python benchmarks/bench_mount.py [--runs 1] [--baseline SRC] [ARM ...]
+
+Each run is a fresh Python process with a fresh empty cache directory that writes the arm
+files (``tests/menagerie_like.py``) and times ``automatic_mount`` alone (imports and
+writing the files excluded): wall seconds and the process's CPU seconds (on a machine
+other jobs share, wall time grows with their load; CPU time does not). ARM is a name of
+``menagerie_like.ALL`` with its tool point from ``menagerie_like.SUGGESTED``; the default
+is every arm there. ``--baseline SRC`` also times the package at SRC (a checkout of
+another commit: ``armtransfer`` imported from there, not the installed one) in the same
+runs, alternating.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+from armtransfer import script
+
+ROOT = Path(__file__).resolve().parent.parent
+
+CHILD = r"""
+import json, os, sys, time
+from pathlib import Path
+source = os.environ.get("BENCH_SOURCE")
+if source:  # the baseline checkout, ahead of the installed (editable) package
+    sys.meta_path[:] = [f for f in sys.meta_path if not getattr(f, "__module__", "").startswith("__editable__")]
+    sys.path.insert(0, source)
+    import armtransfer
+    assert armtransfer.__file__.startswith(source), armtransfer.__file__
+sys.path.insert(0, sys.argv[3])
+import menagerie_like as ml
+from armtransfer.errors import ArmTransferError
+from armtransfer.tasks.arms import automatic_mount, make_tool
+name = sys.argv[1]
+path = ml.ALL[name](Path(sys.argv[2]))
+tip = {k: v for k, v in ml.SUGGESTED[name].items() if k.startswith("tip")}
+tool = make_tool(tip.get("tip_site"), tip.get("tip_body"), tip.get("tip_offset"))
+t0, c0 = time.perf_counter(), time.process_time()
+try:
+    pose = automatic_mount(path, tool)
+    out = {"pose": pose.describe()}
+except ArmTransferError as err:
+    out = {"error": str(err)}
+out["seconds"] = time.perf_counter() - t0
+out["cpu"] = time.process_time() - c0
+print(json.dumps(out))
+"""
+
+
+def _run(name: str, source: str | None) -> dict:
+    with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as files:
+        env = dict(os.environ, ARMTRANSFER_CACHE=cache, MUJOCO_GL=os.environ.get("MUJOCO_GL", "egl"))
+        if source:
+            env["BENCH_SOURCE"] = source
+        out = subprocess.run([sys.executable, "-c", CHILD, name, files, str(ROOT / "tests")], env=env,
+                             check=True, cwd=ROOT, capture_output=True, text=True).stdout
+    return json.loads(out.strip().splitlines()[-1])
+
+
+def main() -> None:
+    sys.path.insert(0, str(ROOT / "tests"))
+    import menagerie_like as ml
+
+    parser = script.parser(__doc__)
+    parser.add_argument("arms", nargs="*", default=[n for n in ml.ALL if n in ml.SUGGESTED])
+    parser.add_argument("--runs", type=int, default=1)
+    parser.add_argument("--baseline", default=None, help="a checkout of the baseline commit")
+    args = parser.parse_args()
+    print("| arm | code | wall s (median) | CPU s (median) | runs (wall/CPU) | result |")
+    print("|---|---|---:|---:|---|---|")
+    for name in args.arms:
+        runs: dict[str, list] = {"this": [], "baseline": []}
+        for _ in range(args.runs):
+            runs["this"].append(_run(name, None))
+            if args.baseline:
+                runs["baseline"].append(_run(name, args.baseline))
+        for code, rows in runs.items():
+            if not rows:
+                continue
+            wall, cpu = [r["seconds"] for r in rows], [r["cpu"] for r in rows]
+            result = rows[0].get("pose") or rows[0].get("error")
+            print(f"| {name} | {code} | {statistics.median(wall):.1f} | {statistics.median(cpu):.1f} | "
+                  f"{', '.join(f'{w:.1f}/{c:.1f}' for w, c in zip(wall, cpu))} | {result} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
