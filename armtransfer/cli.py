@@ -24,6 +24,7 @@ COMMANDS = {
     "summarize": "summarize",
     "arms": "arms",
     "matrix": "matrix",
+    "benchmark": "benchmark",
 }
 
 

@@ -71,12 +71,17 @@ def summarize(records: list[dict]) -> list[dict]:
                 "improvement_percent": None,
                 "improvement_ci95": None,
                 "improvement_design": None,
+                "improvement_censored": None,
+                "improvement_cap_dominated": None,
+                "mean_cap_dominated": st["cap_dominated"],
             }
             if base is not None and label != "none":
                 imp = _improvement(base, col, cap)
                 row["improvement_percent"] = imp["percent"]
                 row["improvement_ci95"] = imp["ci95"]
                 row["improvement_design"] = imp["design"]
+                row["improvement_censored"] = imp["censored"]
+                row["improvement_cap_dominated"] = imp["cap_dominated"]
             rows.append(row)
     return rows
 

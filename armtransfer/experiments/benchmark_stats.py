@@ -1,0 +1,139 @@
+"""The statistics of a benchmark run, from its records alone.
+
+Per case and method, over every source seed and trial:
+
+  first exposure     steps until the goal is first reached: Kaplan-Meier median and 95%
+                     interval (censored at the trial's cap), the median over source seeds of
+                     each seed's median (with a percentile bootstrap interval over seeds),
+                     and the worst source seed's median
+  failure rate       the share of trials that never reached the goal within the cap (a
+                     method that could not run counts every trial as failed)
+  success rate       the share of trials that reached it within the budget
+                     (``suites.BUDGET_FACTOR`` x the target's shortest path)
+  convergence        steps until the greedy path settled: Kaplan-Meier median (censored at
+                     the cap: a trial that never settled)
+  area               the area under the learning curve (``learning_metrics.curve``: steps of
+                     the first ``HORIZON`` episodes), mean over trials
+
+and against the method's baseline (the method sharing its learner), paired per source seed:
+the factor baseline / method of the seeds' median first exposures (geometric mean over seeds
+with a bootstrap interval on the log scale, the worst seed's factor) and Taylor and Stone's
+transfer ratio, the share of the baseline's learning-curve area the method saves.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+
+import numpy as np
+
+from armtransfer.experiments import survival
+from armtransfer.experiments.metrics import median_is_lower_bound
+
+
+def _seed_median(values: list, cap: float) -> tuple[float, bool]:
+    """(median with None counted at ``cap``, whether censoring reaches it: a lower bound)."""
+    x = np.array([cap if v is None else v for v in values], dtype=np.float64)
+    return float(np.median(x)), median_is_lower_bound(sum(v is None for v in values), len(values))
+
+
+def cell_stats(recs: list[dict]) -> dict:
+    """The statistics of one case and method (``recs``: its records, one per source seed)."""
+    cap = recs[0]["cap"]
+    fe = [v for r in recs for v in r["first_exposure"]]
+    n = len(fe)
+    km = survival.kaplan_meier(fe, cap)
+    seeds = [_seed_median(r["first_exposure"], cap) for r in recs]
+    medians = [m for m, _ in seeds]
+    conv = [v for r in recs for v in r["convergence_steps"]]
+    conv_km = survival.kaplan_meier(conv, cap)
+    within = [v is not None and v <= r["budget"] for r in recs for v in r["first_exposure"]]
+    areas = [a for r in recs for a in r["area"] if a is not None]
+    curves = [c for r in recs for c in r["curves"]]
+    return {
+        "trials": n,
+        "source_seeds": len(recs),
+        "errors": sorted({r["error"] for r in recs if r["error"]}),
+        "failure_rate": sum(v is None for v in fe) / n if n else None,
+        "success_rate": sum(within) / n if n else None,
+        "first_exposure": {
+            "km_median": km["median"], "km_median_ci95": km["median_ci95"],
+            "km_median_beyond_cap": km["median_beyond_cap"],
+            "seed_medians": medians,
+            "median_over_seeds": float(np.median(medians)) if medians else None,
+            "median_over_seeds_ci95": survival.bootstrap_ci(medians, np.median),
+            "worst_seed": max(medians) if medians else None,
+            "worst_seed_is_lower_bound": any(lb and m == max(medians) for m, lb in seeds),
+            "seeds_at_cap": sum(lb for _, lb in seeds),
+        },
+        "survival": {k: km[k] for k in ("times", "survival", "low", "high")},
+        "convergence": {"km_median": conv_km["median"], "km_median_ci95": conv_km["median_ci95"],
+                        "km_median_beyond_cap": conv_km["median_beyond_cap"],
+                        "converged": sum(v is not None for v in conv)},
+        "area": {"mean": float(np.mean(areas)) if areas else None,
+                 "ci95": survival.bootstrap_ci([np.mean(r["area"]) for r in recs if None not in r["area"]])},
+        "curve_mean": [float(v) for v in np.mean(curves, axis=0)] if curves else [],
+    }
+
+
+def paired(method: list[dict], base: list[dict]) -> dict:
+    """The method against its baseline, paired by source seed (records in seed order)."""
+    cap = method[0]["cap"]
+    logs, ratios, bounds = [], [], 0
+    for m, b in zip(method, base):
+        assert m["source_seed"] == b["source_seed"]
+        mm, mlb = _seed_median(m["first_exposure"], cap)
+        bm, blb = _seed_median(b["first_exposure"], cap)
+        logs.append(math.log(bm / mm))
+        bounds += bool(mlb or blb)
+        if None not in m["area"] and None not in b["area"]:
+            ratios.append(1.0 - float(np.mean(m["area"])) / float(np.mean(b["area"])))
+    out = survival.ratio_summary(logs)
+    out["log_factors"] = logs
+    out["seeds_with_censored_median"] = bounds
+    out["transfer_ratio"] = float(np.mean(ratios)) if ratios else None
+    out["transfer_ratio_ci95"] = survival.bootstrap_ci(ratios)
+    return out
+
+
+def summarize(records: list[dict]) -> dict:
+    """``{section: {"cases": [{label, methods: {name: stats}}], "pooled": {name: factor}}}``.
+
+    ``pooled`` is the factor against the baseline over every (case, source seed) of the
+    section, each pair one unit of the bootstrap."""
+    by_cell: dict = defaultdict(list)
+    for r in records:
+        by_cell[(r["section"], r["case"], r["method"])].append(r)
+    out: dict = {}
+    for r in records:
+        sec = out.setdefault(r["section"], {"cases": {}, "pooled": {}})
+        sec["cases"].setdefault(r["case"], {"label": r["label"], "optimal_per_seed": [], "methods": {}})
+    for (section, case, method), recs in by_cell.items():
+        recs.sort(key=lambda r: r["source_seed"])
+        entry = cell_stats(recs)
+        entry["baseline"] = recs[0]["baseline"]
+        b = by_cell.get((section, case, entry["baseline"]))
+        entry["against_baseline"] = None if b is None else paired(recs, sorted(b, key=lambda r: r["source_seed"]))
+        out[section]["cases"][case]["methods"][method] = entry
+        out[section]["cases"][case]["optimal_per_seed"] = [r["optimal"] for r in recs]
+    for section, sec in out.items():
+        order = [r["method"] for r in records if r["section"] == section]
+        names = list(dict.fromkeys(order))
+        for name in names:
+            logs = []
+            cens = 0
+            base = None
+            for case in sec["cases"].values():
+                ab = case["methods"].get(name, {}).get("against_baseline")
+                if ab is not None:
+                    logs += ab["log_factors"]
+                    cens += ab["seeds_with_censored_median"]
+                    base = case["methods"][name]["baseline"]
+            if base is not None:
+                sec["pooled"][name] = dict(survival.ratio_summary(logs), baseline=base,
+                                           seeds_with_censored_median=cens)
+        sec["cases"] = [sec["cases"][k] for k in sorted(sec["cases"])]
+        for case in sec["cases"]:
+            case["methods"] = {n: case["methods"][n] for n in names if n in case["methods"]}
+    return out
