@@ -30,9 +30,30 @@ def test_unreached_trials_count_at_the_cap_and_the_mean_is_a_lower_bound():
     assert st["mean"] >= cap * 2 / 5
     # the old mean over successes only (200) would have flattered it
     assert st["mean"] > metrics.mean_ci(values)[0]
+    # the t-interval of these skewed counts would reach below zero steps; the bootstrap's stays
+    # within the values and holds the mean
     half = stats.t.ppf(0.975, 4) * np.std([100, 200, 1000, 300, 1000], ddof=1) / np.sqrt(5)
-    assert st["ci95"] == pytest.approx([st["mean"] - half, st["mean"] + half])
+    assert st["mean"] - half < 0
+    assert 100 <= st["ci95"][0] < st["mean"] < st["ci95"][1] <= cap
     assert st["median"] == 300 and not st["median_is_lower_bound"]
+
+
+def test_a_median_at_exactly_half_censored_is_a_lower_bound():
+    st = metrics.exploration_stats([100, 200, None, None], 1000)
+    assert st["median"] == 600 and st["median_is_lower_bound"]
+    st = metrics.exploration_stats([100, 200, 300, None], 1000)
+    assert st["median"] == 250 and not st["median_is_lower_bound"]
+    assert metrics.median_is_lower_bound(3, 5) and not metrics.median_is_lower_bound(2, 5)
+
+
+def test_a_mean_made_mostly_of_the_cap_is_flagged():
+    st = metrics.exploration_stats([100, 200, None], 1000)
+    assert st["cap_dominated"]
+    assert not metrics.exploration_stats([100, 200, 300, None], 400)["cap_dominated"]  # 400 of 1000
+    p = metrics.paired_improvement([100, 200, None], [100, 200, 300], 1000)
+    assert p["censored"] and p["cap_dominated"]
+    p = metrics.paired_improvement([100, 200, 300], [100, 200, 250], 1000)
+    assert not p["censored"] and not p["cap_dominated"]
 
 
 def test_all_unreached_is_the_cap_not_n_a():
@@ -110,6 +131,7 @@ def test_summarize_reports_reached_and_a_censored_mean():
     assert e["mean"] >= 2 * cap / 3
     assert e["improvement_percent"] < 0  # worse than none, as it is
     assert e["improvement_design"] == metrics.PAIRED_DESIGN
+    assert e["improvement_censored"] and e["improvement_cap_dominated"] and e["mean_cap_dominated"]
     assert out["none"]["improvement_design"] is None and not out["none"]["mean_is_lower_bound"]
     for key in ("exploration_steps", "mean", "ci95", "improvement_percent", "improvement_ci95", "greedy_steps",
                 "greedy_mean", "greedy_ci95", "total_steps", "total_mean", "total_ci95", "converged",
@@ -134,6 +156,8 @@ def test_sweep_summary_counts_unreached_trials():
     assert p["reached"] == 3 and p["trials"] == 4 and p["mean_is_lower_bound"]
     assert p["mean"] == pytest.approx((10 + 20 + 20_000_000 + 40) / 4)
     assert p["improvement_design"] == metrics.PAIRED_DESIGN
+    assert p["improvement_censored"] and p["improvement_cap_dominated"]
+    assert next(r for r in rows if r["method"] == "none")["improvement_censored"] is None
     text = summary_markdown(rows)
     assert "3/4" in text and "≥" in text
 

@@ -89,9 +89,11 @@ WIND = Section(
     tuple(Case("coarse", "fine", t, 0.01) for t in (1, 2, 3, 4)), source_seeds=10, trials=2,
     max_total_steps=2_000_000)
 DEV = Section(
-    "dev", "the development cases parameters may be chosen on: drawn tasks between grid robots "
-    "and planar3:joint -> planar4:cartesian task 4",
-    (Case("fine", "coarse", None), Case("coarse", "fine", None), Case("planar3:joint", "planar4:cartesian", 4)),
+    "dev", "the development cases parameters may be chosen on: tasks drawn apart from the held-out ones "
+    "(coarse -> fine), and the robot pairs earlier parameters were chosen on (ur5e_like:cartesian -> "
+    "planar2:joint task 3, planar3:joint -> planar4:cartesian task 4)",
+    (Case("coarse", "fine", None), Case("ur5e_like:cartesian", "planar2:joint", 3),
+     Case("planar3:joint", "planar4:cartesian", 4)),
     source_seeds=10, trials=2, max_total_steps=2_000_000)
 FAST = Section(
     "fast", "coarse -> fine task 1, two source seeds: checks the whole protocol in seconds",
