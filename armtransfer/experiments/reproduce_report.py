@@ -307,7 +307,7 @@ def _ratio_sentence(protocol: dict, base: dict, where: str) -> str:
 
 
 def _vs_paper(rows: list[tuple[int, dict, float | None]]) -> tuple[list[int], list[int], list[int]]:
-    """(tasks better than the paper, within CI, worse), from improvement CIs."""
+    """(tasks better than the paper, those this run cannot tell from it, worse), from improvement CIs."""
     better: list[int] = []
     same: list[int] = []
     worse: list[int] = []
