@@ -52,14 +52,18 @@ def test_report_names_each_methods_baseline(fast_runs):
     root, _ = fast_runs
     report = (root / "a" / "report.md").read_text()
     data = json.loads((root / "a" / "results.json").read_text())
+    named = 0
     for m in data["methods"]:
-        if m == "none":
-            continue
-        base = benchmark.baseline_of(m)
-        assert data["baselines"][m] == base
-        assert f"`{m}` reached the goal first" in report and f"as fast as `{base}`" in report
-        row = next(line for line in report.splitlines() if line.startswith(f"| {m} "))
-        assert row.split("|")[2].strip().startswith(base)
+        bases = list(benchmark.baselines_of(m))
+        assert data["baselines"][m] == bases
+        listed, row = [line for line in report.splitlines() if line.startswith(f"| {m} ")]  # methods, case
+        assert listed.split("|")[2].strip().startswith(", ".join(bases) or "-")
+        assert row.split("|")[2].strip() == (", ".join(bases) or "-")
+        for base in bases:
+            named += 1
+            assert f"`{m}` reached the goal first" in report and f"as fast as `{base}`" in report
+            assert f"{base}: " in row.split("|")[10]
+    assert named >= 3
     # two source seeds: the numbers, but no claim
     assert "too few pairs for a claim (2 < 10)" in report
 
@@ -147,8 +151,8 @@ def test_bootstrap_is_deterministic_and_handles_small_samples():
 
 
 def _rec(method, seed, fe, cap=1000, case=0, baseline="none"):
-    return {"section": "s", "case": case, "label": "c", "method": method, "baseline": None if method == "none"
-            else baseline, "source_seed": seed, "cap": cap, "budget": 100, "optimal": 10, "error": None,
+    return {"section": "s", "case": case, "label": "c", "method": method, "baselines": [] if method == "none"
+            else [baseline], "source_seed": seed, "cap": cap, "budget": 100, "optimal": 10, "error": None,
             "first_exposure": fe, "convergence_steps": [None] * len(fe), "area": [float(v or cap) for v in fe],
             "curves": [[float(v or cap)] * 3 for v in fe]}
 
@@ -159,10 +163,10 @@ def test_paired_factor_is_per_source_seed():
         base = [100 * (seed + 1), 300 * (seed + 1)]
         recs += [_rec("none", seed, base), _rec("pseudo", seed, [v // 4 for v in base])]
     out = benchmark_stats.summarize(recs)
-    ab = out["s"]["cases"][0]["methods"]["pseudo"]["against_baseline"]
+    ab = out["s"]["cases"][0]["methods"]["pseudo"]["against"]["none"]
     assert ab["factor"] == pytest.approx(4.0) and ab["ci95"] == pytest.approx([4.0, 4.0])
     assert ab["transfer_ratio"] == pytest.approx(0.75)
-    pooled = out["s"]["pooled"]["pseudo"]
+    pooled = out["s"]["pooled"]["pseudo"]["none"]
     assert pooled["baseline"] == "none" and pooled["n"] == 10
     assert benchmark_report.judgement(pooled) == "faster than its baseline"
 
@@ -173,9 +177,9 @@ def test_failures_are_counted_and_censored_medians_flagged():
     e = benchmark_stats.summarize(recs)["s"]["cases"][0]["methods"]["pseudo"]
     assert e["failure_rate"] == pytest.approx(6 / 20)
     assert e["first_exposure"]["worst_seed"] == 1000 and e["first_exposure"]["worst_seed_is_lower_bound"]
-    assert e["against_baseline"]["seeds_with_censored_median"] == 3
-    assert e["against_baseline"]["worst"] == pytest.approx(150 / 1000)
-    sentence = benchmark_report.sentence("pseudo", dict(e["against_baseline"], baseline="none"), "s")
+    assert e["against"]["none"]["seeds_with_censored_median"] == 3
+    assert e["against"]["none"]["worst"] == pytest.approx(150 / 1000)
+    sentence = benchmark_report.sentence("pseudo", dict(e["against"]["none"], baseline="none"), "s")
     assert "3 pairs a median was at the step cap" in sentence
 
 
@@ -186,13 +190,18 @@ def test_an_interval_spanning_one_makes_no_claim():
 
 def test_baseline_comes_from_the_registry_when_it_names_one(monkeypatch):
     class Named:
-        baseline = "pseudo"
+        baselines = ("pseudo", "dense")
 
-    assert benchmark.baseline_of("none") is None and benchmark.baseline_of("dense") == "none"
+    class Unnamed:
+        pass
+
+    assert benchmark.baseline_of("none") is None
     monkeypatch.setitem(methods.METHODS, "guided", Named())
-    assert benchmark.baseline_of("guided") == "pseudo" and benchmark.registered_baseline("guided") == "pseudo"
+    monkeypatch.setitem(methods.METHODS, "dense", Unnamed())
+    assert benchmark.baselines_of("guided") == ("pseudo", "dense") and benchmark.registered_baseline("guided")
+    assert benchmark.baselines_of("dense") == ("none",) and not benchmark.registered_baseline("dense")
     ran, _ = benchmark.methods_to_run(("guided",))
-    assert ran == ["none", "pseudo", "guided"]  # and pseudo's own baseline
+    assert ran == ["none", "pseudo", "dense", "guided"]  # and their own baselines
 
 
 def test_drawn_tasks_are_deterministic_and_long_enough():

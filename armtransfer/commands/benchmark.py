@@ -34,7 +34,7 @@ def results_bytes(suite: suites.Suite, seed: int, ran: list[str], missing: list[
                   summary: dict) -> bytes:
     """results.json's bytes: the same for the same suite, seed and build."""
     data = {"suite": suite.to_dict(), "seed": seed, "methods": ran, "not_in_registry": missing,
-            "baselines": {m: benchmark.baseline_of(m) for m in ran}, "records": records, "summary": summary}
+            "baselines": {m: list(benchmark.baselines_of(m)) for m in ran}, "records": records, "summary": summary}
     return (json.dumps(data, indent=1, sort_keys=False) + "\n").encode()
 
 
@@ -55,6 +55,7 @@ def run(args: argparse.Namespace) -> int:
         write_text_atomic(tmp / "report.md", benchmark_report.report_markdown(suite, args.seed, summary, ran, missing))
     print(f"wrote {out / 'report.md'} ({time.perf_counter() - t0:.0f} s)")
     for section in suite.sections:
-        for name, ab in summary[section.name]["pooled"].items():
-            print(benchmark_report.sentence(name, ab, section.name))
+        for name, against in summary[section.name]["pooled"].items():
+            for ab in against.values():
+                print(benchmark_report.sentence(name, ab, section.name))
     return 0

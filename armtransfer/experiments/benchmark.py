@@ -42,30 +42,42 @@ SOURCE_CONFIG = LearnerConfig()
 robot 2's trials at."""
 
 
-def registered_baseline(name: str) -> str | None:
-    """The baseline the registry names for ``name`` (its ``baseline`` field), if any."""
-    named = getattr(methods.get(name), "baseline", None)
-    return named if named in methods.METHODS and named != name else None
+def baselines_of(name: str) -> tuple[str, ...]:
+    """The methods ``name``'s gain is measured against, each sharing its learner and told less:
+    the registry's ``Method.baselines`` (the no-transfer one first; empty for a method that is
+    itself no transfer), or, from a registry without that field, ``none`` for every method but
+    ``none``."""
+    m = methods.get(name)
+    if hasattr(m, "baselines"):
+        return tuple(b for b in m.baselines if b in methods.METHODS and b != name)
+    return () if name == "none" else ("none",)
+
+
+def registered_baseline(name: str) -> bool:
+    """Whether the registry itself names ``name``'s baselines (rather than the ``none`` default)."""
+    return hasattr(methods.get(name), "baselines")
 
 
 def baseline_of(name: str) -> str | None:
-    """The method that shares ``name``'s learner and differs only in the transfer: the
-    registry's ``baseline`` where the method names one, else ``none`` (SARSA(lambda) without
-    anything transferred); ``none`` itself has none."""
-    if name == "none":
-        return None
-    return registered_baseline(name) or "none"
+    """The no-transfer method sharing ``name``'s learner (None: ``name`` is one itself)."""
+    named = baselines_of(name)
+    return named[0] if named else None
 
 
 def methods_to_run(wanted: tuple[str, ...] = suites.METHODS) -> tuple[list[str], list[str]]:
     """(the methods to run, in registry order: those of ``wanted`` this build has and every
     baseline they name; those of ``wanted`` this build does not have)."""
-    chosen = {m for m in wanted if m in methods.METHODS}
-    for m in list(chosen):
-        b = baseline_of(m)
-        while b is not None and b not in chosen:
-            chosen.add(b)
-            b = baseline_of(b)
+    chosen: set[str] = set()
+
+    def add(name: str) -> None:
+        if name not in chosen:
+            chosen.add(name)
+            for b in baselines_of(name):
+                add(b)
+
+    for m in wanted:
+        if m in methods.METHODS:
+            add(m)
     return [m for m in methods.METHODS if m in chosen], [m for m in wanted if m not in methods.METHODS]
 
 
@@ -179,13 +191,14 @@ def _run_one(name: str, base: dict, target: DiscreteRobot, start: int, goal: int
     """One record: ``trials`` trials of method ``name`` (none when it could not run: then
     ``error`` says why and every trial counts as a failure)."""
     m = methods.get(name)
-    rec = dict(base, method=name, baseline=baseline_of(name), error=None)
+    rec = dict(base, method=name, baselines=list(baselines_of(name)), error=None)
     res = None
-    if m.shaped and traj is None:
+    needs = m.shaped and getattr(m, "uses_trajectory", True)
+    if needs and traj is None:
         rec["error"] = f"no trajectory: {base['source_failure']}"
     else:
         try:
-            res = experiment.run_method(name, target, start, goal, [traj] if m.shaped else None, trials, seed,
+            res = experiment.run_method(name, target, start, goal, [traj] if needs else None, trials, seed,
                                         config, wind=wind, on_trial=tick, threads=threads)
         except ArmTransferError as err:
             rec["error"] = str(err)

@@ -60,11 +60,15 @@ def judgement(ab: dict) -> str:
 
 
 def sentence(name: str, ab: dict, where: str) -> str:
-    """One claim about ``name`` against its baseline, from the pooled factor ``ab``."""
-    from armtransfer.experiments.benchmark import registered_baseline
+    """One claim about ``name`` against one of its baselines, from the pooled factor ``ab``."""
+    from armtransfer.experiments.benchmark import baselines_of, registered_baseline
 
-    whose = ("its baseline, the same learner without this transfer" if registered_baseline(name) else
-             "the default baseline: the registry names none that shares this method's learner")
+    if not registered_baseline(name):
+        whose = "the default baseline: this build's registry names none for it"
+    elif baselines_of(name)[:1] == (ab["baseline"],):
+        whose = "its baseline: the same learner, told nothing"
+    else:
+        whose = "a baseline sharing its learner and told less: what the rest of the transfer adds"
     text = (f"{where}: `{name}` reached the goal first {_factor_ci(ab)} as fast as `{ab['baseline']}` ({whose}; "
             f"geometric mean over {ab['n']} case x source-seed pairs, 95% bootstrap interval; worst pair "
             f"{_factor(ab['worst'])}): {judgement(ab)}.")
@@ -74,26 +78,36 @@ def sentence(name: str, ab: dict, where: str) -> str:
     return text
 
 
+def _against(e: dict) -> str:
+    parts = [f"{b}: {_factor_ci(ab)} ({_factor(ab['worst'])})" for b, ab in e["against"].items()]
+    return "; ".join(parts) or "-"
+
+
+def _transfer_ratio(e: dict) -> str:
+    parts = []
+    for b, ab in e["against"].items():
+        ci = ab["transfer_ratio_ci95"]
+        if ab["transfer_ratio"] is not None:
+            parts.append(f"{b}: {_pct(ab['transfer_ratio'])} [{_pct(ci[0]) if ci else 'n/a'}, "
+                         f"{_pct(ci[1]) if ci else 'n/a'}]")
+    return "; ".join(parts) or "-"
+
+
 def case_table(case: dict, cap: float) -> str:
-    header = ["method", "baseline", "first exposure, KM median [95%]", "median over seeds [95%]", "worst seed",
+    header = ["method", "baselines", "first exposure, KM median [95%]", "median over seeds [95%]", "worst seed",
               "failed", "success in budget", "convergence, KM median [95%]", "area (100 ep.)",
-              "vs baseline [95%] (worst seed)", "transfer ratio [95%]"]
+              "vs each baseline [95%] (worst seed)", "transfer ratio [95%]"]
     rows = []
     for name, e in case["methods"].items():
         fe = e["first_exposure"]
-        ab = e["against_baseline"]
         worst = ("≥ " if fe["worst_seed_is_lower_bound"] else "") + _steps(fe["worst_seed"])
         seeds_ci = fe["median_over_seeds_ci95"]
         rows.append([
-            name + (" (error)" if e["errors"] else ""), e["baseline"] or "-", _km(fe, cap),
+            name + (" (error)" if e["errors"] else ""), ", ".join(e["baselines"]) or "-", _km(fe, cap),
             f"{_steps(fe['median_over_seeds'])} [{_steps(seeds_ci[0]) if seeds_ci else 'n/a'}, "
             f"{_steps(seeds_ci[1]) if seeds_ci else 'n/a'}]",
             worst, _pct(e["failure_rate"]), _pct(e["success_rate"]), _km(e["convergence"], cap),
-            fmt_num(e["area"]["mean"], 0),
-            "-" if ab is None else f"{_factor_ci(ab)} ({_factor(ab['worst'])})",
-            "-" if ab is None or ab["transfer_ratio"] is None else
-            f"{_pct(ab['transfer_ratio'])} [{_pct(ab['transfer_ratio_ci95'][0]) if ab['transfer_ratio_ci95'] else 'n/a'}"
-            f", {_pct(ab['transfer_ratio_ci95'][1]) if ab['transfer_ratio_ci95'] else 'n/a'}]",
+            fmt_num(e["area"]["mean"], 0), _against(e), _transfer_ratio(e),
         ])
     return markdown_table(header, rows)
 
@@ -110,7 +124,7 @@ def write_figures(summary: dict, suite: suites.Suite, out: Path) -> None:
 
 
 def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str], missing: list[str]) -> str:
-    from armtransfer.experiments.benchmark import baseline_of, registered_baseline
+    from armtransfer.experiments.benchmark import baselines_of, registered_baseline
 
     kind = ("held out: no parameter of any method was chosen on it" if suite.held_out
             else "not held out: parameters may be chosen on it")
@@ -119,16 +133,17 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
            "## Methods and their baselines", "",
            "Every method's gain is measured against the baseline that shares its learner and differs only "
            "in what is transferred; each baseline is run beside it on the same random streams.", ""]
-    out.append(markdown_table(["method", "baseline", "what it is"],
-                              [[m, (baseline_of(m) or "-") + ("" if m == "none" or registered_baseline(m)
-                                                                  else " (default: the registry names none)"),
+    out.append(markdown_table(["method", "baselines (the first: told nothing)", "what it is"],
+                              [[m, (", ".join(baselines_of(m)) or "-") + ("" if m == "none" or registered_baseline(m)
+                                                                          else " (default: the registry names none)"),
                                 methods.get(m).description] for m in ran]))
     if missing:
         out += ["", f"Not in this build's method registry, so not run: {', '.join(missing)}."]
     out += ["", "## Claims", ""]
     for section in suite.sections:
-        for name, ab in summary[section.name]["pooled"].items():
-            out.append("- " + sentence(name, ab, f"{section.name}"))
+        for name, against in summary[section.name]["pooled"].items():
+            for ab in against.values():
+                out.append("- " + sentence(name, ab, section.name))
     for section in suite.sections:
         sec = summary[section.name]
         out += ["", f"## Section `{section.name}`", "",
@@ -157,7 +172,7 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
             "- Convergence: steps until the greedy path stopped changing (censored at the cap when it never did).",
             "- Area: the area under the learning curve, steps of the first 100 episodes (a converged trial "
             "continues at its greedy length).",
-            "- vs baseline: baseline / method of the seeds' median first exposures, paired by source seed, "
+            "- vs each baseline: baseline / method of the seeds' median first exposures, paired by source seed, "
             "geometric mean with a percentile bootstrap interval over seeds (it stays inside the factors seen); "
             "above 1 the method is faster. Transfer ratio (Taylor and Stone): the share of the baseline's area "
             "that the method saves, mean over seeds.",

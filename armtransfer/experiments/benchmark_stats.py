@@ -98,10 +98,11 @@ def paired(method: list[dict], base: list[dict]) -> dict:
 
 
 def summarize(records: list[dict]) -> dict:
-    """``{section: {"cases": [{label, methods: {name: stats}}], "pooled": {name: factor}}}``.
+    """``{section: {"cases": [{label, methods: {name: stats}}], "pooled": {name: {baseline: factor}}}}``.
 
-    ``pooled`` is the factor against the baseline over every (case, source seed) of the
-    section, each pair one unit of the bootstrap."""
+    A method's stats hold ``against``: per baseline it names (the no-transfer one first), the
+    paired comparison. ``pooled`` is that factor over every (case, source seed) of the section,
+    each pair one unit of the bootstrap."""
     by_cell: dict = defaultdict(list)
     for r in records:
         by_cell[(r["section"], r["case"], r["method"])].append(r)
@@ -112,27 +113,25 @@ def summarize(records: list[dict]) -> dict:
     for (section, case, method), recs in by_cell.items():
         recs.sort(key=lambda r: r["source_seed"])
         entry = cell_stats(recs)
-        entry["baseline"] = recs[0]["baseline"]
-        b = by_cell.get((section, case, entry["baseline"]))
-        entry["against_baseline"] = None if b is None else paired(recs, sorted(b, key=lambda r: r["source_seed"]))
+        entry["baselines"] = recs[0]["baselines"]
+        entry["against"] = {b: paired(recs, sorted(by_cell[(section, case, b)], key=lambda r: r["source_seed"]))
+                            for b in entry["baselines"] if (section, case, b) in by_cell}
         out[section]["cases"][case]["methods"][method] = entry
         out[section]["cases"][case]["optimal_per_seed"] = [r["optimal"] for r in recs]
     for section, sec in out.items():
         order = [r["method"] for r in records if r["section"] == section]
         names = list(dict.fromkeys(order))
         for name in names:
-            logs = []
-            cens = 0
-            base = None
+            pooled = {}
             for case in sec["cases"].values():
-                ab = case["methods"].get(name, {}).get("against_baseline")
-                if ab is not None:
-                    logs += ab["log_factors"]
-                    cens += ab["seeds_with_censored_median"]
-                    base = case["methods"][name]["baseline"]
-            if base is not None:
-                sec["pooled"][name] = dict(survival.ratio_summary(logs), baseline=base,
-                                           seeds_with_censored_median=cens)
+                for base, ab in case["methods"].get(name, {}).get("against", {}).items():
+                    p = pooled.setdefault(base, {"logs": [], "cens": 0})
+                    p["logs"] += ab["log_factors"]
+                    p["cens"] += ab["seeds_with_censored_median"]
+            if pooled:
+                sec["pooled"][name] = {base: dict(survival.ratio_summary(p["logs"]), baseline=base,
+                                                  seeds_with_censored_median=p["cens"])
+                                       for base, p in pooled.items()}
         sec["cases"] = [sec["cases"][k] for k in sorted(sec["cases"])]
         for case in sec["cases"]:
             case["methods"] = {n: case["methods"][n] for n in names if n in case["methods"]}
