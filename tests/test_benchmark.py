@@ -166,9 +166,14 @@ def test_paired_factor_is_per_source_seed():
     ab = out["s"]["cases"][0]["methods"]["pseudo"]["against"]["none"]
     assert ab["factor"] == pytest.approx(4.0) and ab["ci95"] == pytest.approx([4.0, 4.0])
     assert ab["transfer_ratio"] == pytest.approx(0.75)
+    # no trial converged in either: every convergence median is the cap, a bound and no gain
+    assert ab["convergence"]["factor"] == 1.0 and ab["convergence"]["seeds_with_censored_median"] == 10
     pooled = out["s"]["pooled"]["pseudo"]["none"]
     assert pooled["baseline"] == "none" and pooled["n"] == 10
     assert benchmark_report.judgement(pooled) == "faster than its baseline"
+    text = benchmark_report.sentence("pseudo", pooled, "s")
+    assert "4.00x [4.00x, 4.00x] as fast as `none`" in text and "settled 1.00x" in text
+    assert "In 10 pairs a median convergence was at the step cap" in text
 
 
 def test_failures_are_counted_and_censored_medians_flagged():
@@ -180,7 +185,7 @@ def test_failures_are_counted_and_censored_medians_flagged():
     assert e["against"]["none"]["seeds_with_censored_median"] == 3
     assert e["against"]["none"]["worst"] == pytest.approx(150 / 1000)
     sentence = benchmark_report.sentence("pseudo", dict(e["against"]["none"], baseline="none"), "s")
-    assert "3 pairs a median was at the step cap" in sentence
+    assert "3 pairs a median first exposure was at the step cap" in sentence
 
 
 def test_an_interval_spanning_one_makes_no_claim():

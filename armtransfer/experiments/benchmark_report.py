@@ -72,14 +72,20 @@ def sentence(name: str, ab: dict, where: str) -> str:
     text = (f"{where}: `{name}` reached the goal first {_factor_ci(ab)} as fast as `{ab['baseline']}` ({whose}; "
             f"geometric mean over {ab['n']} case x source-seed pairs, 95% bootstrap interval; worst pair "
             f"{_factor(ab['worst'])}): {judgement(ab)}.")
-    if ab.get("seeds_with_censored_median"):
-        text += (f" In {ab['seeds_with_censored_median']} pairs a median was at the step cap, so those factors "
-                 "are bounds, not values.")
+    conv = ab.get("convergence")
+    if conv is not None:
+        text += (f" Its greedy path settled {_factor_ci(conv)} as fast (worst pair {_factor(conv['worst'])}): "
+                 f"{judgement(conv)}.")
+    for what, block in (("first exposure", ab), ("convergence", conv or {})):
+        if block.get("seeds_with_censored_median"):
+            text += (f" In {block['seeds_with_censored_median']} pairs a median {what} was at the step cap, so "
+                     "those factors are bounds, not values.")
     return text
 
 
-def _against(e: dict) -> str:
-    parts = [f"{b}: {_factor_ci(ab)} ({_factor(ab['worst'])})" for b, ab in e["against"].items()]
+def _against(e: dict, key: str | None = None) -> str:
+    parts = [f"{b}: {_factor_ci(ab if key is None else ab[key])} ({_factor((ab if key is None else ab[key])['worst'])})"
+             for b, ab in e["against"].items()]
     return "; ".join(parts) or "-"
 
 
@@ -96,7 +102,7 @@ def _transfer_ratio(e: dict) -> str:
 def case_table(case: dict, cap: float) -> str:
     header = ["method", "baselines", "first exposure, KM median [95%]", "median over seeds [95%]", "worst seed",
               "failed", "success in budget", "convergence, KM median [95%]", "area (100 ep.)",
-              "vs each baseline [95%] (worst seed)", "transfer ratio [95%]"]
+              "first exposure vs each baseline [95%] (worst seed)", "convergence vs each baseline", "transfer ratio [95%]"]
     rows = []
     for name, e in case["methods"].items():
         fe = e["first_exposure"]
@@ -107,7 +113,7 @@ def case_table(case: dict, cap: float) -> str:
             f"{_steps(fe['median_over_seeds'])} [{_steps(seeds_ci[0]) if seeds_ci else 'n/a'}, "
             f"{_steps(seeds_ci[1]) if seeds_ci else 'n/a'}]",
             worst, _pct(e["failure_rate"]), _pct(e["success_rate"]), _km(e["convergence"], cap),
-            fmt_num(e["area"]["mean"], 0), _against(e), _transfer_ratio(e),
+            fmt_num(e["area"]["mean"], 0), _against(e), _against(e, "convergence"), _transfer_ratio(e),
         ])
     return markdown_table(header, rows)
 
@@ -172,9 +178,9 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
             "- Convergence: steps until the greedy path stopped changing (censored at the cap when it never did).",
             "- Area: the area under the learning curve, steps of the first 100 episodes (a converged trial "
             "continues at its greedy length).",
-            "- vs each baseline: baseline / method of the seeds' median first exposures, paired by source seed, "
-            "geometric mean with a percentile bootstrap interval over seeds (it stays inside the factors seen); "
-            "above 1 the method is faster. Transfer ratio (Taylor and Stone): the share of the baseline's area "
+            "- vs each baseline: baseline / method of the seeds' median first exposures (or convergence steps), "
+            "paired by source seed, geometric mean with a percentile bootstrap interval over seeds (it stays inside "
+            "the factors seen); above 1 the method is faster. Transfer ratio (Taylor and Stone): the share of the baseline's area "
             "that the method saves, mean over seeds.",
             ""]
     return "\n".join(out)

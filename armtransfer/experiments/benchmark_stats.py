@@ -77,24 +77,38 @@ def cell_stats(recs: list[dict]) -> dict:
     }
 
 
-def paired(method: list[dict], base: list[dict]) -> dict:
-    """The method against its baseline, paired by source seed (records in seed order)."""
+def _factors(method: list[dict], base: list[dict], key: str) -> dict:
+    """baseline / method of the per-seed medians of ``key`` (censored at the cap), paired by
+    source seed: the summary of :func:`survival.ratio_summary`, the log factors, and how many
+    seeds had a median that censoring reached (their factor is a bound)."""
     cap = method[0]["cap"]
-    logs, ratios, bounds = [], [], 0
-    for m, b in zip(method, base):
-        assert m["source_seed"] == b["source_seed"]
-        mm, mlb = _seed_median(m["first_exposure"], cap)
-        bm, blb = _seed_median(b["first_exposure"], cap)
+    by_seed = {b["source_seed"]: b for b in base}
+    logs, bounds = [], 0
+    for m in method:
+        mm, mlb = _seed_median(m[key], cap)
+        bm, blb = _seed_median(by_seed[m["source_seed"]][key], cap)
         logs.append(math.log(bm / mm))
         bounds += bool(mlb or blb)
-        if None not in m["area"] and None not in b["area"]:
-            ratios.append(1.0 - float(np.mean(m["area"])) / float(np.mean(b["area"])))
-    out = survival.ratio_summary(logs)
-    out["log_factors"] = logs
-    out["seeds_with_censored_median"] = bounds
+    return dict(survival.ratio_summary(logs), log_factors=logs, seeds_with_censored_median=bounds)
+
+
+def paired(method: list[dict], base: list[dict]) -> dict:
+    """The method against one baseline, paired by source seed: the first-exposure factor (the
+    top level), the convergence factor, and the transfer ratio of the learning-curve areas."""
+    by_seed = {b["source_seed"]: b for b in base}
+    ratios = [1.0 - float(np.mean(m["area"])) / float(np.mean(by_seed[m["source_seed"]]["area"]))
+              for m in method if None not in m["area"] and None not in by_seed[m["source_seed"]]["area"]]
+    out = _factors(method, base, "first_exposure")
+    out["convergence"] = _factors(method, base, "convergence_steps")
     out["transfer_ratio"] = float(np.mean(ratios)) if ratios else None
     out["transfer_ratio_ci95"] = survival.bootstrap_ci(ratios)
     return out
+
+
+def _pool(entries: list[dict], base: str) -> dict:
+    logs = [x for e in entries for x in e["log_factors"]]
+    cens = sum(e["seeds_with_censored_median"] for e in entries)
+    return dict(survival.ratio_summary(logs), baseline=base, seeds_with_censored_median=cens)
 
 
 def summarize(records: list[dict]) -> dict:
@@ -122,16 +136,14 @@ def summarize(records: list[dict]) -> dict:
         order = [r["method"] for r in records if r["section"] == section]
         names = list(dict.fromkeys(order))
         for name in names:
-            pooled = {}
+            pairs: dict[str, list[dict]] = {}
             for case in sec["cases"].values():
                 for base, ab in case["methods"].get(name, {}).get("against", {}).items():
-                    p = pooled.setdefault(base, {"logs": [], "cens": 0})
-                    p["logs"] += ab["log_factors"]
-                    p["cens"] += ab["seeds_with_censored_median"]
-            if pooled:
-                sec["pooled"][name] = {base: dict(survival.ratio_summary(p["logs"]), baseline=base,
-                                                  seeds_with_censored_median=p["cens"])
-                                       for base, p in pooled.items()}
+                    pairs.setdefault(base, []).append(ab)
+            if pairs:
+                sec["pooled"][name] = {base: dict(_pool(abs_, base),
+                                                  convergence=_pool([a["convergence"] for a in abs_], base))
+                                       for base, abs_ in pairs.items()}
         sec["cases"] = [sec["cases"][k] for k in sorted(sec["cases"])]
         for case in sec["cases"]:
             case["methods"] = {n: case["methods"][n] for n in names if n in case["methods"]}
