@@ -140,6 +140,7 @@ def test_summarize_reports_reached_and_a_censored_mean():
     table = method_table(out)
     assert "1/3" in table and f"≥ {e['mean']:,.1f}" in table and "lower bound" in table
     assert "common random numbers" in table
+    assert f"{e['improvement_percent']:,.1f}‡" in table and "more than half of a mean" in table
 
 
 def test_sweep_summary_counts_unreached_trials():
@@ -159,7 +160,7 @@ def test_sweep_summary_counts_unreached_trials():
     assert p["improvement_censored"] and p["improvement_cap_dominated"]
     assert next(r for r in rows if r["method"] == "none")["improvement_censored"] is None
     text = summary_markdown(rows)
-    assert "3/4" in text and "≥" in text
+    assert "3/4" in text and "≥" in text and "‡" in text and "more than half of a mean" in text
 
 
 def test_learning_curve_means_include_converged_trials():

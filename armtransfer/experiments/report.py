@@ -34,6 +34,17 @@ def fmt_median(entry: dict, digits: int = 1) -> str:
             + f"{fmt_num(entry.get('median'), digits)} {fmt_ci(entry.get('median_ci95'), digits)}{note}")
 
 
+CAP_MARK = "‡"
+CAP_NOTE = (f"{CAP_MARK}: unreached trials counted at the step cap make up more than half of a mean; that "
+            "improvement says more about the cap than about the method (read the medians).")
+
+
+def fmt_improvement(entry: dict) -> str:
+    """An improvement in percent, marked when a cap-dominated mean entered it."""
+    text = fmt_num(entry.get("improvement_percent"))
+    return text + CAP_MARK if entry.get("improvement_cap_dominated") else text
+
+
 def markdown_table(header: list[str], rows: list[list[str]]) -> str:
     widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(header)]
     line = lambda cells: "| " + " | ".join(c.ljust(w) for c, w in zip(cells, widths)) + " |"  # noqa: E731
@@ -68,7 +79,7 @@ def method_table(results: dict) -> str:
                 fmt_mean(r),
                 fmt_ci(r["ci95"]),
                 fmt_median(r),
-                fmt_num(r.get("improvement_percent")),
+                fmt_improvement(r),
                 fmt_ci(r.get("improvement_ci95")),
                 fmt_num(r.get("greedy_mean")),
                 fmt_num(r.get("total_mean"), 0),
@@ -80,6 +91,8 @@ def method_table(results: dict) -> str:
     if any(r.get("mean_is_lower_bound") for r in results.values()):
         table += ("\n\n≥: some trials never reached the goal; they count at the step cap, so the mean "
                   "is a lower bound.")
+    if any(r.get("improvement_cap_dominated") for r in results.values()):
+        table += "\n\n" + CAP_NOTE
     if designs:
         table += "\n\nImprovement CIs: " + "; ".join(sorted(designs)) + "."
     return table
