@@ -104,8 +104,9 @@ def draw_task(source: DiscreteRobot, target: DiscreteRobot, rng: np.random.Gener
         if len(goals) == 0:
             continue
         goal = int(rng.choice(goals))
-        paths = [r.shortest_path(r.start_state(start), goal) for r in (source, target)]
-        if all(p is not None for p in paths) and max(len(p) - 1 for p in paths) >= MIN_DISTANCE:
+        lengths = [r.shortest_path(r.start_state(start), goal) for r in (source, target)]
+        steps = [len(p) - 1 for p in lengths if p is not None]
+        if len(steps) == 2 and max(steps) >= MIN_DISTANCE:
             return start, goal
     raise InvalidTaskError(f"no task of {MIN_DISTANCE}+ steps that both {source.name} and {target.name} "
                            f"can do in {DRAWS} draws")
@@ -158,8 +159,9 @@ def run_suite(suite: suites.Suite, seed: int = 0, tick: Callable[[], None] | Non
                 start, goal = case_cells(case, source, target, seed, section.name, ci, j)
                 t0 = time.perf_counter()
                 traj, why = _source_trajectory(source, start, goal, rs)
+                per_method: dict[str, float] = {}
                 timing = {"section": section.name, "case": ci, "source_seed": j,
-                          "source_seconds": time.perf_counter() - t0, "methods": {}}
+                          "source_seconds": time.perf_counter() - t0, "methods": per_method}
                 path = target.shortest_path(target.start_state(start), goal)
                 if path is None:
                     raise InvalidTaskError(f"{case.label}: {target.name} cannot reach the goal")
@@ -173,7 +175,7 @@ def run_suite(suite: suites.Suite, seed: int = 0, tick: Callable[[], None] | Non
                     t1 = time.perf_counter()
                     records.append(_run_one(name, base, target, start, goal, traj, section.trials, rs, config,
                                             case.wind, tick, threads))
-                    timing["methods"][name] = time.perf_counter() - t1
+                    per_method[name] = time.perf_counter() - t1
                 timings["runs"].append(timing)
     timings["total_seconds"] = time.perf_counter() - t_all
     return records, timings
@@ -198,8 +200,9 @@ def _run_one(name: str, base: dict, target: DiscreteRobot, start: int, goal: int
         rec["error"] = f"no trajectory: {base['source_failure']}"
     else:
         try:
-            res = experiment.run_method(name, target, start, goal, [traj] if needs else None, trials, seed,
-                                        config, wind=wind, on_trial=tick, threads=threads)
+            given = [traj] if needs and traj is not None else None
+            res = experiment.run_method(name, target, start, goal, given, trials, seed, config, wind=wind,
+                                        on_trial=tick, threads=threads)
         except ArmTransferError as err:
             rec["error"] = str(err)
     if res is None:

@@ -49,7 +49,7 @@ def judgement(ab: dict) -> str:
     ci = ab.get("ci95")
     if ab.get("factor") is None:
         return "no comparison"
-    if ab["n"] < suites.MIN_SEEDS_FOR_CLAIM:
+    if ab["n"] < suites.MIN_SEEDS_FOR_CLAIM or ci is None:
         return f"too few pairs for a claim ({ab['n']} < {suites.MIN_SEEDS_FOR_CLAIM})"
     if ci[0] > 1:
         return "faster than its baseline"

@@ -67,7 +67,7 @@ def first_time_at_or_below(times: Sequence[float], curve: Sequence[float], level
     return None
 
 
-def bootstrap_ci(values: Sequence[float], statistic: Callable = np.mean, seed: int = BOOTSTRAP_SEED,
+def bootstrap_ci(values: Sequence[float] | np.ndarray, statistic: Callable = np.mean, seed: int = BOOTSTRAP_SEED,
                  resamples: int = BOOTSTRAP_RESAMPLES) -> list[float] | None:
     """Percentile bootstrap 95% interval of ``statistic`` of ``values`` (a 1-d sample).
 
