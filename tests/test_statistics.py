@@ -46,6 +46,18 @@ def test_a_median_at_exactly_half_censored_is_a_lower_bound():
     assert metrics.median_is_lower_bound(3, 5) and not metrics.median_is_lower_bound(2, 5)
 
 
+def test_an_improvement_interval_stays_below_100_percent():
+    # a method 20x faster, with one slow trial: an interval on the ratio itself went below 0
+    base = [1000, 1200, 900, 1100, 1000]
+    other = [10, 12, 9, 11, 500]
+    p = metrics.paired_improvement(base, other, 10_000)
+    assert p["ci95"][0] < p["percent"] < p["ci95"][1] < 100.0
+    r = 1 - p["percent"] / 100
+    d = np.array(other) - r * np.array(base)
+    half = stats.t.ppf(0.975, 4) * np.std(d, ddof=1) / np.sqrt(5) / np.mean(base)
+    assert r - half < 0  # where the old interval on r would have reached
+
+
 def test_a_mean_made_mostly_of_the_cap_is_flagged():
     st = metrics.exploration_stats([100, 200, None], 1000)
     assert st["cap_dominated"]

@@ -128,7 +128,9 @@ def paired_improvement(base: Sequence[int | None], other: Sequence[int | None], 
     ``paired``: trial i of both came from the same random stream (common random numbers,
     ``experiment.trial_rng``), so the interval is the delta method on the paired residuals
     d_i = o_i - r b_i (r the ratio of means), var(r) ~ var(d) / (n mean(b)^2), t with n-1
-    df. Otherwise the two samples are independent: delta method on both variances.
+    df. Otherwise the two samples are independent: delta method on both variances. The
+    interval is a t-interval on log r (standard error se(r)/r), so the ratio's stays positive
+    and the improvement's below 100%, which an interval on r itself did not.
     ``censored`` says a cap entered either mean (then the percent is that of the censored
     means, not of the true ones)."""
     b = censor(base, cap)
@@ -155,8 +157,10 @@ def paired_improvement(base: Sequence[int | None], other: Sequence[int | None], 
         se = r * math.sqrt(o.var(ddof=1) / len(o) / o.mean() ** 2 + b.var(ddof=1) / len(b) / b.mean() ** 2) \
             if o.mean() > 0 else math.sqrt(o.var(ddof=1) / len(o)) / b.mean()
         df = min(len(b), len(o)) - 1
-    half = t95(df) * se
-    out["ci95"] = [100.0 * (1.0 - (r + half)), 100.0 * (1.0 - (r - half))]
+    if r <= 0:
+        return out
+    half = t95(df) * se / r  # on log r: the ratio's interval stays positive, the percent below 100
+    out["ci95"] = [100.0 * (1.0 - r * math.exp(half)), 100.0 * (1.0 - r * math.exp(-half))]
     return out
 
 
