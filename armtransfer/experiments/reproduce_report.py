@@ -453,9 +453,10 @@ def report_markdown(res: dict, figures: dict[str, str]) -> str:
         f"{res['trials']} trials per cell (the paper: {paper.PAPER_TRIALS}), seed {res['seed']}. "
         "Exploration steps = steps until the goal is first reached. Every trial counts: one that never "
         f"reaches the goal within {cfg['max_total_steps']:,} steps counts at that cap, and its mean is "
-        "then a lower bound (≥, with reached k/n). Means with 95% t-intervals over trials; improvement "
-        "intervals by the delta method on paired trials (all methods share the random stream of trial i: "
-        "common random numbers).",
+        "then a lower bound (≥, with reached k/n). Means with 95% percentile-bootstrap intervals over trials "
+        "(they stay within the steps observed); improvement intervals by the delta method on the log of the "
+        "ratio of means, on paired trials (all methods share the random stream of trial i: common random "
+        "numbers).",
         "",
         f"Learner: SARSA(lambda), alpha {cfg['alpha']}, gamma {cfg['gamma']}, lambda {cfg['lam']}, "
         f"epsilon {cfg['epsilon']}, step reward {cfg['step_reward']}, goal reward {cfg['goal_reward']}, "
