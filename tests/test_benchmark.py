@@ -222,3 +222,27 @@ def test_drawn_tasks_are_deterministic_and_long_enough():
         rooms |= {fine.layout.room_of(*fine.layout.xy(s)), fine.layout.room_of(*fine.layout.xy(g))}
     assert rooms == {1, 2, 3, 4}
     assert math.isfinite(benchmark.run_seed(0, "paper", 0, 0))
+
+
+def test_a_source_that_does_not_converge_is_counted_not_dropped(monkeypatch):
+    from dataclasses import replace
+
+    from armtransfer.experiments import experiment
+
+    def never(*args, **kwargs):
+        raise InvalidParameterError("did not converge")
+
+    monkeypatch.setattr(experiment, "source_trajectory", never)
+    section = replace(suites.FAST, source_seeds=1, trials=1, max_total_steps=50_000)
+    records, _ = benchmark.run_suite(suites.Suite("t", 1, False, "", (section,)), threads=1)
+    by = {r["method"]: r for r in records}
+    assert set(by) == set(benchmark.methods_to_run()[0])
+    for name, rec in by.items():
+        m = methods.get(name)
+        if m.shaped and getattr(m, "uses_trajectory", True):
+            assert rec["error"].startswith("no trajectory: robot 1 (coarse) did not converge")
+            assert rec["first_exposure"] == [None]
+        else:  # none (and a baseline that reads no trajectory) still runs
+            assert rec["error"] is None and rec["episodes"][0] > 0
+    stats = benchmark_stats.summarize(records)["fast"]["cases"][0]["methods"]
+    assert stats["pseudo"]["failure_rate"] == 1.0 and stats["pseudo"]["errors"]

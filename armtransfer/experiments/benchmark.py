@@ -168,7 +168,7 @@ def run_suite(suite: suites.Suite, seed: int = 0, tick: Callable[[], None] | Non
                 base = {"section": section.name, "case": ci, "label": case.label, "source": case.source,
                         "target": case.target, "task": case.task, "start": list(target.layout.xy(start)),
                         "goal": list(target.layout.xy(goal)), "wind": case.wind, "source_seed": j, "seed": rs,
-                        "source_steps": None if traj is None else len(traj.cells) - 1,
+                        "source_steps": None if traj is None else len(traj),
                         "source_failure": why, "optimal": len(path) - 1, "cap": section.max_total_steps,
                         "budget": suites.BUDGET_FACTOR * (len(path) - 1)}
                 for name in run:
@@ -182,10 +182,12 @@ def run_suite(suite: suites.Suite, seed: int = 0, tick: Callable[[], None] | Non
 
 
 def _source_trajectory(source: DiscreteRobot, start: int, goal: int, seed: int) -> tuple[Trajectory | None, str | None]:
+    """Robot 1's converged greedy path, or None and why not (it did not converge)."""
     try:
         return experiment.source_trajectory("learned", source, start, goal, SOURCE_CONFIG, seed), None
-    except ArmTransferError as err:
-        return None, str(err)
+    except ArmTransferError:
+        return None, (f"robot 1 ({source.name}) did not converge on a path within "
+                      f"{SOURCE_CONFIG.max_episodes:,} episodes and {SOURCE_CONFIG.max_total_steps:,} steps")
 
 
 def _run_one(name: str, base: dict, target: DiscreteRobot, start: int, goal: int, traj: Trajectory | None,
