@@ -122,6 +122,13 @@ def test_kaplan_meier_matches_a_hand_computed_example():
     assert km["n"] == 6 and km["events"] == 4
 
 
+def test_kaplan_meier_of_all_reached_trials_stays_within_the_data():
+    km = survival.kaplan_meier([30, 10, 20, 40], cap=1000)
+    assert km["survival"][-1] == 0.0 and km["median"] == 20.0
+    lo, hi = km["median_ci95"]
+    assert 10.0 <= lo <= 20.0 <= hi <= 40.0
+
+
 def test_kaplan_meier_of_mostly_unreached_trials_has_no_median():
     km = survival.kaplan_meier([4, None, None], cap=100)
     assert km["median"] is None and km["median_beyond_cap"]

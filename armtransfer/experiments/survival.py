@@ -45,13 +45,16 @@ def kaplan_meier(values: Sequence[float | None], cap: float) -> dict:
     if events == 0:
         return out
     sf = stats.ecdf(censored_data(values, cap)).sf
-    with warnings.catch_warnings():  # undefined where the curve is 0 or 1: nan, set to the band's edge below
+    with warnings.catch_warnings():  # undefined where the curve is 0: nan, set below
         warnings.simplefilter("ignore", RuntimeWarning)
         band = sf.confidence_interval(LEVEL, method="log-log")
     times = [float(t) for t in sf.quantiles]
     surv = [float(p) for p in sf.probabilities]
-    low = [float(p) for p in np.nan_to_num(band.low.probabilities, nan=0.0)]
-    high = [float(p) for p in np.nan_to_num(band.high.probabilities, nan=1.0)]
+    # the log-log band is undefined where the curve is 0 (after the last trial reached the goal):
+    # there it is 0 too, so the median's interval ends at most at the last time observed
+    empty = np.asarray(sf.probabilities) <= 0
+    low = [float(p) for p in np.where(empty, 0.0, np.nan_to_num(band.low.probabilities, nan=0.0))]
+    high = [float(p) for p in np.where(empty, 0.0, np.nan_to_num(band.high.probabilities, nan=1.0))]
     median = first_time_at_or_below(times, surv, 0.5)
     out.update(times=times, survival=surv, low=low, high=high, median=median,
                median_beyond_cap=median is None,
