@@ -12,7 +12,8 @@ file's path is its module's path:
                                    the guide, mapping; never imports MuJoCo
   armtransfer.experiments          trials, results, sweeps, stores, matrices, statistics,
                                    reports and figures
-  armtransfer                      the Python API, Gymnasium wrappers, the command
+  armtransfer                      the Python API, Gymnasium wrappers, dm_control
+                                   environments (armtransfer.dmc), the command
 
 The public names below are loaded on first use, so importing any part stays cheap:
 

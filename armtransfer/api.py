@@ -54,6 +54,7 @@ def transfer(
     beta: float | None = None,
     trajectory: TrajectorySpec | Sequence[TrajectorySpec] | None = None,
     controls: bool = True,
+    baselines: bool = True,
     mapping: str | Path | ActionMapping | None = None,
     save_mapping: bool = False,
     max_span: int = DEFAULT_MAX_SPAN,
@@ -68,7 +69,9 @@ def transfer(
     trajectory file names its task, else task 1. ``trajectory`` is one or several of
     :data:`TRAJECTORY_KINDS`, trajectory JSON files or :class:`Trajectory` objects (default
     ``learned``). ``controls`` also runs every reward-only method with a shuffled and a
-    random trajectory, each trial with its own draw (``experiment.run_control``). ``mapping`` (for method ``mapping``) is a mapping or its JSON file;
+    random trajectory, each trial with its own draw (``experiment.run_control``). ``baselines``
+    also runs, before the methods that need them, the baselines sharing their learners
+    (``Method.baselines``, see :func:`armtransfer.learning.methods.with_baselines`). ``mapping`` (for method ``mapping``) is a mapping or its JSON file;
     with ``save_mapping`` the file is updated from this run's converged trials.
     ``learner_options`` are :class:`LearnerConfig` fields (``alpha``, ``epsilon``, ...).
     ``progress`` is called after every trial.
@@ -77,6 +80,8 @@ def transfer(
     method_names = [registry.get(m).name for m in _as_sequence(methods, "methods")]
     if not method_names:
         raise InvalidParameterError(f"give at least one method; valid methods: {', '.join(registry.METHODS)}")
+    if baselines:
+        method_names = registry.with_baselines(method_names)
     trials = _whole(trials, "trials", 1)
     seed = _whole(seed, "seed", 0)
     wind = _probability(wind, "wind")
@@ -116,7 +121,7 @@ def transfer(
             mapping_obj = load_mapping(mapping_path, src, tgt)
         if mapping_obj is not None:
             mapping_obj.check_new_task(start_cell, goal_cell, tgt.layout)
-    shaped = any(registry.get(m).shaped for m in method_names)
+    shaped = any(registry.get(m).shaped and registry.get(m).uses_trajectory for m in method_names)
     trajs = resolve_trajectories(specs, src, the_task, config, seed) if shaped else []
     # every method's K, checked before any learning: a farmable method's K by value iteration
     # over the shaped task (refused in one line naming the largest safe K; 'auto' is verified)
@@ -125,7 +130,7 @@ def transfer(
         if registry.get(m).shaped:
             k_per_method[m] = farming.check_k(m, tgt, tgt.start_state(start_cell), goal_cell, trajs, K, config,
                                               wind)
-            registry.build_shaping(m, tgt, trajs, k_per_method[m], config.step_reward, beta=beta)
+            registry.build_shaping(m, tgt, trajs, k_per_method[m], config.step_reward, beta=beta, gamma=config.gamma)
 
     entries_before = 0 if mapping_obj is None else len(mapping_obj)
     runs, learned = experiment.run_all(

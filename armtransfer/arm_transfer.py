@@ -38,7 +38,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     common.add_task_arguments(p)
     p.add_argument("--source", default=DEFAULT_SOURCE, metavar="ARM[:ACTIONS]",
                    help=f"the arm that solves the task (default {DEFAULT_SOURCE}); "
-                        f"'{CUSTOM}[:ACTIONS]' is the arm of --arm-xml")
+                        f"'{CUSTOM}[:ACTIONS]' or 'NAME[:ACTIONS]' (its name, as 'arms list' prints it) is the "
+                        "arm of --arm-xml")
     p.add_argument("--target", default=DEFAULT_TARGET, metavar="ARM[:ACTIONS]",
                    help=f"the arm that learns (default {DEFAULT_TARGET})")
     p.add_argument("--source-planner", choices=["learn", "bfs"], default="learn",
@@ -58,7 +59,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def arm_options(args: argparse.Namespace) -> dict:
-    """The bring-your-own arm's options (for ``custom[:ACTIONS]``) and the cell size."""
+    """The bring-your-own arm's options (for ``custom[:ACTIONS]`` or its name) and the cell size."""
     options = dict(cell_size=args.cell_size)
     if getattr(args, "arm_xml", None):
         options.update(common.arm_file_options(args))

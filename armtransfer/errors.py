@@ -27,6 +27,10 @@ class UnknownArmError(UnknownRobotError):
     """An arm or action model name is not known (the message lists the valid ones)."""
 
 
+class InvalidActionError(ArmTransferError):
+    """An action outside an environment's action spec."""
+
+
 class ArmModelError(ArmTransferError):
     """An arm's MJCF cannot be used: unreadable, no hinge joints, missing tip site."""
 

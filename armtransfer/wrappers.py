@@ -17,21 +17,13 @@ The term is also in ``info["shaping"]``. Per-episode state (which trajectory cel
 
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
 
 import gymnasium as gym
-import numpy as np
 
-from armtransfer.errors import InvalidParameterError, InvalidTrajectoryError
-from armtransfer.learning import methods as registry
-from armtransfer.learning import trajectory as trajectories
+from armtransfer.errors import InvalidParameterError
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.learning.sarsa import _shaping
-from armtransfer.learning.shaping import MODE_NONE
-from armtransfer.learning.trajectory import Trajectory
-
-TrajectoryLike = Trajectory | str | os.PathLike
+from armtransfer.learning.reward_term import TrajectoryLike, TransferTerm
 
 
 class TransferReward(gym.Wrapper, gym.utils.RecordConstructorArgs):
@@ -42,7 +34,8 @@ class TransferReward(gym.Wrapper, gym.utils.RecordConstructorArgs):
     ``step_reward`` and ``goal_cell`` and reports the robot's state as its observation.
     ``trajectory``: a :class:`Trajectory`, a trajectory JSON file, or a list of them.
     ``gamma`` is the discount of the potential-based methods' F = gamma*phi(s') - phi(s):
-    set it to your learner's discount.
+    set it to your learner's discount (their potential is bounded for it, so that no move
+    that leaves the state unchanged pays; ``potentials.bounded``).
     """
 
     def __init__(self, env: gym.Env, trajectory: TrajectoryLike | Sequence[TrajectoryLike], method: str = "pseudo",
@@ -56,39 +49,34 @@ class TransferReward(gym.Wrapper, gym.utils.RecordConstructorArgs):
             raise InvalidParameterError(
                 f"TransferReward needs one of armtransfer's environments (no {', '.join(missing)} on "
                 f"{type(base).__name__})")
-        m = registry.get(method)
-        if m.name not in registry.REWARD_ONLY:
-            why = "adds no reward" if not m.shaped else "changes how the learner chooses actions, not a reward"
-            raise InvalidParameterError(f"method {method!r} {why}; valid methods: {', '.join(registry.REWARD_ONLY)}")
-        if not (isinstance(gamma, (int, float)) and 0.0 <= gamma <= 1.0):
-            raise InvalidParameterError(f"gamma must be in [0, 1], got {gamma!r}")
+        self.transfer = TransferTerm(base.robot, trajectory, method, K, base.step_reward, gamma, beta)
         self.robot = base.robot
-        self.trajectories = [self._load(t) for t in _as_list(trajectory)]
-        self.method = m.name
-        self.shaping = registry.build_shaping(m.name, self.robot, self.trajectories, K, base.step_reward, beta=beta)
-        self.gamma = float(gamma)
         self.goal_cell = int(base.goal_cell)
-        n_ids = int(self.shaping.traj_index.max()) + 1 if len(self.shaping.traj_index) else 1
-        self._paid = np.full(max(n_ids, 1), -1, np.int64)
-        self._episode = -1
-        self._best = 0.0
         self._state: int | None = None
 
-    def _load(self, t: TrajectoryLike) -> Trajectory:
-        traj = t if isinstance(t, Trajectory) else trajectories.load(t)
-        n_cells = self.robot.layout.n_cells
-        if any(not 0 <= c < n_cells for c in (*traj.cells, traj.goal)):
-            raise InvalidTrajectoryError(f"the trajectory names cells outside this robot's layout (0..{n_cells - 1})")
-        return traj
+    @property
+    def method(self) -> str:
+        return self.transfer.method
+
+    @property
+    def trajectories(self) -> list:
+        return self.transfer.trajectories
+
+    @property
+    def shaping(self):
+        return self.transfer.shaping
+
+    @property
+    def gamma(self) -> float:
+        return self.transfer.gamma
 
     @property
     def K(self) -> float:
-        return self.shaping.K
+        return self.transfer.K
 
     def reset(self, **kwargs):
         obs, info = self.env.reset(**kwargs)
-        self._episode += 1
-        self._best = 0.0
+        self.transfer.reset()
         self._state = int(obs)
         return obs, info
 
@@ -96,21 +84,7 @@ class TransferReward(gym.Wrapper, gym.utils.RecordConstructorArgs):
         if self._state is None:
             raise InvalidParameterError("call reset() before step()")
         obs, reward, terminated, truncated, info = self.env.step(action)
-        s, s2 = self._state, int(obs)
-        term = 0.0
-        if self.shaping.mode != MODE_NONE:
-            sh = self.shaping
-            term, self._best = _shaping(sh.mode, s, s2, bool(terminated), sh.bonus, sh.traj_index, sh.phi,
-                                        self.gamma, self._paid, self._episode, self._best)
-        self._state = s2
-        info = dict(info, shaping=float(term))
+        term = self.transfer.term(self._state, int(obs), bool(terminated))
+        self._state = int(obs)
+        info = dict(info, shaping=term)
         return obs, reward + term, terminated, truncated, info
-
-
-def _as_list(trajectory) -> list:
-    if isinstance(trajectory, (Trajectory, str, os.PathLike)):
-        return [trajectory]
-    out = list(trajectory)
-    if not out:
-        raise InvalidParameterError("TransferReward needs at least one trajectory")
-    return out

@@ -2,20 +2,23 @@
 baseline of ``armtransfer bench`` moves by half within an hour here) cancels out.
 
     python benchmarks/bench_kernels.py                      # plain kernel against the guided one, no guide
-    python benchmarks/bench_kernels.py --against 0cd2902    # ... and against an older commit's kernel
+    python benchmarks/bench_kernels.py --against 7f3bd4f    # ... and against an older commit's kernel
+    python benchmarks/bench_kernels.py --against 7f3bd4f main  # ... and against several
     python benchmarks/bench_kernels.py --fast               # a smoke run
 
 Each round runs every contender on the same work, in turn: Table I task 1, the fine robot, no
 transfer, trials back to back until ``--steps`` steps (``armtransfer bench``'s measurement),
 seed = the round. Reported: each contender's median steps/s over the rounds and the median of
-the per-round ratios to the first. ``--against REV`` loads ``armtransfer/learning/sarsa.py`` and
-``armtransfer/learning/guide.py`` as they were at git revision REV of this checkout, beside today's
-(a revision whose kernel takes other arguments than ``sarsa.learn`` gives them fails in one line).
+the per-round ratios to the first. ``--against REV ...`` loads the learner's kernel (``sarsa.py`` and
+its guide) as it was at git revision REV of this checkout, from ``armtransfer/learning/`` or, before
+the move, ``transfer/``, beside today's (a revision whose kernel takes other arguments than
+``sarsa.learn`` gives them fails in one line).
 """
 
 from __future__ import annotations
 
 import importlib
+import re
 import statistics
 import subprocess
 import argparse
@@ -36,25 +39,56 @@ from armtransfer.tasks.grid_robots import grid_robot
 ROOT = Path(__file__).resolve().parents[1]
 
 
+LEARNER_FOLDERS = ("armtransfer/learning", "transfer")
+"""Where a revision keeps its learner: today's path, then the one before the move."""
+KERNEL_FILES = ("sarsa.py", "guide.py", "guide/")  # a revision's guide is one file or a package
+"""The learner's compiled files, loaded as they were at the revision (a folder: all its files);
+every other import resolves to today's modules."""
+RENAMES = ((re.compile(r"\bfrom tasks\."), "from armtransfer.tasks."),
+           (re.compile(r"\bfrom transfer\.rewards import Shaping\b"), "from armtransfer.learning.shaping import Shaping"),
+           (re.compile(r"\bfrom transfer\."), "from armtransfer.learning."))
+"""Imports of the old tree, in today's names (the kernel's plain run reads only ``Shaping.none``)."""
+
+
+def _git(*args: str) -> str:
+    try:
+        proc = subprocess.run(["git", "-C", str(ROOT), *args], capture_output=True, text=True)
+    except OSError as e:
+        raise ArmTransferError(f"--against needs git and this checkout's history: {e}") from None
+    if proc.returncode != 0:
+        err = proc.stderr.strip().splitlines()
+        raise ArmTransferError(f"git {' '.join(args)} failed: {err[-1] if err else 'no message'}")
+    return proc.stdout
+
+
 def load_revision(rev: str, where: Path):
-    """``sarsa`` of git revision ``rev``, importing its own ``guide`` of that revision."""
-    files = {}
-    for name in ("sarsa", "guide"):
-        try:
-            proc = subprocess.run(["git", "-C", str(ROOT), "show", f"{rev}:transfer/{name}.py"],
-                                  capture_output=True, text=True)
-        except OSError as e:
-            raise ArmTransferError(f"--against needs git and this checkout's history: {e}") from None
-        if proc.returncode != 0:
-            raise ArmTransferError(f"cannot read transfer/{name}.py at revision {rev!r}: "
-                                   f"{proc.stderr.strip().splitlines()[-1] if proc.stderr.strip() else 'git failed'}")
-        files[name] = proc.stdout
-    tag = "".join(c for c in rev if c.isalnum())
-    (where / f"guide_{tag}.py").write_text(files["guide"])
-    src = files["sarsa"].replace("from armtransfer.learning import guide as _guide", f"import guide_{tag} as _guide")
-    (where / f"sarsa_{tag}.py").write_text(src)
+    """``sarsa`` of git revision ``rev``, with that revision's guide, as package ``rev_<commit>``
+    under ``where``. The learner is read from ``armtransfer/learning/`` or, for a revision before
+    the move, ``transfer/``."""
+    tag = "rev_" + _git("rev-parse", "--short=12", f"{rev}^{{commit}}").strip()
+    if tag in sys.modules:
+        return sys.modules[f"{tag}.sarsa"]
+    for folder in LEARNER_FOLDERS:
+        names = _git("ls-tree", "-r", "--name-only", rev, "--", folder + "/").split()
+        if f"{folder}/sarsa.py" in names:
+            break
+    else:
+        raise ArmTransferError(f"revision {rev!r} has no learner kernel in {' or '.join(LEARNER_FOLDERS)}/")
+    own = re.compile(r"\b(?:armtransfer\.learning|transfer)(\.guide\b| import guide\b)")
+    pkg = where / tag
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    for name in names:
+        rel = name[len(folder) + 1:]
+        if not any(rel == k or (k.endswith("/") and rel.startswith(k) and rel.endswith(".py")) for k in KERNEL_FILES):
+            continue
+        src = own.sub(lambda m: tag + m.group(1), _git("show", f"{rev}:{name}"))
+        for pattern, repl in RENAMES:
+            src = pattern.sub(repl, src)
+        (pkg / rel).parent.mkdir(parents=True, exist_ok=True)
+        (pkg / rel).write_text(src)
     sys.path.insert(0, str(where))
-    return importlib.import_module(f"sarsa_{tag}")
+    return importlib.import_module(f"{tag}.sarsa")
 
 
 def measure(learn, steps: int, seed: int) -> float:
@@ -84,7 +118,8 @@ def main(argv: list[str] | None = None) -> int:
     p = script.parser(__doc__)
     p.add_argument("--rounds", type=int, default=8)
     p.add_argument("--steps", type=int, default=1_000_000, help="steps per contender per round")
-    p.add_argument("--against", metavar="REV", help="also time the kernel of this git revision")
+    p.add_argument("--against", metavar="REV", nargs="+", default=[],
+                   help="also time the kernel of each of these git revisions")
     p.add_argument("--fast", action="store_true", help="a smoke run: 2 rounds of 20,000 steps")
     args = p.parse_args(argv)
     return script.run(_run, args)
@@ -97,9 +132,8 @@ def _run(args: argparse.Namespace) -> int:
     contenders = {"plain kernel (no guide compiled in)": sarsa.learn,
                   "guided kernel, run without a guide": guided_kernel_without_guide}
     with tempfile.TemporaryDirectory() as tmp:
-        if args.against:
-            old = load_revision(args.against, Path(tmp))
-            contenders[f"kernel at {args.against}"] = old.learn
+        for rev in args.against:
+            contenders[f"kernel at {rev}"] = load_revision(rev, Path(tmp)).learn
         for learn in contenders.values():  # compile or load every kernel outside the timing
             try:
                 measure(learn, 1_000, 0)

@@ -10,6 +10,7 @@ pairs of exploration steps / optimal distance (first episode only, 20 trials per
     python research/select_defaults.py --method guided --pairs 6 --trials 10
     python research/select_defaults.py --method guided-tip       # the tip model's, then the fill's
     python research/select_defaults.py --method guided-fill      # the fill's alone, about 20 s
+    python research/select_defaults.py --method dense-bound --pairs 4 --trials 5   # the potential's bound
 
 For ``guided`` the held-out pairs are drawn for each of coarse -> fine, fine -> coarse and
 planar2:joint <-> ur5e_like:cartesian, with the source's shortest path as the trajectory. A
@@ -17,7 +18,7 @@ candidate's score is the mean first exposure / optimal distance of its worst rob
 issue's target is on the mean, which a rare long trial dominates). The grid GUIDED is
 searched first; then GIVE_UP with the best of it, taking the smallest value within 2% of
 never giving up. Chosen this way (8 pairs, 20 trials, seed 2026): weight 2, window 2,
-reach 1, knn 8, blocked moves generalised, give up after 100 moves (``transfer.guide``).
+reach 1, knn 8, blocked moves generalised, give up after 100 moves (``armtransfer.learning.guide.params``).
 They were chosen without the tip model and the grid runs without it, as then; ``guided-tip``
 then chooses the tip model's parameters with those in place (``select_tip``).
 """
@@ -69,11 +70,8 @@ def score(method: str, params: dict, pairs, trials: int) -> float:
     ratios = []
     for s, g in pairs:
         traj = trajectories.shortest(coarse, s, g)
-        if method == "dense":
-            phi = potentials.dense(fine, traj, params["K"], params["beta"])
-            shaping = Shaping.potential(phi, params["K"])
-        else:
-            shaping = methods.build_shaping(method, fine, traj, params["K"], config.step_reward)
+        shaping = methods.build_shaping(method, fine, traj, params["K"], config.step_reward, beta=params.get("beta"),
+                                        gamma=config.gamma)
         optimal = len(fine.shortest_path(fine.start_state(s), g)) - 1
         runs = map_trials(lambda t: sarsa.learn(fine, fine.start_state(s), g, config, trial_rng(12345, t),
                                                 shaping=shaping), trials)
@@ -83,9 +81,9 @@ def score(method: str, params: dict, pairs, trials: int) -> float:
 
 GUIDED = [{"weight": wt, "window": w, "reach": r, "knn": k, "blocked": b}
           for wt, w, r, k, b in itertools.product((1.0, 2.0, 3.0), (1.0, 2.0, 4.0), (1.0, 1.5), (3, 8), (False, True))]
-"""Candidates for method ``guided`` (transfer.guide: WEIGHT, WINDOW, REACH, KNN, BLOCKED)."""
+"""Candidates for method ``guided`` (armtransfer.learning.guide.params: WEIGHT, WINDOW, REACH, KNN, BLOCKED)."""
 GIVE_UP = (25, 50, 100, 200)
-"""Then transfer.guide.GIVE_UP, smallest first."""
+"""Then guide.params.GIVE_UP, smallest first."""
 GUIDED_PAIRS = [("coarse", "fine"), ("fine", "coarse"),
                 ("planar2:joint", "ur5e_like:cartesian"), ("ur5e_like:cartesian", "planar2:joint")]
 
@@ -121,11 +119,11 @@ def draw_tasks(src, dst, n: int, seed: int, keep) -> list[tuple]:
     return tasks
 
 
-def guided_held_out(n: int, seed: int) -> dict:
-    """For each robot pair of GUIDED_PAIRS: n held-out start/goal pairs that both robots can
+def guided_held_out(n: int, seed: int, robot_pairs=GUIDED_PAIRS) -> dict:
+    """For each robot pair of ``robot_pairs``: n held-out start/goal pairs that both robots can
     do, at least 20 target steps apart, none a Table I task; with the source's shortest path."""
     out = {}
-    for src_name, dst_name in GUIDED_PAIRS:
+    for src_name, dst_name in robot_pairs:
         src, dst = _robot(src_name), _robot(dst_name)
 
         def keep(s, g, src=src):
@@ -142,14 +140,24 @@ def score_guided(params: dict, held: dict, trials: int, cap: int = 50_000) -> di
     from armtransfer.learning import guide
     from armtransfer.learning.shaping import MODE_NONE
 
+    def shaping_for(dst, traj):
+        gd = guide.build(dst, [traj], **{"give_up": 0, **params})  # give_up is chosen afterwards
+        n = dst.n_states
+        return Shaping(MODE_NONE, np.zeros(n), np.full(n, -1, np.int64), np.zeros(n), 0.0, guide=gd)
+
+    return score_per_pair(shaping_for, held, trials, cap)
+
+
+def score_per_pair(shaping_for, held: dict, trials: int, cap: int) -> dict:
+    """The mean over the held-out tasks and trials of first exposure / optimal distance per robot
+    pair (an unreached trial at the cap), with ``shaping_for(target, trajectory)``, and the worst
+    pair's under "all"."""
     config = LearnerConfig(max_episodes=1, max_total_steps=cap)
     per = {}
     for key, (dst, tasks) in held.items():
         ratios = []
         for s, g, traj, optimal in tasks:
-            gd = guide.build(dst, [traj], **{"give_up": 0, **params})  # give_up is chosen afterwards
-            n = dst.n_states
-            shaping = Shaping(MODE_NONE, np.zeros(n), np.full(n, -1, np.int64), np.zeros(n), 0.0, guide=gd)
+            shaping = shaping_for(dst, traj)
             runs = map_trials(lambda t: sarsa.learn(dst, dst.start_state(s), g, config, trial_rng(12345, t),
                                                     shaping=shaping), trials)
             ratios += [(res.exploration_steps or cap) / optimal for res in runs]
@@ -181,7 +189,7 @@ def select_guided(pairs: int, trials: int, seed: int) -> None:
 
 TIP = [{"tip": False}] + [{"tip_anchor": an, "tip_ridge": r, "tip_nearest": k}
                           for an, r, k in itertools.product((False, True), (1e-3, 1e-2, 1e-1, 1.0), (1, 3, 8))]
-"""Candidates for the tip model of method ``guided`` (transfer.guide: TIP_ANCHOR, TIP_RIDGE,
+"""Candidates for the tip model of method ``guided`` (armtransfer.learning.guide.params: TIP_ANCHOR, TIP_RIDGE,
 TIP_NEAREST), chosen after the grid GUIDED; the first is the tip model off, the baseline."""
 
 
@@ -219,7 +227,7 @@ def select_tip(pairs: int, trials: int, seed: int) -> None:
     """The tip model's parameters, the other guided parameters at their defaults, on two held-out
     sets of each robot pair of GUIDED_PAIRS whose target moves its joints: its tasks of
     ``guided_held_out`` and those of ``unreachable_held_out``. A candidate's score is the worse
-    of its two means (transfer.guide: chosen this way, 8 pairs each, 20 trials, seed 2026)."""
+    of its two means (armtransfer.learning.guide.params: chosen this way, 8 pairs each, 20 trials, seed 2026)."""
     sets = tip_held_out(pairs, seed)
     for name, held in zip(("held-out", "held-out with unreachable cells"), sets):
         for key, (_, tasks) in held.items():
@@ -236,7 +244,7 @@ def select_tip(pairs: int, trials: int, seed: int) -> None:
 
 
 FILL = (0.0, 0.1, 0.25, 0.5, 1.0, 2.0)
-"""Candidates for the fill of method ``guided`` (transfer.guide.FILL_COST), 0 first (off), chosen
+"""Candidates for the fill of method ``guided`` (guide.params.FILL_COST), 0 first (off), chosen
 after the tip model's parameters on the same two held-out sets."""
 
 
@@ -252,21 +260,62 @@ def select_fill(pairs: int, trials: int, seed: int) -> None:
     print(f"-> guided fill: best {best[1]} ({best[0]:.2f} x optimal, the worse of the two)", flush=True)
 
 
+BOUND = (None, 0.1, 0.25, 0.35, 0.5, 0.6, 0.75, 0.9)
+"""Candidates for the bound of the potential-based methods' potential (potentials.LOOP_MARGIN,
+the bound as a fraction of -step_reward / (1 - gamma)); None: unbounded, the baseline."""
+BOUND_PAIRS = [*GUIDED_PAIRS, ("planar3:joint", "planar4:cartesian")]
+"""GUIDED_PAIRS and a joint-space arm to a cartesian arm, where unbounded ``dense`` loops."""
+
+
+def score_bound(margin: float | None, held: dict, trials: int, cap: int = 300_000) -> dict:
+    """``dense`` (its default K and beta) with its potential bounded at ``margin``: the mean over
+    the held-out tasks and trials of first exposure / optimal distance per robot pair, an
+    unreached trial at the cap, and the worst pair's."""
+    config = LearnerConfig()
+
+    def shaping_for(dst, traj):
+        phi = potentials.dense(dst, traj)
+        if margin is not None:
+            phi = potentials.bounded(phi, config.gamma, config.step_reward, margin)
+        return Shaping.potential(phi, potentials.DENSE_K)
+
+    return score_per_pair(shaping_for, held, trials, cap)
+
+
+def select_bound(pairs: int, trials: int, seed: int) -> None:
+    """potentials.LOOP_MARGIN on held-out tasks of BOUND_PAIRS (the source's shortest path as the
+    trajectory): the smallest worst-pair mean (chosen this way, 8 pairs, 10 trials, seed 2026)."""
+    held = guided_held_out(pairs, seed, BOUND_PAIRS)
+    for key, (_, tasks) in held.items():
+        print(f"bound held-out {key[0]} -> {key[1]}:", [(ROOMS.xy(s), ROOMS.xy(g)) for s, g, _, _ in tasks])
+    results = []
+    for margin in BOUND:
+        per = score_bound(margin, held, trials)
+        results.append((per["all"], margin))
+        print(f"dense bound  {margin}: " + ", ".join(f"{k if k == 'all' else '->'.join(k)} {v:.1f}x"
+                                                   for k, v in per.items()), flush=True)
+    best = min(results[1:], key=lambda x: x[0])
+    print(f"-> dense bound: best {best[1]} ({best[0]:.1f} x optimal, the worst pair's mean; "
+          f"unbounded {results[0][0]:.1f}x)", flush=True)
+
+
 def main() -> None:
     p = script.parser(__doc__)
     p.add_argument("--pairs", type=int, default=8)
     p.add_argument("--trials", type=int, default=20)
     p.add_argument("--seed", type=int, default=2026)
     p.add_argument("--method", nargs="*", default=None, help="only these methods",
-                   choices=[*CANDIDATES, "guided", "guided-tip", "guided-fill"])
+                   choices=[*CANDIDATES, "guided", "guided-tip", "guided-fill", "dense-bound"])
     args = p.parse_args()
+    if args.method and "dense-bound" in args.method:
+        select_bound(args.pairs, args.trials, args.seed)
     if args.method and "guided" in args.method:
         select_guided(args.pairs, args.trials, args.seed)
     if args.method and {"guided", "guided-tip"} & set(args.method):
         select_tip(args.pairs, args.trials, args.seed)
     if args.method and {"guided", "guided-tip", "guided-fill"} & set(args.method):
         select_fill(args.pairs, args.trials, args.seed)
-    if args.method and set(args.method) <= {"guided", "guided-tip", "guided-fill"}:
+    if args.method and set(args.method) <= {"guided", "guided-tip", "guided-fill", "dense-bound"}:
         return
     pairs = held_out_pairs(args.pairs, args.seed)
     print("held-out pairs:", [(ROOMS.xy(s), ROOMS.xy(g)) for s, g in pairs])

@@ -201,3 +201,20 @@ def test_bench_kernels_fast_mode_times_both_kernels_and_refuses_a_bad_revision()
     proc = subprocess.run([sys.executable, str(script), "--fast", "--against", "no-such-revision"],
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr
+
+
+def test_bench_kernels_loads_a_kernel_of_the_old_tree_and_of_todays():
+    """--against reads the learner from transfer/ (before the move) or armtransfer/learning/, with
+    its guide as one file or as a package."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    old = "7f3bd4f"  # the last kernel before the methods joined it; transfer/ layout, no guide
+    if subprocess.run(["git", "-C", str(root), "cat-file", "-e", f"{old}^{{commit}}"], capture_output=True).returncode:
+        pytest.skip("this checkout has no history")
+    proc = subprocess.run([sys.executable, str(root / "benchmarks" / "bench_kernels.py"), "--fast", "--against", old,
+                           "HEAD"], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert f"kernel at {old}: median" in proc.stdout and "kernel at HEAD: median" in proc.stdout

@@ -34,13 +34,14 @@ def guided_shaping(robot, trajs, **params):
     return replace(sh, guide=guide.build(robot, trajs, **params)) if params else sh
 
 
-def assert_kernel_is_reference(robot, start, goal, config, seed, shaping, wind=0.0) -> list[int]:
+def assert_kernel_is_reference(robot, start, goal, config, seed, shaping, wind=0.0, traj=None) -> list[int]:
     """The numba kernel and the dense reference (Algorithm 1 with the guide, written out plainly)
-    give the same episode lengths and the same Q, bit for bit; returns the episode lengths."""
+    give the same episode lengths and the same Q, bit for bit; returns the episode lengths.
+    ``traj``: the reference also pays the pseudo reward of this trajectory at ``shaping.K``."""
     s0 = robot.start_state(start)
     fast = sarsa.learn(robot, s0, goal, config, np.random.default_rng(seed), shaping=shaping, wind=wind, keep_q=True)
     Q, steps = reference.learn(robot, s0, goal, config, np.random.default_rng(seed), episodes=config.max_episodes,
-                               guide=shaping.guide, wind=wind)
+                               guide=shaping.guide, wind=wind, traj=traj, K=shaping.K if traj is not None else 0.0)
     assert fast.episode_steps.tolist() == steps
     assert np.array_equal(fast.Q, Q)
     return steps
@@ -92,11 +93,11 @@ def test_kernel_is_bit_identical_to_the_dense_reference_when_it_gives_a_trajecto
     steps = assert_kernel_is_reference(fine, start, goal, config, 3, sh)
     # the first episode did give every trajectory up: its progress ends one past its cells
     g = sh.guide
-    gm = guide.model_arrays_for(g, fine.n_states, fine.n_actions)
+    gm = guide.new_model(g, fine.n_states, fine.n_actions)
     first = sarsa.learn(fine, fine.start_state(start), goal, replace(config, max_episodes=1), np.random.default_rng(3),
-                        shaping=sh, guide_arrays=gm)
+                        shaping=sh, guide_model=gm)
     assert first.episode_steps.tolist() == steps[:1]
-    assert gm[4].tolist() == g.tstart[1:].tolist()
+    assert gm.progress.index.tolist() == g.tstart[1:].tolist()
 
 
 @pytest.mark.parametrize("anchor", [False, True])
@@ -109,7 +110,7 @@ def test_kernel_is_bit_identical_to_the_dense_reference_with_the_tip_model_on_a_
     start, goal = TABLE_I[4].cells()
     trajs = [trajectories.shortest(coarse, start, goal)]
     sh = guided_shaping(arm, trajs, tip_anchor=anchor)
-    assert sh.guide.tip and sh.guide.fj.shape == (9, guide.TIP_ORDER)  # 2 joints: 1 + 4 + 4 features
+    assert sh.guide.params.tip and sh.guide.fj.shape == (9, guide.TIP_ORDER)  # 2 joints: 1 + 4 + 4 features
     config = LearnerConfig(trace_cutoff=0.0, max_episodes=2, patience=1000)
     assert_kernel_is_reference(arm, start, goal, config, 5, sh)
 
@@ -120,12 +121,12 @@ def test_the_tip_model_is_on_for_joint_moves_only():
     coarse = grid_robot("coarse")
     start, goal = TABLE_I[1].cells()
     traj = trajectories.shortest(coarse, start, goal)
-    assert guide.build(resolve("planar2:joint"), [traj]).tip
+    assert guide.build(resolve("planar2:joint"), [traj]).params.tip
     for name in ("fine", "ur5e_like:cartesian"):  # a cell a move: the label shows every move
         robot = resolve(name) if ":" in name else grid_robot(name)
         g = guide.build(robot, [traj])
-        assert not g.tip and g.fj.shape[0] == 0
-    assert guide.build(grid_robot("fine"), [traj], tip=True).tip  # asked for
+        assert not g.params.tip and g.fj.shape[0] == 0
+    assert guide.build(grid_robot("fine"), [traj], tip=True).params.tip  # asked for
 
 
 def test_tip_features_fit_a_planar_chain_exactly():
@@ -170,15 +171,15 @@ def test_the_fill_is_on_with_the_tip_model_and_raises_h_where_robot_2_waited():
     start, goal = TABLE_I[1].cells()
     traj = experiment.source_trajectory("optimal", source, start, goal, LearnerConfig(), 0)
     g = guide.build(arm, [traj])
-    assert g.params[14] == guide.FILL_COST > 0
-    assert guide.build(grid_robot("fine"), [traj]).params[14] == 0.0
-    gm = guide.model_arrays_for(g, arm.n_states, arm.n_actions)
+    assert g.params.fill == guide.FILL_COST > 0
+    assert guide.build(grid_robot("fine"), [traj]).params.fill == 0.0
+    gm = guide.new_model(g, arm.n_states, arm.n_actions)
     shaping = replace(guided_shaping(arm, [traj]), guide=g)
     config = LearnerConfig(max_episodes=1)
     res = sarsa.learn(arm, arm.start_state(start), goal, config, np.random.default_rng(3), shaping=shaping,
-                      guide_arrays=gm)
+                      guide_model=gm)
     assert res.exploration_steps is not None
-    h, seen = gm[32], gm[33] >= 0
+    h, seen = gm.fill.h, gm.fill.h_epoch >= 0
     assert (h[seen] > 0).any()
     assert not h[~seen].any()
 
@@ -244,7 +245,7 @@ def test_the_guide_reads_only_configurations_labels_and_the_trajectory():
     assert np.array_equal(g.lxy, arm.layout.xy_of(arm.label).astype(np.float64).reshape(-1, 2))
     scrambled = replace(arm, next_state=np.zeros_like(arm.next_state))
     g2 = guide.build(scrambled, [trajectories.shortest(coarse, start, goal)])
-    for x, y in zip(guide.as_tuple(g), guide.as_tuple(g2)):
+    for x, y in zip(g, g2):
         assert np.array_equal(x, y)
 
 
@@ -542,11 +543,11 @@ def test_the_tip_model_learns_where_the_tip_is():
     start, goal = TABLE_I[4].cells()
     traj = trajectories.shortest(coarse, start, goal)
     g = guide.build(arm, [traj])
-    gm = guide.model_arrays_for(g, arm.n_states, arm.n_actions)
+    gm = guide.new_model(g, arm.n_states, arm.n_actions)
     res = sarsa.learn(arm, arm.start_state(start), goal, LearnerConfig(max_episodes=1), np.random.default_rng(2),
-                      shaping=replace(guided_shaping(arm, [traj]), guide=g), guide_arrays=gm)
+                      shaping=replace(guided_shaping(arm, [traj]), guide=g), guide_model=gm)
     assert res.exploration_steps is not None
-    seen = np.flatnonzero(gm[25])
+    seen = np.flatnonzero(gm.tip.seen)
     assert len(seen) > 50
     # the true tip in cell units: the affine map from metres that best fits the labels of all states
     tip = np.asarray(arm.arm.tip)[:, :2]
@@ -555,8 +556,8 @@ def test_the_tip_model_learns_where_the_tip_is():
     true = X @ M
     feats = np.empty((len(seen), g.fj.shape[0]))
     for i, s in enumerate(seen):
-        guide.features(guide.as_tuple(g), g.tq[s], feats[i])
-    est = feats @ gm[22] + gm[23]
+        guide.tip.features(g, g.tq[s], feats[i])
+    est = feats @ gm.tip.W + gm.tip.first
     err = np.linalg.norm(est - true[seen], axis=1)
     label_err = np.linalg.norm(g.lxy[seen] - true[seen], axis=1)
     assert np.median(err) < 0.5 * np.median(label_err)
@@ -569,7 +570,7 @@ def test_the_tip_model_learns_where_the_tip_is():
         t = arm.next_state[s, 0]  # q1+ (one lattice step of the first joint) where it is not blocked
         if t != s:
             f1 = np.empty(g.fj.shape[0])
-            guide.features(guide.as_tuple(g), g.tq[s] + step, f1)
-            moved.append(np.linalg.norm((f1 - feats[list(seen).index(s)]) @ gm[22] - (true[t] - true[s])))
+            guide.tip.features(g, g.tq[s] + step, f1)
+            moved.append(np.linalg.norm((f1 - feats[list(seen).index(s)]) @ gm.tip.W - (true[t] - true[s])))
     assert len(moved) > 20
     assert np.median(moved) < 0.05

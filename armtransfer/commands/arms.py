@@ -19,25 +19,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--family", default=None, help="arms generate: planar, spatial6 or spatial7")
     parser.add_argument("--dof", type=common.positive_int, default=None,
                         help="arms generate: joints (planar 2-7, spatial6 6, spatial7 7)")
-    parser.add_argument("--arm-xml", metavar="PATH",
-                        help="a bring-your-own MJCF arm (a MuJoCo Menagerie file works as it is); "
-                             "'custom[:ACTIONS]' is its robot")
-    parser.add_argument("--tip-site", metavar="NAME", default=None,
-                        help="the tool point of --arm-xml is this site (default: a site named tip)")
-    parser.add_argument("--tip-body", metavar="NAME", default=None,
-                        help="the tool point of --arm-xml is this body's origin (instead of --tip-site)")
-    parser.add_argument("--tip-offset", metavar="X,Y,Z", default=None,
-                        help="the tool point is this far (m) from the tip site or body, in its own frame; "
-                             "the tool's axis, kept pointing down, runs along it (e.g. 0,0,0.12)")
-    parser.add_argument("--arm-name", metavar="NAME", default=None,
-                        help="the name of --arm-xml in tables, plots, JSON and the cache (default: its "
-                             "MJCF model attribute)")
-    parser.add_argument("--base-pos", metavar="X,Y,Z", default=None,
-                        help="base position of --arm-xml in the table frame, metres (tabletop z=0, "
-                             "table centre at the origin); default: chosen automatically, the pose that "
-                             "reaches the most cells; write negative values as --base-pos=-0.1,0,0")
-    parser.add_argument("--base-yaw", metavar="RAD", type=float, default=None,
-                        help="rotation of --arm-xml's base about z (rad); default: facing the table")
+    common.add_arm_file_arguments(parser)
     parser.add_argument("--arm", default=None, metavar="NAMES",
                         help="only these built-in arms, comma-separated (e.g. planar2,ur5e_like)")
     parser.add_argument("--actions", default=None,

@@ -180,6 +180,30 @@ def progress_bar(total: int, desc: str):
 
 
 
+def add_arm_file_arguments(parser: argparse.ArgumentParser) -> None:
+    """--arm-xml and its options: a bring-your-own arm, named ``custom`` or by its name."""
+    parser.add_argument("--arm-xml", metavar="PATH",
+                        help="a bring-your-own MJCF arm (a MuJoCo Menagerie file works as it is); its "
+                             "robot is 'custom[:ACTIONS]' or 'NAME[:ACTIONS]', NAME its --arm-name or else "
+                             "its MJCF model attribute, as 'arms list' prints it")
+    parser.add_argument("--tip-site", metavar="NAME", default=None,
+                        help="the tool point of --arm-xml is this site (default: a site named tip)")
+    parser.add_argument("--tip-body", metavar="NAME", default=None,
+                        help="the tool point of --arm-xml is this body's origin (instead of --tip-site)")
+    parser.add_argument("--tip-offset", metavar="X,Y,Z", default=None,
+                        help="the tool point is this far (m) from the tip site or body, in its own frame; "
+                             "the tool's axis, kept pointing down, runs along it (e.g. 0,0,0.12)")
+    parser.add_argument("--arm-name", metavar="NAME", default=None,
+                        help="the name of --arm-xml in tables, plots, JSON and the cache (default: its "
+                             "MJCF model attribute)")
+    parser.add_argument("--base-pos", metavar="X,Y,Z", default=None,
+                        help="base position of --arm-xml in the table frame, metres (tabletop z=0, "
+                             "table centre at the origin); default: chosen automatically, the pose that "
+                             "reaches the most cells; write negative values as --base-pos=-0.1,0,0")
+    parser.add_argument("--base-yaw", metavar="RAD", type=float, default=None,
+                        help="rotation of --arm-xml's base about z (rad); default: facing the table")
+
+
 def parse_base_pos(text: str | None):
     if text is None:
         return None
@@ -195,7 +219,7 @@ def parse_base_pos(text: str | None):
 def check_arm_flags(args: argparse.Namespace) -> None:
     """The arm flags of ``arms``: a finite positive cell size, and the bring-your-own arm's
     options only with --arm-xml (they would be silently ignored otherwise)."""
-    if not (math.isfinite(args.cell_size) and args.cell_size > 0):
+    if hasattr(args, "cell_size") and not (math.isfinite(args.cell_size) and args.cell_size > 0):
         raise ArmModelError(f"--cell-size must be a positive number of metres, got {args.cell_size!r}")
     flags = (("--base-pos", "base_pos"), ("--base-yaw", "base_yaw"), ("--tip-site", "tip_site"),
              ("--tip-body", "tip_body"), ("--tip-offset", "tip_offset"), ("--arm-name", "arm_name"))

@@ -43,7 +43,8 @@ def _robot_list(text: str) -> list[str]:
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--robots", type=_robot_list, required=True, metavar="SPEC,SPEC,...",
-                   help="robot specs: coarse, fine, ARM:ACTIONS (see `armtransfer arms list`)")
+                   help="robot specs: coarse, fine, ARM:ACTIONS (see `armtransfer arms list`), and the arm "
+                        "of --arm-xml as custom:ACTIONS or NAME:ACTIONS")
     p.add_argument("--tasks", type=_task_list, default=[1, 2, 3, 4], metavar="1-4",
                    help="Table I tasks (default 1-4)")
     p.add_argument("--methods", nargs="+", default=["none", "pseudo", "dense"], metavar="METHOD",
@@ -53,6 +54,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--trajectory", choices=["learned", "optimal"], default="learned",
                    help="each source's learned path (default) or its shortest path")
     p.add_argument("--out", required=True, help="result store directory (re-running resumes)")
+    common.add_arm_file_arguments(p)
     add_executor_arguments(p)
 
 
@@ -61,11 +63,38 @@ def run(args: argparse.Namespace) -> int:
 
     for m in args.methods:
         methods.get(m)
-    sweep = matrix.matrix_sweep(args.robots, args.tasks, args.methods, args.trials, args.seeds, args.trajectory)
+    robots, arms = arm_file_robots(args)
+    sweep = matrix.matrix_sweep(robots, args.tasks, args.methods, args.trials, args.seeds, args.trajectory,
+                                arms=arms)
     code = run_sweep(sweep, args)
     text = write_summary(ResultStore.open_existing(args.out), Path(args.out))
     print(text)
     return code
+
+
+def arm_file_robots(args: argparse.Namespace) -> tuple[list[str], dict]:
+    """The robots with the arm of --arm-xml (``custom`` or its name) named by its name, and
+    that arm as a sweep's ``[arms.NAME]`` table: the store's runs name the arm as ``arms list``
+    prints it, and carry its file and options."""
+    from armtransfer.models import ARMS
+    from armtransfer.tasks.grid_robots import GRID_ROBOTS
+    from armtransfer.tasks.specs import CUSTOM, xml_arm_name
+
+    common.check_arm_flags(args)
+    if not args.arm_xml:
+        return list(args.robots), {}
+    options = common.arm_file_options(args)
+    name = xml_arm_name(args.arm_xml, options.pop("arm_name"))
+    if name in ARMS or name in GRID_ROBOTS or ":" in name or name == CUSTOM:
+        raise InvalidParameterError(f"the arm of --arm-xml is named {name!r}, as a built-in robot is (or not a "
+                                    "name); give it another with --arm-name")
+    robots = [name + spec[len(CUSTOM):] if spec.partition(":")[0] == CUSTOM else spec for spec in args.robots]
+    if not any(spec.partition(":")[0] == name for spec in robots):
+        raise InvalidParameterError(f"--arm-xml is given but no robot of --robots names it ({CUSTOM}:ACTIONS or "
+                                    f"{name}:ACTIONS)")
+    table = {"xml": str(Path(args.arm_xml).expanduser().resolve())}
+    table.update({k: (list(v) if isinstance(v, tuple) else v) for k, v in options.items() if v is not None})
+    return robots, {name: table}
 
 
 def write_summary(store: ResultStore, out: Path) -> str:

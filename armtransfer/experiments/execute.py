@@ -38,7 +38,7 @@ def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
     source, target = robots[run["source"]], robots[run["target"]]
     config = learner_config(run)
     traj = None
-    if methods.get(run["method"]).shaped:
+    if methods.get(run["method"]).shaped and methods.get(run["method"]).uses_trajectory:
         traj = experiment.source_trajectory(run["trajectory"], source, start, goal, config, run["seed"])
     res = experiment.run_method(
         run["method"], target, start, goal, traj, run["trials"], run["seed"], config,

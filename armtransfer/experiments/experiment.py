@@ -143,12 +143,14 @@ def run_method(
     def shaping_for(trajs):
         if not m.shaped:
             return None
-        if trajs is None:
+        if trajs is None and m.uses_trajectory:
             raise InvalidParameterError(f"method {method!r} needs a trajectory")
         k = K
         if m.farmable:  # the exact check: value iteration over this task ('auto' comes out verified)
             k = farming.check_k(method, target, start_state, goal_cell, trajs, K, config, wind)
-        return methods.build_shaping(method, target, trajs, k, config.step_reward, beta=beta)
+        sh = methods.build_shaping(method, target, trajs, k, config.step_reward, beta=beta, gamma=config.gamma)
+        farming.check_self_loops(method, target, goal_cell, sh, config, wind)
+        return sh
 
     out = MethodResult(method, control=control)
     if callable(traj):  # each trial its own trajectories (the controls: one draw per trial)
@@ -270,7 +272,11 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int 
     reached the goal counts at the step cap, ``cap`` (default: the steps its first episode
     ran before the cap stopped it, i.e. ``config.max_total_steps``), and the mean is then
     flagged as a lower bound. Improvements are paired (common random numbers,
-    ``trial_rng``) when the baseline has as many trials, else independent."""
+    ``trial_rng``) when the baseline has as many trials, else independent.
+
+    ``improvement_against`` holds, for every baseline that shares the method's learner
+    (``Method.baselines``, the no-transfer one first) and is among ``results``, the same
+    improvement measured against it: ``{name: {"percent", "ci95", "design"}}``."""
 
     def cap_of(r: MethodResult) -> int:
         if cap is not None:
@@ -294,6 +300,14 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int 
         imp = None
         if r.label != baseline and base is not None:
             imp = metrics.paired_improvement(base_ex, ex, c, paired=len(base_ex) == len(ex))
+        against = {}
+        known = methods.METHODS.get(r.method)  # None: a result made outside the registry
+        for name in known.baselines if known is not None else ():
+            if name in by_name and name != r.label:
+                b_ex = by_name[name].column("exploration_steps")
+                bc = max(cap_of(r), cap_of(by_name[name]))
+                d = metrics.paired_improvement(b_ex, ex, bc, paired=len(b_ex) == len(ex))
+                against[name] = {"percent": d["percent"], "ci95": d["ci95"], "design": d["design"]}
         entry = {
             "exploration_steps": ex,
             "mean": st["mean"],
@@ -311,6 +325,7 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int 
             "improvement_percent": None if imp is None else imp["percent"],
             "improvement_ci95": None if imp is None else imp["ci95"],
             "improvement_design": None if imp is None else imp["design"],
+            "improvement_against": against,
             "greedy_steps": greedy,
             "greedy_mean": g_mean,
             "greedy_ci95": g_ci,
@@ -401,7 +416,7 @@ def run_all(
     control trajectory. ``K`` is one K for every method or a dict of K per method. Returns the results in that order and, for ``mapping``, the mapping
     updated from this task's converged trials."""
     chosen = [methods.get(m) for m in method_names]
-    if any(m.shaped for m in chosen) and not trajs:
+    if any(m.shaped and m.uses_trajectory for m in chosen) and not trajs:
         raise InvalidParameterError("the transfer methods need a trajectory")
     if any(m.macros for m in chosen) and len(trajs) != 1:
         raise InvalidParameterError("method 'mapping' takes exactly one trajectory")

@@ -1,7 +1,8 @@
 """The cross-embodiment matrix: which robots help which.
 
 Every ordered (source, target) pair of a set of robots, a robot to itself included, runs
-through the sweep store (resumable, local or Ray) with ``none`` and each transfer method.
+through the sweep store (resumable, local or Ray) with ``none``, each transfer method and the
+baselines that share their learners (``Method.baselines``).
 The matrix cell of a pair and method is the improvement in exploration steps over ``none``
 on the same target, pooled over the tasks:
 
@@ -25,6 +26,7 @@ import numpy as np
 from armtransfer.errors import InvalidParameterError
 from armtransfer.experiments import sweep as sweeps
 from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.methods import with_baselines
 from armtransfer.experiments.report import markdown_table
 
 BOOTSTRAP = 2000
@@ -49,26 +51,29 @@ def family(spec: str) -> str:
 
 
 def matrix_spec(robots: Sequence[str], tasks: Sequence[int], methods: Sequence[str], trials: int,
-                seeds: Sequence[int] = (0,), trajectory: str = "learned", name: str = "matrix") -> dict:
-    """The sweep of every ordered pair of ``robots`` (each robot to itself too)."""
+                seeds: Sequence[int] = (0,), trajectory: str = "learned", name: str = "matrix",
+                arms: dict | None = None) -> dict:
+    """The sweep of every ordered pair of ``robots`` (each robot to itself too); ``arms`` names
+    bring-your-own arms as a sweep file's ``[arms.NAME]`` tables do (``NAME[:ACTIONS]`` robots)."""
     robots = list(robots)
     if len(robots) < 2:
         raise InvalidParameterError("a matrix needs at least two robots")
     if len(set(robots)) != len(robots):
         raise InvalidParameterError("a matrix lists each robot once")
-    methods = list(methods)
-    if "none" not in methods:
-        methods = ["none", *methods]
+    methods = with_baselines(["none", *methods])
     if len(methods) < 2:
         raise InvalidParameterError("a matrix needs a transfer method beside 'none'")
     raw = {"sweep": {"name": name, "tasks": list(tasks), "pairs": [[s, t] for s in robots for t in robots],
                      "methods": methods, "seeds": list(seeds), "trials": trials, "trajectory": trajectory}}
+    if arms:
+        raw["arms"] = arms
     return sweeps.normalise(raw, where="matrix")
 
 
 def matrix_sweep(robots: Sequence[str], tasks: Sequence[int], methods: Sequence[str], trials: int,
-                 seeds: Sequence[int] = (0,), trajectory: str = "learned", name: str = "matrix") -> sweeps.Sweep:
-    spec = matrix_spec(robots, tasks, methods, trials, seeds, trajectory, name)
+                 seeds: Sequence[int] = (0,), trajectory: str = "learned", name: str = "matrix",
+                 arms: dict | None = None) -> sweeps.Sweep:
+    spec = matrix_spec(robots, tasks, methods, trials, seeds, trajectory, name, arms)
     return sweeps.Sweep(spec["name"], spec, tuple(sweeps.expand(spec)))
 
 

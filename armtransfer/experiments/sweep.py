@@ -45,10 +45,11 @@ from pathlib import Path
 
 from armtransfer.tasks.catalog import TABLE_I, parse_xy
 from armtransfer.errors import ArmTransferError
+from armtransfer.learning import methods as _methods
 from armtransfer.learning.config import LearnerConfig
 
 RUN_FORMAT = "armtransfer-run/1"
-METHODS = ("none", "pseudo", "first-visit", "potential", "progress", "dense")
+METHODS = tuple(name for name, m in _methods.METHODS.items() if not m.macros)
 """Every method but `mapping`, whose protocol (tasks in order, one mapping carried from task
 to task) is not a grid of independent runs: use `armtransfer rooms --method mapping --mapping PATH`."""
 

@@ -24,6 +24,12 @@ gain at most once per episode, so the shaping paid in an episode is bounded by n
 an endless loop earns only step rewards; ``potential`` and ``dense`` are potential-based
 (gamma*phi(s') - phi(s), phi = 0 at the goal), which leaves the optimal policy unchanged
 (Ng, Harada and Russell 1999). :func:`check_k` therefore accepts every K for them.
+
+That is about the optimal policy. A learner on its way can be held by less: a move that
+leaves its state unchanged (a blocked move, or with wind a push back) and pays, because its Q
+then rises above every other action's and the learner repeats it. :func:`check_self_loops`
+checks every method's shaping, as the kernel pays it, at every such move of the robot (with
+the potentials unbounded, ``dense`` failed it: ``potentials.bounded``).
 """
 
 from __future__ import annotations
@@ -37,6 +43,8 @@ import numpy as np
 from armtransfer.errors import InvalidParameterError
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.learning import methods, rewards
+from armtransfer.learning.sarsa import _shaping as kernel_shaping
+from armtransfer.learning.shaping import Shaping
 from armtransfer.learning.trajectory import Trajectory
 
 SAFETY_FRACTION = 0.9
@@ -275,8 +283,8 @@ def check_k(method: str, robot: DiscreteRobot, start_state: int, goal_cell: int,
     mapping) returns :func:`auto_k`. The others are never farmable (see the module
     docstring) and get their own ``Method.resolve_k``.
     """
-    trajs = rewards.as_list(trajs)
     m = methods.get(method)
+    trajs = rewards.as_list(trajs) if m.uses_trajectory else []
     k = m.resolve_k(K, config.step_reward, trajs)  # the same input checks for every method
     if not m.farmable:
         return k
@@ -290,3 +298,51 @@ def check_k(method: str, robot: DiscreteRobot, start_state: int, goal_cell: int,
             f"the largest safe K is {safe.k:.6g} (old bound -step_reward/n = {old:.6g})"
         )
     return k
+
+
+def self_loops(robot: DiscreteRobot, goal_cell: int, wind: float = 0.0) -> np.ndarray:
+    """The states (not labelled the goal) at which some move leaves the state unchanged: a
+    blocked move, next_state[s, a] == s, or with wind a move the push brings back."""
+    nxt = robot.next_state
+    same = nxt == np.arange(robot.n_states)[:, None]
+    if wind > 0.0:
+        same |= robot.wind_state[nxt] == np.arange(robot.n_states)[:, None]
+    return np.flatnonzero(same.any(axis=1) & (robot.label != goal_cell))
+
+
+def self_loop_shaping(shaping: Shaping, states: np.ndarray, gamma: float) -> np.ndarray:
+    """The shaping term the kernel (``sarsa._shaping``) pays for repeating a self-loop at each of
+    ``states``, after the learner arrived there: a once-per-episode bonus already paid, the best
+    bonus of the episode at least the state's own."""
+    sh = shaping
+    n_ids = int(sh.traj_index.max()) + 1 if len(sh.traj_index) else 1
+    paid = np.zeros(max(n_ids, 1), np.int64)  # episode 0: every cell counts as paid this episode
+    out = np.empty(len(states))
+    for k, s in enumerate(states):
+        s = int(s)
+        out[k], _ = kernel_shaping(sh.mode, s, s, False, sh.bonus, sh.traj_index, sh.phi, float(gamma), paid, 0,
+                                   float(sh.bonus[s]))
+    return out
+
+
+def check_self_loops(method: str, robot: DiscreteRobot, goal_cell: int, shaping: Shaping | None, config,
+                     wind: float = 0.0) -> None:
+    """Raise ``InvalidParameterError`` when ``method``'s shaping pays a learner for a move that
+    leaves its state unchanged: a positive shaping term with which the step costs nothing or
+    earns (step_reward + term >= 0). Every method is checked, as the kernel pays it; a learner
+    whose Q starts at 0 would repeat such a move for ever."""
+    if shaping is None:
+        return
+    states = self_loops(robot, goal_cell, wind)
+    if not len(states):
+        return
+    term = self_loop_shaping(shaping, states, config.gamma)
+    bad = (term > 0.0) & (config.step_reward + term >= 0.0)
+    if bad.any():
+        k = int(np.argmax(np.where(bad, term, -np.inf)))
+        x, y = robot.layout.xy(int(robot.label[states[k]]))
+        raise InvalidParameterError(
+            f"method {method!r} pays a learner for a move that leaves its state unchanged at {int(bad.sum())} "
+            f"states (at cell ({x},{y}): step reward {config.step_reward:g} + shaping {term[k]:.4g} >= 0); "
+            f"bound its potential (potentials.bounded) or lower K"
+        )

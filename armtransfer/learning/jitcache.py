@@ -1,7 +1,7 @@
 """Numba's on-disk cache, kept honest across files.
 
 Numba keys a cached kernel on its own file's time stamp and its own bytecode, not on the jitted
-functions it calls from other files. So after an edit to ``guide.py`` alone, ``sarsa.py``'s
+functions it calls from other files. So after an edit to a guide module alone, ``sarsa.py``'s
 cached trial kernels (which inline the guide's functions) would load, still running the old
 guide, and a run would silently measure code that is no longer there.
 

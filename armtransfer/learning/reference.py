@@ -1,18 +1,23 @@
 """Algorithm 1, line by line, in plain Python with dense traces: the reference the
-compiled learner (``transfer.sarsa``) is tested against. Slow; for tests and benchmarks.
+compiled learner (``learning.sarsa``) is tested against. Slow; for tests and benchmarks.
 
-It draws from the random stream exactly as ``transfer.sarsa`` documents, so with the
-same generator and ``trace_cutoff=0`` the two give bit-identical Q tables.
+It draws from the random stream exactly as ``learning.sarsa`` documents, so with the
+same generator and ``trace_cutoff=0`` the two give bit-identical Q tables. Method ``guided``'s
+model is written out one class per mechanism of ``learning.guide`` (``Displacement``, ``Tip``,
+``Progress``, ``Fill``, ``Planner``), reading the same ``guide.Guide`` record, and
+``GuideModel`` composes them and chooses as ``guide.choice`` does.
 """
 
 from __future__ import annotations
 
 import math
 from collections import deque
+from dataclasses import dataclass
 
 import numpy as np
 
 from armtransfer.learning import guide as guide_module
+from armtransfer.learning.guide import Guide
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.trajectory import Trajectory
@@ -29,52 +34,93 @@ def _egreedy(q_row: np.ndarray, eps: float, rng: np.random.Generator) -> int:
     return ties[int(rng.random() * len(ties))]
 
 
-class GuideModel:
-    """The model of method ``guided`` (``transfer.guide``), written out plainly: what robot 2
-    learns of its own actions, its predictions and its tie-breaking."""
+@dataclass
+class Effect:
+    """What the moves of one pair did to the label: summed displacement and their number."""
 
-    def __init__(self, guide, n_states: int, n_actions: int):
-        self.g = guide
-        self.window, self.reach = guide.params[0], guide.params[1]
-        self.knn, self.memory = int(guide.params[2]), int(guide.params[3])
-        self.episodes = int(guide.params[5])
-        self.sums: dict[tuple[int, int], list[float]] = {}  # (s, a) -> [sum dx, sum dy, count]
+    dx: float = 0.0
+    dy: float = 0.0
+    n: int = 0
+
+
+class Displacement:
+    """``guide.displacement``, written out plainly: what each move did to the label, and its
+    generalisation to untried pairs by the nearest states where the action was tried."""
+
+    def __init__(self, g: Guide, n_actions: int):
+        self.g = g
+        self.sums: dict[tuple[int, int], Effect] = {}
         self.tried_at: list[list[int]] = [[] for _ in range(n_actions)]  # states, in order
         self.generalised: set[tuple[int, int]] = set()  # pairs whose effect is generalised
         self.moved: set[tuple[int, int]] = set()  # pairs seen to move at least once
-        self.n_traj = len(guide.tstart) - 1
-        self.prog = [0] * self.n_traj
-        self.plans = guide.params[8] > 0
-        self.successors: dict[tuple[int, int], list[list[int]]] = {}  # (s, a) -> [[s2, count], ...] first seen first
-        self.preds: dict[int, list[int]] = {}  # s2 -> the states of the pairs it followed, first seen first
-        # the tip model (transfer.guide.tip_learn): ridge least squares, one recursive step per new state
-        self.tip = guide.params[10] > 0
-        n_f = guide.fj.shape[0]
-        ridge = float(guide.params[11])
+
+    def record(self, s: int, a: int, s2: int) -> None:
+        g = self.g
+        effect = self.sums.setdefault((s, a), Effect())
+        if s2 != s:
+            self.moved.add((s, a))
+        if (s2 != s or g.params.blocked) and (s, a) not in self.generalised:  # blocked: only if asked
+            self.generalised.add((s, a))
+            self.tried_at[a].append(s)
+        effect.dx += g.lxy[s2][0] - g.lxy[s][0]
+        effect.dy += g.lxy[s2][1] - g.lxy[s][1]
+        effect.n += 1
+
+    def recent(self, a: int) -> list[int]:
+        """The most recent ``memory`` states a was tried at, in the kernel's ring-buffer slot order."""
+        slots: dict[int, int] = {}
+        for i, u in enumerate(self.tried_at[a]):
+            slots[i % self.g.params.memory] = u
+        return [slots[k] for k in sorted(slots)]
+
+    def nearest(self, s: int, a: int, k: int) -> list[int]:
+        """The k of those states nearest to s in configuration space (ties: the earlier slot)."""
+        recent = self.recent(a)
+        f = self.g.feat
+
+        def dist(u: int) -> float:
+            d = 0.0
+            for c in range(f.shape[1]):
+                d += (f[u, c] - f[s, c]) * (f[u, c] - f[s, c])
+            return d
+
+        order = sorted(range(len(recent)), key=lambda i: (dist(recent[i]), i))
+        return [recent[i] for i in order[: min(k, len(recent))]]
+
+    def near_blocked(self, s: int, a: int) -> bool:
+        near = self.nearest(s, a, self.g.params.tip_nearest)
+        return bool(near) and all((u, a) not in self.moved for u in near)
+
+    def predict(self, s: int, a: int):
+        if (s, a) in self.sums:
+            e = self.sums[(s, a)]
+            return e.dx / e.n, e.dy / e.n
+        near = self.nearest(s, a, self.g.params.knn)
+        if not near:
+            return None
+        sx = sy = 0.0
+        for u in near:
+            e = self.sums[(u, a)]
+            sx += e.dx / e.n
+            sy += e.dy / e.n
+        return sx / len(near), sy / len(near)
+
+
+class Tip:
+    """``guide.tip``, written out plainly: ridge least squares of the label on the joints'
+    features, one recursive step per new state."""
+
+    def __init__(self, g: Guide, n_actions: int):
+        self.g = g
+        n_f = g.fj.shape[0]
+        ridge = float(g.params.tip_ridge)
         self.P = [[(1.0 if i == j else 0.0) / ridge for j in range(n_f)] for i in range(n_f)]
         self.W = [[0.0, 0.0] for _ in range(n_f)]
         self.first: tuple[float, float] | None = None  # the first label the tip model learned from
-        self.tip_seen: set[int] = set()
-        n_j = guide.tq.shape[1] if n_f else 0
+        self.seen: set[int] = set()
+        n_j = g.tq.shape[1] if n_f else 0
         self.dq = [[0.0] * n_j for _ in range(n_actions)]  # summed joint displacement of each action's moves
         self.dqn = [0] * n_actions
-        # the fill (transfer.guide: learning real-time search): h per state, valid in one epoch
-        self.fill = float(guide.params[14])
-        self.h: dict[int, float] = {}
-        self.h_epoch: dict[int, int] = {}
-        self.epoch = 0  # +1 at an episode's start and whenever a trajectory's progress moves
-        self.last: dict[tuple[int, int], int] = {}  # (s, a) -> the state observed after it last
-
-    def cells(self, t: int) -> range:
-        return range(int(self.g.tstart[t]), int(self.g.tstart[t + 1]))
-
-    def start_episode(self, s: int, guided: bool) -> None:
-        self.prog = [int(self.g.tstart[t]) for t in range(self.n_traj)]
-        self.wait = [0] * self.n_traj
-        self.epoch += 1
-        if guided and self.tip:
-            self.tip_learn(s)
-        self.reached(s)
 
     def features(self, q) -> list[float]:
         g = self.g
@@ -89,11 +135,11 @@ class GuideModel:
             out.append(v)
         return out
 
-    def tip_learn(self, s: int) -> None:
+    def learn(self, s: int) -> None:
         """One recursive least-squares step towards s's label (relative to the first one)."""
-        if s in self.tip_seen:
+        if s in self.seen:
             return
-        self.tip_seen.add(s)
+        self.seen.add(s)
         lx, ly = float(self.g.lxy[s][0]), float(self.g.lxy[s][1])
         if self.first is None:
             self.first = (lx, ly)
@@ -120,47 +166,51 @@ class GuideModel:
             for j in range(n):
                 self.P[i][j] -= k * px[j]
 
-    def tip_at(self, f: list[float]) -> tuple[float, float]:
+    def observe(self, s: int, a: int, s2: int) -> None:
+        g = self.g
+        if s2 != s:
+            for c in range(g.tq.shape[1]):
+                self.dq[a][c] += g.tq[s2, c] - g.tq[s, c]
+            self.dqn[a] += 1
+        self.learn(s2)
+
+    def at(self, f: list[float]) -> tuple[float, float]:
         x = y = 0.0
         for i in range(len(f)):
             x += f[i] * self.W[i][0]
             y += f[i] * self.W[i][1]
         return x, y
 
-    def tip_move(self, s: int, a: int, x0: float, y0: float) -> tuple[float, float]:
+    def move(self, s: int, a: int, x0: float, y0: float) -> tuple[float, float]:
         if self.dqn[a] == 0:
             return 0.0, 0.0
         q = [float(self.g.tq[s, c]) + self.dq[a][c] / self.dqn[a] for c in range(self.g.tq.shape[1])]
-        x1, y1 = self.tip_at(self.features(q))
+        x1, y1 = self.at(self.features(q))
         return x1 - x0, y1 - y0
 
-    def recent(self, a: int) -> list[int]:
-        """The most recent ``memory`` states a was tried at, in the kernel's ring-buffer slot order."""
-        slots: dict[int, int] = {}
-        for i, u in enumerate(self.tried_at[a]):
-            slots[i % self.memory] = u
-        return [slots[k] for k in sorted(slots)]
 
-    def nearest(self, s: int, a: int, k: int) -> list[int]:
-        """The k of those states nearest to s in configuration space (ties: the earlier slot)."""
-        recent = self.recent(a)
-        f = self.g.feat
+class Progress:
+    """``guide.progress``, written out plainly: how far along each trajectory robot 2 has come,
+    giving up on a cell (or, at its last one, the trajectory) after ``give_up`` moves."""
 
-        def dist(u: int) -> float:
-            d = 0.0
-            for c in range(f.shape[1]):
-                d += (f[u, c] - f[s, c]) * (f[u, c] - f[s, c])
-            return d
+    def __init__(self, g: Guide):
+        self.g = g
+        self.n_traj = len(g.tstart) - 1
+        self.prog = [0] * self.n_traj
+        self.wait = [0] * self.n_traj
+        self.epoch = 0  # +1 at an episode's start and whenever a trajectory's progress moves
 
-        order = sorted(range(len(recent)), key=lambda i: (dist(recent[i]), i))
-        return [recent[i] for i in order[: min(k, len(recent))]]
+    def cells(self, t: int) -> range:
+        return range(int(self.g.tstart[t]), int(self.g.tstart[t + 1]))
 
-    def near_blocked(self, s: int, a: int) -> bool:
-        near = self.nearest(s, a, int(self.g.params[12]))
-        return bool(near) and all((u, a) not in self.moved for u in near)
+    def reset(self) -> None:
+        self.prog = [int(self.g.tstart[t]) for t in range(self.n_traj)]
+        self.wait = [0] * self.n_traj
+        self.epoch += 1
 
-    def reached(self, s: int) -> None:
+    def update(self, s: int) -> None:
         g = self.g
+        window, reach, give_up = g.params.window, g.params.reach, g.params.give_up
         x, y = g.lxy[s]
         for t in range(self.n_traj):
             i0 = self.prog[t]
@@ -169,16 +219,16 @@ class GuideModel:
             for j in self.cells(t):
                 if j <= i0:
                     continue
-                if g.trem[i0] - g.trem[j] > self.window + self.reach:
+                if g.trem[i0] - g.trem[j] > window + reach:
                     break
-                if np.sqrt((g.tx[j] - x) * (g.tx[j] - x) + (g.ty[j] - y) * (g.ty[j] - y)) <= self.reach:
+                if np.sqrt((g.tx[j] - x) * (g.tx[j] - x) + (g.ty[j] - y) * (g.ty[j] - y)) <= reach:
                     self.prog[t] = j
             if self.prog[t] != i0:
                 self.wait[t] = 0
                 self.epoch += 1
             else:
                 self.wait[t] += 1
-                if g.params[7] > 0 and self.wait[t] >= g.params[7]:  # past the last cell: the trajectory
+                if give_up > 0 and self.wait[t] >= give_up:  # past the last cell: the trajectory
                     self.prog[t] += 1
                     self.wait[t] = 0
                     self.epoch += 1
@@ -187,43 +237,71 @@ class GuideModel:
         """Every trajectory given up on, its goal s_tg included: Algorithm 1 chooses alone."""
         return all(self.prog[t] > self.cells(t)[-1] for t in range(self.n_traj))
 
-    def observe(self, s: int, a: int, s2: int, guided: bool) -> None:
+    def score(self, x: float, y: float) -> float:
         g = self.g
-        entry = self.sums.get((s, a))
-        if entry is None:
-            entry = self.sums[(s, a)] = [0.0, 0.0, 0]
-        if s2 != s:
-            self.moved.add((s, a))
-        if self.fill > 0:
-            self.last[(s, a)] = s2
-        if guided and self.tip:
-            if s2 != s:
-                for c in range(g.tq.shape[1]):
-                    self.dq[a][c] += g.tq[s2, c] - g.tq[s, c]
-                self.dqn[a] += 1
-            self.tip_learn(s2)
-        if (s2 != s or g.params[6] > 0) and (s, a) not in self.generalised:  # blocked: only if asked
-            self.generalised.add((s, a))
-            self.tried_at[a].append(s)
-        entry[0] += g.lxy[s2][0] - g.lxy[s][0]
-        entry[1] += g.lxy[s2][1] - g.lxy[s][1]
-        entry[2] += 1
-        if self.plans:
-            seen = self.successors.setdefault((s, a), [])
-            for item in seen:
-                if item[0] == s2:
-                    item[1] += 1
+        best = np.inf
+        for t in range(self.n_traj):
+            i0 = self.prog[t]
+            for j in self.cells(t):
+                if j < i0:
+                    continue
+                if g.trem[i0] - g.trem[j] > g.params.window:
                     break
-            else:
-                if len(seen) >= guide_module.SUCCESSORS:
-                    raise ValueError("more distinct successors of one move than the planner keeps")
-                seen.append([s2, 1])
-                self.preds.setdefault(s2, []).append(s)
+                v = np.sqrt((g.tx[j] - x) * (g.tx[j] - x) + (g.ty[j] - y) * (g.ty[j] - y)) + g.trem[j]
+                best = min(best, v)
+        return best
+
+
+class Fill:
+    """``guide.fill``, written out plainly: learning real-time search, h per state, valid in the
+    progress epoch it was set in."""
+
+    def __init__(self, g: Guide):
+        self.cost = float(g.params.fill)
+        self.h: dict[int, float] = {}
+        self.h_epoch: dict[int, int] = {}
+        self.last: dict[tuple[int, int], int] = {}  # (s, a) -> the state observed after it last
+
+    def observe(self, s: int, a: int, s2: int) -> None:
+        self.last[(s, a)] = s2
+
+    def visit(self, epoch: int, s: int) -> None:
+        if self.h_epoch.get(s) != epoch:
+            self.h_epoch[s] = epoch
+            self.h[s] = 0.0
+
+    def ahead(self, epoch: int, s: int, a: int) -> float | None:
+        u = self.last[(s, a)]
+        return self.h[u] if self.h_epoch.get(u) == epoch else None
+
+    def raise_at(self, s: int, low: float, here: float) -> None:
+        """Raise h(s) to the best neighbour's score + the fill - the score at s."""
+        raise_to = low + self.cost - here
+        if raise_to > self.h[s]:
+            self.h[s] = raise_to
+
+
+class Planner:
+    """``guide.planner``, written out plainly: value iteration over the tried pairs on their
+    observed successors, with a queue of states."""
+
+    def __init__(self, g: Guide):
+        self.g = g
+        self.successors: dict[tuple[int, int], dict[int, int]] = {}  # (s, a) -> {s2: count}, first seen first
+        self.preds: dict[int, list[int]] = {}  # s2 -> the states of the pairs it followed, first seen first
+
+    def observe(self, s: int, a: int, s2: int) -> None:
+        seen = self.successors.setdefault((s, a), {})
+        if s2 in seen:
+            seen[s2] += 1
+            return
+        if len(seen) >= guide_module.SUCCESSORS:
+            raise ValueError("more distinct successors of one move than the planner keeps")
+        seen[s2] = 1
+        self.preds.setdefault(s2, []).append(s)
 
     def plan(self, Q: np.ndarray, label: np.ndarray, goal: int, config: LearnerConfig) -> None:
-        """Value iteration over the tried pairs on their observed successors, with a queue of
-        states (``transfer.guide.plan``, written out plainly)."""
-        tol = self.g.params[9]
+        tol = self.g.params.plan_tol
         n_states, n_actions = Q.shape
         for x in range(n_states):
             for a in range(n_actions):
@@ -240,9 +318,9 @@ class GuideModel:
                 seen = self.successors.get((x, a))
                 if seen is None:
                     continue
-                n = sum(c for _, c in seen)
+                n = sum(seen.values())
                 total = 0.0
-                for y, c in seen:
+                for y, c in seen.items():
                     w = c / n
                     if label[y] == goal:
                         total += w * (config.step_reward + config.goal_reward)
@@ -258,86 +336,96 @@ class GuideModel:
                         queue.append(p)
                         queued.add(p)
 
-    def predict(self, s: int, a: int):
-        if (s, a) in self.sums:
-            sx, sy, n = self.sums[(s, a)]
-            return sx / n, sy / n
-        near = self.nearest(s, a, self.knn)
-        if not near:
-            return None
-        sx = sy = 0.0
-        for u in near:
-            ex, ey, n = self.sums[(u, a)]
-            sx += ex / n
-            sy += ey / n
-        return sx / len(near), sy / len(near)
 
-    def score(self, x: float, y: float) -> float:
-        g = self.g
-        best = np.inf
-        for t in range(self.n_traj):
-            i0 = self.prog[t]
-            for j in self.cells(t):
-                if j < i0:
-                    continue
-                if g.trem[i0] - g.trem[j] > self.window:
-                    break
-                v = np.sqrt((g.tx[j] - x) * (g.tx[j] - x) + (g.ty[j] - y) * (g.ty[j] - y)) + g.trem[j]
-                best = min(best, v)
-        return best
+class GuideModel:
+    """The model of method ``guided`` (``guide.model``), one object per mechanism as in the
+    kernel, and its choice (``guide.choice``), written out plainly."""
+
+    def __init__(self, guide: Guide, n_states: int, n_actions: int):
+        self.g = guide
+        self.episodes = guide.params.episodes
+        self.plans = guide.params.plan
+        self.tip = guide.params.tip
+        self.displacement = Displacement(guide, n_actions)
+        self.progress = Progress(guide)
+        self.tip_model = Tip(guide, n_actions)
+        self.fill = Fill(guide)
+        self.planner = Planner(guide)
+
+    def start_episode(self, s: int, guided: bool) -> None:
+        self.progress.reset()
+        if guided and self.tip:
+            self.tip_model.learn(s)
+        self.progress.update(s)
+
+    def observe(self, s: int, a: int, s2: int, guided: bool) -> None:
+        if self.fill.cost > 0:
+            self.fill.observe(s, a, s2)
+        if guided and self.tip:
+            self.tip_model.observe(s, a, s2)
+        self.displacement.record(s, a, s2)
+        if self.plans:
+            self.planner.observe(s, a, s2)
+        self.progress.update(s2)
+
+    def exhausted(self) -> bool:
+        return self.progress.exhausted()
+
+    def plan(self, Q: np.ndarray, label: np.ndarray, goal: int, config: LearnerConfig) -> None:
+        self.planner.plan(Q, label, goal, config)
 
     def egreedy(self, q_row: np.ndarray, s: int, eps: float, rng: np.random.Generator) -> int:
         n_actions = len(q_row)
         if rng.random() < eps:
             return int(rng.random() * n_actions)
-        x, y = self.g.lxy[s]
-        w = self.g.params[4]
+        g, d, tip, progress, fill = self.g, self.displacement, self.tip_model, self.progress, self.fill
+        x, y = g.lxy[s]
+        w = g.params.weight
         x0 = y0 = 0.0
         if self.tip:
-            x0, y0 = self.tip_at(self.features(self.g.tq[s]))
-            if self.g.params[13] > 0:  # anchored: the tip model's estimate, kept inside the cell
-                lx, ly = self.g.lxy[s]
-                x = min(max(self.first[0] + x0, lx - 0.5), lx + 0.5)
-                y = min(max(self.first[1] + y0, ly - 0.5), ly + 0.5)
-        fill = self.fill > 0
-        here = self.score(x, y) if self.tip or fill else 0.0  # the score where the tip is now
-        if fill and self.h_epoch.get(s) != self.epoch:
-            self.h_epoch[s] = self.epoch
-            self.h[s] = 0.0
+            x0, y0 = tip.at(tip.features(g.tq[s]))
+            if g.params.tip_anchor:  # anchored: the tip model's estimate, kept inside the cell
+                lx, ly = g.lxy[s]
+                x = min(max(tip.first[0] + x0, lx - 0.5), lx + 0.5)
+                y = min(max(tip.first[1] + y0, ly - 0.5), ly + 0.5)
+        filling = fill.cost > 0
+        epoch = progress.epoch
+        here = progress.score(x, y) if self.tip or filling else 0.0  # the score where the tip is now
+        if filling:
+            fill.visit(epoch, s)
         val = []
         heads = []  # each action's predicted score (plus h of its known successor), None when unknown
         for a in range(n_actions):
             ha = None
-            if (s, a) in self.sums and (s, a) not in self.moved:
+            if (s, a) in d.sums and (s, a) not in d.moved:
                 v = -np.inf  # blocked at every try here
-            elif self.tip and (s, a) not in self.sums:  # the tip model predicts a pair not tried here
-                if not self.tried_at[a]:
+            elif self.tip and (s, a) not in d.sums:  # the tip model predicts a pair not tried here
+                if not d.tried_at[a]:
                     v = np.inf
-                elif self.near_blocked(s, a):
-                    ha = here + self.h[s] if fill else here
+                elif d.near_blocked(s, a):
+                    ha = here + fill.h[s] if filling else here
                     v = q_row[a] - w * ha
                 else:
-                    dx, dy = self.tip_move(s, a, x0, y0)
-                    ha = self.score(x + dx, y + dy)
+                    dx, dy = tip.move(s, a, x0, y0)
+                    ha = progress.score(x + dx, y + dy)
                     v = q_row[a] - w * ha
             else:
-                p = self.predict(s, a)
+                p = d.predict(s, a)
                 if p is None:
                     v = np.inf
                 else:
-                    ha = self.score(x + p[0], y + p[1])
-                    if fill and (s, a) in self.sums:
-                        u = self.last[(s, a)]
-                        if self.h_epoch.get(u) == self.epoch:
-                            ha += self.h[u]
+                    dx, dy = p
+                    ha = progress.score(x + dx, y + dy)
+                    if filling and (s, a) in d.sums:
+                        hu = fill.ahead(epoch, s, a)
+                        if hu is not None:
+                            ha += hu
                     v = q_row[a] - w * ha
             val.append(v)
             heads.append(ha)
         known = [ha for ha in heads if ha is not None]
-        if fill and known:  # learning real-time search: raise h(s) to the best neighbour's + the fill
-            raise_to = min(known) + self.fill - here
-            if raise_to > self.h[s]:
-                self.h[s] = raise_to
+        if filling and known:  # learning real-time search: raise h(s) to the best neighbour's + the fill
+            fill.raise_at(s, min(known), here)
         best = max(val)
         keep = [a for a in range(n_actions) if val[a] == best]
         if len(keep) == 1:
@@ -372,13 +460,13 @@ def learn(
 ) -> tuple[np.ndarray, list[int]]:
     """Run ``episodes`` episodes; returns (Q, steps per episode).
 
-    ``macros`` (a ``transfer.mapping.MacroTable``): at a state with a macro, when none is
+    ``macros`` (a ``learning.mapping.MacroTable``): at a state with a macro, when none is
     running, one draw u and the macro's target sequence runs when u < 1 - epsilon; its
     steps are ordinary steps; it is abandoned when a step is blocked (the robot did not move,
     observed after wind), and then the next
     action is epsilon-greedy without a macro draw.
 
-    ``guide`` (a ``transfer.guide.Guide``, method ``guided``): its model breaks the ties of
+    ``guide`` (a ``learning.guide.Guide``, method ``guided``): its model breaks the ties of
     epsilon-greedy (:class:`GuideModel`). ``trace``, when given, gets every state visited.
     """
     model = None if guide is None else GuideModel(guide, robot.n_states, robot.n_actions)
@@ -423,7 +511,6 @@ def learn(
             steps += 1
             if model is not None:
                 model.observe(s, a, s2, episode < model.episodes)
-                model.reached(s2)
             if trace is not None:
                 trace.append(s2)
             terminal = robot.label[s2] == goal_cell

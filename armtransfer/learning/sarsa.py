@@ -11,21 +11,21 @@ Faithful to Algorithm 1:
   * delta = r + r'(s') + gamma Q(s', a') - Q(s, a), with Q(terminal, .) = 0;
     e(s, a) += 1 (accumulating); then for every (s, a): Q += alpha delta e; e *= gamma lambda.
   * The shaping term r' is the paper's pseudo reward i*K on reaching the i-th trajectory
-    state (``pseudo``), or one of the other methods in :mod:`transfer.rewards`.
+    state (``pseudo``), or one of the other methods in :mod:`armtransfer.learning.methods`.
 
 Method ``guided`` adds one step after every episode: value iteration over the pairs robot 2
-has tried, on the successors it observed (``transfer.guide.plan``); it draws nothing.
+has tried, on the successors it observed (``guide.planner``); it draws nothing.
 
 The first episode's path, its loops erased, is kept as ``TrialResult.first_path`` for the
 online action sequence mapping (``experiment.online_mapping``); it draws nothing.
 
 Sparse traces: only pairs with a non-zero trace are stored. A trace that decays below
 ``trace_cutoff`` is dropped; with ``trace_cutoff=0`` nothing is dropped until it underflows
-to 0, and the result is bit-for-bit the dense Algorithm 1 (``transfer.reference``), as a
+to 0, and the result is bit-for-bit the dense Algorithm 1 (``learning.reference``), as a
 test checks.
 
 The random stream, in the order it is drawn (the dense reference draws the same):
-  1. choosing an action at a state with a macro (``transfer.mapping``), when no macro is
+  1. choosing an action at a state with a macro (``learning.mapping``), when no macro is
      running: one draw u, the macro runs when u < 1 - epsilon. A running macro supplies
      its next action without a draw; it ends after its last action, or is abandoned when
      a step is blocked: the robot did not move, s' == s observed after wind (the robot
@@ -36,7 +36,7 @@ The random stream, in the order it is drawn (the dense reference draws the same)
   2. epsilon-greedy: one draw u; if u < epsilon one more draw picks the action as
      floor(u2 * n_actions); otherwise, when k > 1 actions tie for the largest Q, one more
      draw picks the floor(u2 * k)-th of them in index order;
-     With a guide (method ``guided``, ``transfer.guide``), in its exploration phase, the
+     With a guide (method ``guided``, ``learning.guide``), in its exploration phase, the
      largest value is that of Q(s, a) - weight * score(a) instead of Q, and the extra draw
      is made only when m > 1 actions tie for it, picking the floor(u2 * m)-th of them in
      index order (no other draw is added);
@@ -46,6 +46,7 @@ The random stream, in the order it is drawn (the dense reference draws the same)
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -55,6 +56,10 @@ from armtransfer.learning.config import LearnerConfig
 
 from armtransfer.learning import guide as _guide
 from armtransfer.learning import jitcache as _jitcache
+from armtransfer.learning.guide import choice as _choice
+from armtransfer.learning.guide import model as _model
+from armtransfer.learning.guide import planner as _planner
+from armtransfer.learning.guide import progress as _progress
 from armtransfer.learning.shaping import (  # noqa: E402  (the kernel's shaping modes)
     MODE_FIRST_VISIT,
     MODE_NONE,
@@ -63,6 +68,85 @@ from armtransfer.learning.shaping import (  # noqa: E402  (the kernel's shaping 
     MODE_PSEUDO,
     Shaping,
 )
+
+
+class World(NamedTuple):
+    """The robot's tables and the task, as the kernel reads them."""
+
+    next_state: np.ndarray
+    """int64 [S, A]: the state after each action."""
+    wind_state: np.ndarray
+    """int64 [S]: where a gust pushes each state."""
+    label: np.ndarray
+    """int64 [S]: the cell each state is labelled with."""
+    start: int
+    goal: int
+    """The goal cell (a label)."""
+    wind: float
+    """The probability of a gust after a move."""
+
+
+class Rewards(NamedTuple):
+    """The shaping term's arrays (``shaping.Shaping``, without its guide)."""
+
+    mode: int
+    bonus: np.ndarray
+    traj_index: np.ndarray
+    phi: np.ndarray
+
+
+class Macros(NamedTuple):
+    """The mapped macros, flat (``mapping.MacroTable.arrays``): a state's macro is
+    actions[start[s]:start[s] + length[s]]; offered in the first ``episodes`` episodes."""
+
+    start: np.ndarray
+    length: np.ndarray
+    actions: np.ndarray
+    episodes: int
+
+
+class Learning(NamedTuple):
+    """The learner's parameters (``config.LearnerConfig``), as the kernel reads them."""
+
+    alpha: float
+    gamma: float
+    lam: float
+    epsilon: float
+    step_reward: float
+    goal_reward: float
+    trace_cutoff: float
+    max_episodes: int
+    max_total_steps: int
+    max_episode_steps: int
+    patience: int
+
+    @staticmethod
+    def of(config: LearnerConfig) -> "Learning":
+        return Learning(float(config.alpha), float(config.gamma), float(config.lam), float(config.epsilon),
+                        float(config.step_reward), float(config.goal_reward), float(config.trace_cutoff),
+                        int(config.max_episodes), int(config.max_total_steps), int(config.max_episode_steps),
+                        int(config.patience))
+
+
+class Outputs(NamedTuple):
+    """What the kernel writes: Q, per-episode counts, and the paths it found."""
+
+    Q: np.ndarray
+    """float64 [S, A], learned in place (it may start from a given Q)."""
+    episode_steps: np.ndarray
+    """int64 [max_episodes]: steps per episode, negative when it hit a cap."""
+    greedy_len: np.ndarray
+    """int64 [max_episodes]: the greedy path's length after each episode (-1: misses the goal)."""
+    macro_steps: np.ndarray
+    """int64 [max_episodes]: steps taken inside macros per episode."""
+    path_buf: np.ndarray
+    """int64 [S + 1]: scratch, the greedy path after an episode."""
+    prev_path: np.ndarray
+    """int64 [S + 1]: the last greedy path that changed (the converged one at the end)."""
+    fp_states: np.ndarray
+    """int64 [S + 1]: the first episode's path, its loops erased."""
+    fp_actions: np.ndarray
+    """int64 [S + 1]: the action taken at each of its states."""
 
 
 @numba.njit(cache=True, inline="always")
@@ -92,40 +176,37 @@ def _egreedy(Q, s, n_actions, eps, rng):
 
 
 @numba.njit(cache=True, inline="always")
-def _macro_step(s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start, macro_len, macro_actions):
+def _macro_step(s, eps, rng, in_macro, m_pos, m_end, may_start, macros):
     """(True, the running macro's next step, in_macro, m_pos, m_end); else a new macro starting
     at s (one draw, runs when < 1 - epsilon); else (False, -1, ...). m_pos/m_end index the flat
     macro actions."""
     if in_macro:
-        return True, macro_actions[m_pos], True, m_pos + 1, m_end
-    if may_start and macro_len[s] > 0 and rng.random() < 1.0 - eps:
-        m_pos = macro_start[s]
-        return True, macro_actions[m_pos], True, m_pos + 1, m_pos + macro_len[s]
+        return True, macros.actions[m_pos], True, m_pos + 1, m_end
+    if may_start and macros.length[s] > 0 and rng.random() < 1.0 - eps:
+        m_pos = macros.start[s]
+        return True, macros.actions[m_pos], True, m_pos + 1, m_pos + macros.length[s]
     return False, -1, False, m_pos, m_end
 
 
 @numba.njit(cache=True, inline="always")
-def _choose(Q, s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start, macro_len, macro_actions):
+def _choose(Q, s, eps, rng, in_macro, m_pos, m_end, may_start, macros):
     """The next action at s: a macro's step (``_macro_step``), else epsilon-greedy. Returns
     (action, in_macro, m_pos, m_end, 1 for a macro step else 0)."""
-    found, a, in_macro, m_pos, m_end = _macro_step(s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start,
-                                                   macro_len, macro_actions)
+    found, a, in_macro, m_pos, m_end = _macro_step(s, eps, rng, in_macro, m_pos, m_end, may_start, macros)
     if found:
         return a, in_macro, m_pos, m_end, 1
     return _egreedy(Q, s, Q.shape[1], eps, rng), False, m_pos, m_end, 0
 
 
 @numba.njit(cache=True, inline="always")
-def _choose_guided(Q, s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start, macro_len, macro_actions,
-                   guided, g, gm):
-    """``_choose`` with the guide's epsilon-greedy (``transfer.guide.egreedy``) in its
+def _choose_guided(Q, s, eps, rng, in_macro, m_pos, m_end, may_start, macros, guided, g, m):
+    """``_choose`` with the guide's epsilon-greedy (``guide.choice.egreedy``) in its
     exploration phase (``guided``)."""
-    found, a, in_macro, m_pos, m_end = _macro_step(s, eps, rng, in_macro, m_pos, m_end, may_start, macro_start,
-                                                   macro_len, macro_actions)
+    found, a, in_macro, m_pos, m_end = _macro_step(s, eps, rng, in_macro, m_pos, m_end, may_start, macros)
     if found:
         return a, in_macro, m_pos, m_end, 1
-    if guided and not _guide.exhausted(g, gm):  # every trajectory given up on: Algorithm 1's own
-        return _guide.egreedy(Q, s, eps, rng, g, gm), False, m_pos, m_end, 0
+    if guided and not _progress.exhausted(g, m.progress):  # every trajectory given up on: Algorithm 1's own
+        return _choice.egreedy(Q, s, eps, rng, g, m), False, m_pos, m_end, 0
     return _egreedy(Q, s, Q.shape[1], eps, rng), False, m_pos, m_end, 0
 
 
@@ -179,52 +260,31 @@ def _shaping(mode, s, s2, terminal, bonus, traj_index, phi, gamma, paid_stamp, e
 def _make_run_trial(with_guide: bool):
     """The trial kernel, compiled with or without the guide (``with_guide``, a constant to numba).
 
-    Why two: handed the guide's 21 arrays, even empty and unused, the plain methods ran about
+    Why two: handed the guide's records, even empty and unused, the plain methods ran about
     a third slower (``benchmarks/bench_kernels.py``, BENCHMARKS.md). Compiled without the guide,
-    every guide branch (``if with_guide``) is dropped before typing and ``g``/``gm`` are
+    every guide branch (``if with_guide``) is dropped before typing and ``g``/``m`` are
     None. Both come from this one body, so they cannot drift apart; numba caches each (the
-    constant is part of its cache key)."""
+    constant is part of its cache key).
+
+    Arguments: ``world`` (:class:`World`), ``rewards`` (:class:`Rewards`), ``macros``
+    (:class:`Macros`), ``learning`` (:class:`Learning`), the generator ``rng``, the guide ``g``
+    and what robot 2 learns, ``m`` (``guide.Guide``, ``guide.Model``; None without the guide),
+    and ``out`` (:class:`Outputs`). Returns (episodes, the converged episode or -1, the length
+    of ``out.prev_path``, the length of ``out.fp_states``)."""
 
     @numba.njit(cache=True, nogil=True)  # nogil: trials run on threads (experiment.trial_threads)
-    def _run_trial(
-        next_state,
-        wind_state,
-        label,
-        start,
-        goal,
-        mode,
-        bonus,
-        traj_index,
-        phi,
-        macro_start,
-        macro_len,
-        macro_actions,
-        macro_episodes,
-        alpha,
-        gamma,
-        lam,
-        eps,
-        r_step,
-        r_goal,
-        wind_p,
-        cutoff,
-        max_episodes,
-        max_total_steps,
-        max_episode_steps,
-        patience,
-        rng,
-        g,
-        gm,
-        Q,
-        episode_steps,
-        greedy_len,
-        macro_steps_out,
-        path_buf,
-        prev_path,
-        fp_states,
-        fp_actions,
-    ):
+    def _run_trial(world, rewards, macros, learning, rng, g, m, out):
+        next_state, wind_state, label = world.next_state, world.wind_state, world.label
+        start, goal, wind_p = world.start, world.goal, world.wind
+        mode, bonus, traj_index, phi = rewards.mode, rewards.bonus, rewards.traj_index, rewards.phi
+        alpha, gamma, eps = learning.alpha, learning.gamma, learning.epsilon
+        r_step, r_goal, cutoff = learning.step_reward, learning.goal_reward, learning.trace_cutoff
+        max_total_steps, max_episode_steps = learning.max_total_steps, learning.max_episode_steps
+        patience = learning.patience
+        Q, episode_steps, greedy_len, macro_steps_out = out.Q, out.episode_steps, out.greedy_len, out.macro_steps
+        path_buf, prev_path, fp_states, fp_actions = out.path_buf, out.prev_path, out.fp_states, out.fp_actions
         n_states, n_actions = next_state.shape
+        q_flat = Q.reshape(n_states * n_actions)  # a view: the trace loop indexes pairs s * n_actions + a
         # the first episode's path with its loops erased (for the online action sequence mapping):
         # fp_states[0..fp_n-1], fp_actions[i] taken at fp_states[i]; fp_pos: a state's place in it
         fp_pos = np.full(n_states, -1, np.int64)
@@ -238,25 +298,25 @@ def _make_run_trial(with_guide: bool):
         tr_e = np.empty(cap, np.float64)
         pos = np.full(cap, -1, np.int64)
         n_tr = 0
-        decay = gamma * lam
+        decay = gamma * learning.lam
         total = 0
         prev_n = 0
         stable = 0
         converged_episode = -1
         episodes = 0
-        has_macros = macro_actions.shape[0] > 0
+        has_macros = macros.actions.shape[0] > 0
         # Every use of the guide sits under ``if with_guide``, a constant: compiled without the
-        # guide, numba drops those branches before typing, and g and gm may be None.
+        # guide, numba drops those branches before typing, and g and m may be None.
         has_guide = False
         guide_episodes = 0
         plan = False
         if with_guide:
-            has_guide = g[5].shape[0] > 1  # the guide has at least one trajectory (transfer.guide)
-            guide_episodes = int(g[6][5])
-            plan = g[6][8] > 0.0
-        for ep in range(max_episodes):
+            has_guide = g.tstart.shape[0] > 1  # the guide has at least one trajectory
+            guide_episodes = g.params.episodes
+            plan = g.params.plan
+        for ep in range(learning.max_episodes):
             guided = has_guide and ep < guide_episodes  # the model chooses in the exploration phase
-            use_macros = has_macros and ep < macro_episodes
+            use_macros = has_macros and ep < macros.episodes
             # reset traces
             for k in range(n_tr):
                 pos[tr_sa[k]] = -1
@@ -264,16 +324,14 @@ def _make_run_trial(with_guide: bool):
             s = start
             best = 0.0
             if with_guide and has_guide:
-                _guide.reset_progress(g, gm, s, guided)
+                _model.start_episode(g, m, s, guided)
             # choose the first action (m_pos: position in the running macro, m_end: its end)
             if with_guide:
                 a, in_macro, m_pos, m_end, macro_used = _choose_guided(
-                    Q, s, eps, rng, False, 0, 0, use_macros, macro_start, macro_len, macro_actions, guided, g, gm
+                    Q, s, eps, rng, False, 0, 0, use_macros, macros, guided, g, m
                 )
             else:
-                a, in_macro, m_pos, m_end, macro_used = _choose(
-                    Q, s, eps, rng, False, 0, 0, use_macros, macro_start, macro_len, macro_actions
-                )
+                a, in_macro, m_pos, m_end, macro_used = _choose(Q, s, eps, rng, False, 0, 0, use_macros, macros)
             if ep == 0:
                 fp_states[0] = s
                 fp_pos[s] = 0
@@ -301,8 +359,7 @@ def _make_run_trial(with_guide: bool):
                         fp_pos[s2] = fp_n
                         fp_n += 1
                 if with_guide and has_guide:  # robot 2 records what its move did to the label it perceives
-                    _guide.observe(g, gm, s, a, s2, guided)
-                    _guide.update_progress(g, gm, s2)
+                    _model.observe(g, m, s, a, s2, guided)
                 terminal = label[s2] == goal
                 r = r_step
                 if terminal:
@@ -323,13 +380,12 @@ def _make_run_trial(with_guide: bool):
                     # right after an abandoned macro, Algorithm 1 chooses (no immediate retry)
                     if with_guide:
                         a2, in_macro, m_pos, m_end, used = _choose_guided(
-                            Q, s2, eps, rng, in_macro, m_pos, m_end, use_macros and not abandoned,
-                            macro_start, macro_len, macro_actions, guided, g, gm,
+                            Q, s2, eps, rng, in_macro, m_pos, m_end, use_macros and not abandoned, macros,
+                            guided, g, m,
                         )
                     else:
                         a2, in_macro, m_pos, m_end, used = _choose(
-                            Q, s2, eps, rng, in_macro, m_pos, m_end, use_macros and not abandoned,
-                            macro_start, macro_len, macro_actions,
+                            Q, s2, eps, rng, in_macro, m_pos, m_end, use_macros and not abandoned, macros,
                         )
                     macro_used += used
                     q_next = Q[s2, a2]
@@ -347,7 +403,7 @@ def _make_run_trial(with_guide: bool):
                 while k < n_tr:
                     pair = tr_sa[k]
                     e = tr_e[k]
-                    Q[pair // n_actions, pair % n_actions] += alpha * delta * e
+                    q_flat[pair] += alpha * delta * e
                     e *= decay
                     if e < cutoff or e == 0.0:
                         # drop: move the last trace into this slot
@@ -366,8 +422,8 @@ def _make_run_trial(with_guide: bool):
                 s = s2
                 a = a2
             total += steps
-            if with_guide and has_guide and plan:  # robot 2 plans over the moves it has tried (transfer.guide.plan)
-                _guide.plan(g, gm, Q, label, goal, gamma, r_step, r_goal)
+            if with_guide and has_guide and plan:  # robot 2 plans over the moves it has tried (guide.planner)
+                _planner.plan(g, m.planner, Q, label, goal, gamma, r_step, r_goal)
             episode_steps[ep] = steps if reached else -steps
             macro_steps_out[ep] = macro_used
             episodes = ep + 1
@@ -444,53 +500,43 @@ def learn(
     macros=None,
     q_init: np.ndarray | None = None,
     keep_q: bool = False,
-    guide_arrays: tuple | None = None,
+    guide_model: _guide.Model | None = None,
 ) -> TrialResult:
     """Run one trial of SARSA(lambda) on ``robot`` from ``start_state`` to ``goal_cell``.
 
     ``shaping`` is a :class:`armtransfer.learning.shaping.Shaping` (None: no transfer); ``macros`` a
-    :class:`transfer.mapping.MacroTable` (None: no action sequence mapping); its attribute
+    :class:`armtransfer.learning.mapping.MacroTable` (None: no action sequence mapping); its attribute
     ``episodes`` (None: all) says in how many first episodes macros are offered. ``rng`` is
-    the only source of randomness. ``guide_arrays``: the guide's model arrays to learn into
-    (``transfer.guide.model_arrays_for``), to read what robot 2 learned afterwards; None: new ones.
+    the only source of randomness. ``guide_model``: what robot 2 learns with the guide, to learn
+    into (``guide.new_model``) and read afterwards; None: a new one.
     """
     n = robot.n_states
     sh = shaping if shaping is not None else Shaping.none(n)
-    m_episodes = None
     guide = getattr(sh, "guide", None)
     kernel = _run_trial if guide is None else _run_trial_guided
     if guide is not None:
-        g = _guide.as_tuple(guide)
-        gm = _guide.model_arrays_for(guide, n, robot.n_actions) if guide_arrays is None else guide_arrays
+        g, m = guide, _guide.new_model(guide, n, robot.n_actions) if guide_model is None else guide_model
     elif kernel is _run_trial_guided:  # run without a guide (benchmarks/bench_kernels.py, a test)
-        g, gm = _guide.inactive(robot.n_actions)
+        g, m = _guide.inactive(robot.n_actions)
     else:  # the plain kernel never reads them
-        g, gm = None, None
+        g, m = None, None
     if macros is None:
-        m_start = np.zeros(n, np.int64)
-        m_len = np.zeros(n, np.int64)
-        m_actions = np.zeros(0, np.int64)
+        table = Macros(np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(0, np.int64), int(config.max_episodes))
     else:
         m_start, m_len, m_actions = macros.arrays(robot)
         m_episodes = getattr(macros, "episodes", None)
-    Q = np.zeros((n, robot.n_actions)) if q_init is None else np.array(q_init, dtype=np.float64)
+        table = Macros(m_start, m_len, m_actions, int(config.max_episodes if m_episodes is None else m_episodes))
     E = config.max_episodes
-    episode_steps = np.zeros(E, np.int64)
-    greedy_len = np.zeros(E, np.int64)
-    macro_steps = np.zeros(E, np.int64)
-    path_buf = np.zeros(n + 1, np.int64)
-    prev_path = np.zeros(n + 1, np.int64)
-    fp_states = np.zeros(n + 1, np.int64)
-    fp_actions = np.zeros(n + 1, np.int64)
-    episodes, conv_ep, path_n, fp_n = kernel(
-        robot.next_state, robot.wind_state, robot.label, int(start_state), int(goal_cell),
-        sh.mode, sh.bonus, sh.traj_index, sh.phi,
-        m_start, m_len, m_actions, config.max_episodes if m_episodes is None else int(m_episodes),
-        config.alpha, config.gamma, config.lam, config.epsilon,
-        config.step_reward, config.goal_reward, float(wind), config.trace_cutoff,
-        config.max_episodes, config.max_total_steps, config.max_episode_steps, config.patience,
-        rng, g, gm, Q, episode_steps, greedy_len, macro_steps, path_buf, prev_path, fp_states, fp_actions,
-    )
+    out = Outputs(Q=np.zeros((n, robot.n_actions)) if q_init is None else np.array(q_init, dtype=np.float64),
+                  episode_steps=np.zeros(E, np.int64), greedy_len=np.zeros(E, np.int64),
+                  macro_steps=np.zeros(E, np.int64), path_buf=np.zeros(n + 1, np.int64),
+                  prev_path=np.zeros(n + 1, np.int64), fp_states=np.zeros(n + 1, np.int64),
+                  fp_actions=np.zeros(n + 1, np.int64))
+    world = World(robot.next_state, robot.wind_state, robot.label, int(start_state), int(goal_cell), float(wind))
+    rewards = Rewards(int(sh.mode), sh.bonus, sh.traj_index, sh.phi)
+    episodes, conv_ep, path_n, fp_n = kernel(world, rewards, table, Learning.of(config), rng, g, m, out)
+    Q, prev_path, fp_states, fp_actions = out.Q, out.prev_path, out.fp_states, out.fp_actions
+    episode_steps, greedy_len, macro_steps = out.episode_steps, out.greedy_len, out.macro_steps
     episode_steps = episode_steps[:episodes].copy()
     first = int(episode_steps[0]) if episodes and episode_steps[0] > 0 else None
     converged = conv_ep >= 0
@@ -527,5 +573,5 @@ def _greedy_action(Q: np.ndarray, s: int) -> int:
 
 
 # The kernels above call the guide's jitted functions; numba's cache does not notice an edit to
-# guide.py alone (``jitcache``), so their cache is emptied when that file changes.
-_jitcache.invalidate_stale(__name__, [_egreedy, _macro_step, _choose, _choose_guided, _greedy_path, _shaping, _run_trial, _run_trial_guided], [_guide.__file__])
+# the guide's files alone (``jitcache``), so their cache is emptied when that file changes.
+_jitcache.invalidate_stale(__name__, [_egreedy, _macro_step, _choose, _choose_guided, _greedy_path, _shaping, _run_trial, _run_trial_guided], _guide.FILES)

@@ -21,7 +21,39 @@ from armtransfer.registration import register_envs  # noqa: F401  (kept importab
 from armtransfer.tasks.robot import DiscreteRobot
 
 
-class RobotRoomsEnv(gym.Env):
+class RoomsRules:
+    """The rules of a start/goal task for one discrete robot, shared by the Gymnasium
+    environment and the dm_control task (``armtransfer.dmc.task``): an action moves the robot
+    by its own transition table, wind then pushes it one cell towards +x with probability
+    ``wind``, every step costs ``step_reward`` and reaching the goal cell pays ``goal_reward``
+    and ends the episode."""
+
+    def _set_rules(self, robot: DiscreteRobot, task: Task, wind: float, step_reward: float,
+                   goal_reward: float) -> None:
+        check_wind(wind)
+        self.robot = robot
+        self.task = task
+        self.start_state, self.goal_cell = task_states(robot, task)
+        self.wind = float(wind)
+        self.step_reward = float(step_reward)
+        self.goal_reward = float(goal_reward)
+        self.state = self.start_state
+
+    def _move(self, action: int, rng: np.random.Generator) -> int:
+        """The robot's next state after ``action``, the wind drawn from ``rng``; it becomes the state."""
+        s = int(self.robot.next_state[self.state, action])
+        if self.wind > 0.0 and rng.random() < self.wind:
+            s = int(self.robot.wind_state[s])
+        self.state = s
+        return s
+
+    def _outcome(self) -> tuple[float, bool]:
+        """(the reward of the step that led to the current state, whether it is at the goal)."""
+        terminated = int(self.robot.label[self.state]) == self.goal_cell
+        return self.step_reward + (self.goal_reward if terminated else 0.0), terminated
+
+
+class RobotRoomsEnv(RoomsRules, gym.Env):
     """A start/goal task for one discrete robot, in the style of Gymnasium's toy_text."""
 
     metadata = {"render_modes": ["ansi", "rgb_array"], "render_fps": 4}
@@ -35,23 +67,13 @@ class RobotRoomsEnv(gym.Env):
         goal_reward: float = 0.0,
         render_mode: str | None = None,
     ) -> None:
-        if not 0.0 <= wind <= 1.0:
-            raise InvalidParameterError(f"wind must be a probability in [0, 1], got {wind}")
+        self._set_rules(robot, task, wind, step_reward, goal_reward)
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise InvalidParameterError(
                 f"unknown render_mode {render_mode!r}; valid: {', '.join(self.metadata['render_modes'])}")
-        self.robot = robot
-        self.task = task
-        start_cell, self.goal_cell = task.cells()
-        self.start_state = robot.start_state(start_cell)
-        robot.start_state(self.goal_cell, what="goal")  # the goal must be reachable by label
-        self.wind = float(wind)
-        self.step_reward = float(step_reward)
-        self.goal_reward = float(goal_reward)
         self.render_mode = render_mode
         self.observation_space = spaces.Discrete(robot.n_states)
         self.action_space = spaces.Discrete(robot.n_actions)
-        self.state = self.start_state
         self._snapshot = None
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
@@ -60,14 +82,9 @@ class RobotRoomsEnv(gym.Env):
         return int(self.state), {"label": int(self.robot.label[self.state])}
 
     def step(self, action):
-        s = int(self.robot.next_state[self.state, int(action)])
-        if self.wind > 0.0 and self.np_random.random() < self.wind:
-            s = int(self.robot.wind_state[s])
-        self.state = s
-        label = int(self.robot.label[s])
-        terminated = label == self.goal_cell
-        reward = self.step_reward + (self.goal_reward if terminated else 0.0)
-        return s, reward, terminated, False, {"label": label}
+        s = self._move(int(action), self.np_random)
+        reward, terminated = self._outcome()
+        return s, reward, terminated, False, {"label": int(self.robot.label[s])}
 
     def render(self):
         """``ansi``: a text map; ``rgb_array``: for an arm robot the arm drawn by MuJoCo
@@ -112,6 +129,26 @@ def grid_image(layout, robot_cell: int, goal_cell: int, cell_pixels: int = CELL_
     return np.ascontiguousarray(image)
 
 
+def check_wind(wind: float) -> None:
+    if not 0.0 <= wind <= 1.0:
+        raise InvalidParameterError(f"wind must be a probability in [0, 1], got {wind}")
+
+
+def task_states(robot: DiscreteRobot, task: Task) -> tuple[int, int]:
+    """(the robot's start state, the goal cell) of ``task``; a cell the robot cannot reach is a
+    one-line error."""
+    start_cell, goal_cell = task.cells()
+    start = robot.start_state(start_cell)
+    robot.start_state(goal_cell, what="goal")  # the goal must be reachable by label
+    return start, goal_cell
+
+
+def rooms_task(task: int | None = 1, start: tuple[int, int] | None = None,
+               goal: tuple[int, int] | None = None) -> Task:
+    """A Table I task, or the custom task from ``start`` to ``goal`` when both are given."""
+    return custom_task(start, goal) if start is not None and goal is not None else table_task(task)
+
+
 def make_rooms_env(
     task: int | None = 1,
     robot: str = "fine",
@@ -122,12 +159,24 @@ def make_rooms_env(
     """Entry point of ``armtransfer/Rooms-v0``: a grid robot on a Table I or custom task."""
     from armtransfer.tasks.grid_robots import grid_robot
 
-    the_task = custom_task(start, goal) if start is not None and goal is not None else table_task(task)
-    return RobotRoomsEnv(grid_robot(robot), the_task, **kwargs)
+    return RobotRoomsEnv(grid_robot(robot), rooms_task(task, start, goal), **kwargs)
 
 
-_ARM_OPTIONS = ("cell_size", "xml_path", "tip_site", "tip_body", "tip_offset", "arm_name", "base_pos", "base_yaw",
-                "joint_step", "cache")
+ARM_OPTIONS = ("cell_size", "xml_path", "tip_site", "tip_body", "tip_offset", "arm_name", "base_pos", "base_yaw",
+               "joint_step", "cache")
+"""The keywords of an arm environment that build its robot (the rest set up the task)."""
+
+
+def rooms_arm(arm: str | None, actions: str, options: dict[str, Any]) -> DiscreteRobot:
+    """The arm robot of an arm environment: a built-in ``arm`` (planar2 by default), or the arm
+    file ``xml_path=`` with its options; the robot's keywords (:data:`ARM_OPTIONS`) are taken
+    out of ``options``, the rest left for the task."""
+    from armtransfer.tasks.arms import arm_robot, parse_robot_spec
+
+    robot_kwargs = {k: options.pop(k) for k in ARM_OPTIONS if k in options}
+    if robot_kwargs.get("xml_path") is None:  # a built-in arm, planar2 by default
+        arm, actions = parse_robot_spec(f"{arm or 'planar2'}:{actions}")
+    return arm_robot(arm, actions, **robot_kwargs)
 
 
 def make_arm_rooms_env(arm: str | None = None, actions: str = "joint", task: int | None = 1,
@@ -136,10 +185,5 @@ def make_arm_rooms_env(arm: str | None = None, actions: str = "joint", task: int
     """Entry point of ``armtransfer/ArmRooms-v0``: an arm robot (compiled or loaded from the
     cache) on a Table I or custom task. Bring-your-own arms: ``xml_path=`` with ``tip_site=`` or
     ``tip_body=``, ``tip_offset=``, ``arm_name=``, ``base_pos=``/``base_yaw=`` (automatic without)."""
-    from armtransfer.tasks.arms import arm_robot, parse_robot_spec
-
-    robot_kwargs = {k: kwargs.pop(k) for k in _ARM_OPTIONS if k in kwargs}
-    if robot_kwargs.get("xml_path") is None:  # a built-in arm, planar2 by default
-        arm, actions = parse_robot_spec(f"{arm or 'planar2'}:{actions}")
-    the_task = custom_task(start, goal) if start is not None and goal is not None else table_task(task)
-    return RobotRoomsEnv(arm_robot(arm, actions, **robot_kwargs), the_task, **kwargs)
+    the_task = rooms_task(task, start, goal)  # a bad task fails before any compiling
+    return RobotRoomsEnv(rooms_arm(arm, actions, kwargs), the_task, **kwargs)

@@ -1,5 +1,6 @@
 """Robot specs as users type them: grid robots by name, arms as ``ARM[:ACTIONS]``, an arm file
-as ``PATH.xml[:ACTIONS]``, and ``custom[:ACTIONS]`` for the arm file given separately."""
+as ``PATH.xml[:ACTIONS]``, and ``custom[:ACTIONS]`` or ``NAME[:ACTIONS]`` (the file's name, as
+``armtransfer arms list`` prints it) for the arm file given separately."""
 
 from __future__ import annotations
 
@@ -44,7 +45,8 @@ def resolve(spec: str | DiscreteRobot, *, xml_path=None, progress: bool = False,
 
         return resolve_generated(spec, progress=progress)
     name, _, actions = spec.partition(":")
-    if name == CUSTOM:
+    given = xml_arm_name(xml_path, arm_options.get("arm_name")) if xml_path is not None else None
+    if name == CUSTOM or (name == given and name not in ARMS):
         if xml_path is None:
             raise UnknownRobotError(f"robot '{CUSTOM}' needs --arm-xml PATH (arm_xml= in the API)")
         from armtransfer.tasks.arms import arm_robot
@@ -56,10 +58,25 @@ def resolve(spec: str | DiscreteRobot, *, xml_path=None, progress: bool = False,
         arm, actions = parse_robot_spec(spec)
         sized = {"cell_size": arm_options["cell_size"]} if arm_options.get("cell_size") is not None else {}
         return arm_robot(arm, actions, progress=progress, **sized)
+    file_arm = f"{CUSTOM} or {given} (the arm of --arm-xml)" if given else f"or {CUSTOM} with --arm-xml"
     if actions:
-        raise UnknownArmError(f"unknown arm {name!r}; valid arms: {', '.join(ARMS)}, or {CUSTOM} with --arm-xml")
+        raise UnknownArmError(f"unknown arm {name!r}; valid arms: {', '.join(ARMS)}, {file_arm}")
+    file_robot = (f"{CUSTOM}[:ACTIONS] or {given}[:ACTIONS] (the arm of --arm-xml)" if given
+                  else f"or {CUSTOM}[:ACTIONS] with --arm-xml")
     raise UnknownRobotError(
         f"unknown robot {spec!r}; valid: {', '.join(sorted(GRID_ROBOTS))}, ARM[:ACTIONS] with ARM one of "
         f"{', '.join(ARMS)} (see `armtransfer arms list`), PATH.xml[:ACTIONS], gen:FAMILY:DOF:SEED[:ACTIONS], "
-        f"or {CUSTOM}[:ACTIONS] with --arm-xml"
+        f"{file_robot}"
     )
+
+
+def xml_arm_name(xml_path, arm_name: str | None = None) -> str:
+    """The name an arm file's robots go by (``NAME:ACTIONS``, as ``armtransfer arms list``
+    prints them): ``arm_name`` when given, else the file's MJCF ``model`` attribute, else its
+    stem. A spec may name the file's arm by it instead of ``custom``; a built-in arm of the
+    same name keeps it."""
+    from pathlib import Path
+
+    from armtransfer.tasks.arms import file_arm_name
+
+    return arm_name or file_arm_name(Path(xml_path))
