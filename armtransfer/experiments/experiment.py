@@ -276,7 +276,8 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int 
 
     ``improvement_against`` holds, for every baseline that shares the method's learner
     (``Method.baselines``, the no-transfer one first) and is among ``results``, the same
-    improvement measured against it: ``{name: {"percent", "ci95", "design"}}``."""
+    improvement measured against it: ``{name: {"percent", "ci95", "design", "censored",
+    "cap_dominated"}}``."""
 
     def cap_of(r: MethodResult) -> int:
         if cap is not None:
@@ -307,7 +308,7 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int 
                 b_ex = by_name[name].column("exploration_steps")
                 bc = max(cap_of(r), cap_of(by_name[name]))
                 d = metrics.paired_improvement(b_ex, ex, bc, paired=len(b_ex) == len(ex))
-                against[name] = {"percent": d["percent"], "ci95": d["ci95"], "design": d["design"]}
+                against[name] = {key: d[key] for key in ("percent", "ci95", "design", "censored", "cap_dominated")}
         entry = {
             "exploration_steps": ex,
             "mean": st["mean"],
