@@ -25,6 +25,7 @@ COMMANDS = {
     "summarize": "summarize",
     "arms": "arms",
     "matrix": "matrix",
+    "benchmark": "benchmark",
 }
 
 

@@ -115,6 +115,8 @@ def test_summaries_state_each_improvement_against_the_baselines_sharing_its_lear
     assert set(out["guided"]["improvement_against"]) == {"plan", "goal-only"}
     assert set(out["dense"]["improvement_against"]) == {"none"}
     assert out["dense"]["improvement_against"]["none"]["percent"] == out["dense"]["improvement_percent"]
+    for key in ("censored", "cap_dominated"):  # the flags travel with every improvement
+        assert out["dense"]["improvement_against"]["none"][key] == out["dense"][f"improvement_{key}"]
     assert out["none"]["improvement_against"] == {} and out["plan"]["improvement_against"] == {}
     plan = np.array(out["plan"]["exploration_steps"], float)
     guided = np.array(out["guided"]["exploration_steps"], float)

@@ -146,11 +146,6 @@ PATH_LIKE = re.compile(r"(?<![\w./-])((?:armtransfer|scripts|research|benchmarks
 LINK = re.compile(r"\]\(([^)#\s]+)(?:#[^)]*)?\)")
 MODULE = re.compile(r"`(armtransfer(?:\.\w+)+)")
 
-ON_OTHER_BRANCHES = ("docs/benchmark.md", "docs/setup.md")
-"""Pages the README links that are written on other branches at the same time; a missing one
-is reported as a skip, never silently."""
-
-
 def _doc_and_model_pages() -> list[Path]:
     return [*PAGES, *sorted((ROOT / "armtransfer" / "models").glob("*/README.md"))]
 
@@ -161,11 +156,7 @@ def test_every_path_and_link_exists(page: Path) -> None:
     named = [ROOT / p for p in PATH_LIKE.findall(text)]
     named += [(page.parent / t).resolve() for t in LINK.findall(text) if not re.match(r"[a-z]+:", t)]
     absent = sorted({str(t.relative_to(ROOT)) for t in named if not t.exists()})
-    pending = [p for p in absent if p in ON_OTHER_BRANCHES]
-    missing = [p for p in absent if p not in ON_OTHER_BRANCHES]
-    assert not missing, f"{page.relative_to(ROOT)} names paths that do not exist: {missing}"
-    if pending:
-        pytest.skip(f"not on this branch yet: {', '.join(pending)}")
+    assert not absent, f"{page.relative_to(ROOT)} names paths that do not exist: {absent}"
 
 
 def test_every_path_in_the_code_exists() -> None:

@@ -30,9 +30,42 @@ def test_unreached_trials_count_at_the_cap_and_the_mean_is_a_lower_bound():
     assert st["mean"] >= cap * 2 / 5
     # the old mean over successes only (200) would have flattered it
     assert st["mean"] > metrics.mean_ci(values)[0]
+    # the t-interval of these skewed counts would reach below zero steps; the bootstrap's stays
+    # within the values and holds the mean
     half = stats.t.ppf(0.975, 4) * np.std([100, 200, 1000, 300, 1000], ddof=1) / np.sqrt(5)
-    assert st["ci95"] == pytest.approx([st["mean"] - half, st["mean"] + half])
+    assert st["mean"] - half < 0
+    assert 100 <= st["ci95"][0] < st["mean"] < st["ci95"][1] <= cap
     assert st["median"] == 300 and not st["median_is_lower_bound"]
+
+
+def test_a_median_at_exactly_half_censored_is_a_lower_bound():
+    st = metrics.exploration_stats([100, 200, None, None], 1000)
+    assert st["median"] == 600 and st["median_is_lower_bound"]
+    st = metrics.exploration_stats([100, 200, 300, None], 1000)
+    assert st["median"] == 250 and not st["median_is_lower_bound"]
+    assert metrics.median_is_lower_bound(3, 5) and not metrics.median_is_lower_bound(2, 5)
+
+
+def test_an_improvement_interval_stays_below_100_percent():
+    # a method 20x faster, with one slow trial: an interval on the ratio itself went below 0
+    base = [1000, 1200, 900, 1100, 1000]
+    other = [10, 12, 9, 11, 500]
+    p = metrics.paired_improvement(base, other, 10_000)
+    assert p["ci95"][0] < p["percent"] < p["ci95"][1] < 100.0
+    r = 1 - p["percent"] / 100
+    d = np.array(other) - r * np.array(base)
+    half = stats.t.ppf(0.975, 4) * np.std(d, ddof=1) / np.sqrt(5) / np.mean(base)
+    assert r - half < 0  # where the old interval on r would have reached
+
+
+def test_a_mean_made_mostly_of_the_cap_is_flagged():
+    st = metrics.exploration_stats([100, 200, None], 1000)
+    assert st["cap_dominated"]
+    assert not metrics.exploration_stats([100, 200, 300, None], 400)["cap_dominated"]  # 400 of 1000
+    p = metrics.paired_improvement([100, 200, None], [100, 200, 300], 1000)
+    assert p["censored"] and p["cap_dominated"]
+    p = metrics.paired_improvement([100, 200, 300], [100, 200, 250], 1000)
+    assert not p["censored"] and not p["cap_dominated"]
 
 
 def test_all_unreached_is_the_cap_not_n_a():
@@ -110,6 +143,7 @@ def test_summarize_reports_reached_and_a_censored_mean():
     assert e["mean"] >= 2 * cap / 3
     assert e["improvement_percent"] < 0  # worse than none, as it is
     assert e["improvement_design"] == metrics.PAIRED_DESIGN
+    assert e["improvement_censored"] and e["improvement_cap_dominated"] and e["mean_cap_dominated"]
     assert out["none"]["improvement_design"] is None and not out["none"]["mean_is_lower_bound"]
     for key in ("exploration_steps", "mean", "ci95", "improvement_percent", "improvement_ci95", "greedy_steps",
                 "greedy_mean", "greedy_ci95", "total_steps", "total_mean", "total_ci95", "converged",
@@ -118,6 +152,7 @@ def test_summarize_reports_reached_and_a_censored_mean():
     table = method_table(out)
     assert "1/3" in table and f"≥ {e['mean']:,.1f}" in table and "lower bound" in table
     assert "common random numbers" in table
+    assert f"{e['improvement_percent']:,.1f}‡" in table and "more than half of a mean" in table
 
 
 def test_sweep_summary_counts_unreached_trials():
@@ -134,8 +169,10 @@ def test_sweep_summary_counts_unreached_trials():
     assert p["reached"] == 3 and p["trials"] == 4 and p["mean_is_lower_bound"]
     assert p["mean"] == pytest.approx((10 + 20 + 20_000_000 + 40) / 4)
     assert p["improvement_design"] == metrics.PAIRED_DESIGN
+    assert p["improvement_censored"] and p["improvement_cap_dominated"]
+    assert next(r for r in rows if r["method"] == "none")["improvement_censored"] is None
     text = summary_markdown(rows)
-    assert "3/4" in text and "≥" in text
+    assert "3/4" in text and "≥" in text and "‡" in text and "more than half of a mean" in text
 
 
 def test_learning_curve_means_include_converged_trials():

@@ -285,7 +285,8 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int 
 
     ``improvement_against`` holds, for every baseline that shares the method's learner
     (``Method.baselines``, the no-transfer one first) and is among ``results``, the same
-    improvement measured against it: ``{name: {"percent", "ci95", "design"}}``."""
+    improvement measured against it: ``{name: {"percent", "ci95", "design", "censored",
+    "cap_dominated"}}``."""
 
     def cap_of(r: MethodResult) -> int:
         if cap is not None:
@@ -316,7 +317,7 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int 
                 b_ex = by_name[name].column("exploration_steps")
                 bc = max(cap_of(r), cap_of(by_name[name]))
                 d = metrics.paired_improvement(b_ex, ex, bc, paired=len(b_ex) == len(ex))
-                against[name] = {"percent": d["percent"], "ci95": d["ci95"], "design": d["design"]}
+                against[name] = {key: d[key] for key in ("percent", "ci95", "design", "censored", "cap_dominated")}
         entry = {
             "exploration_steps": ex,
             "mean": st["mean"],
@@ -328,6 +329,9 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int 
             "median_ci95": st["median_ci95"],
             "median_ci_coverage": st["median_ci_coverage"],
             "median_is_lower_bound": st["median_is_lower_bound"],
+            "mean_cap_dominated": st["cap_dominated"],
+            "improvement_censored": None if imp is None else imp["censored"],
+            "improvement_cap_dominated": None if imp is None else imp["cap_dominated"],
             "improvement_percent": None if imp is None else imp["percent"],
             "improvement_ci95": None if imp is None else imp["ci95"],
             "improvement_design": None if imp is None else imp["design"],

@@ -171,3 +171,52 @@ def task_layout(
     ax.set_title(title)
     ax.legend(loc="lower right", fontsize=7)
     _save(fig, path)
+
+
+def _panel_grid(panels: list, title: str, path: str | os.PathLike, xlabel: str, ylabel: str, draw) -> None:
+    """One panel per (label, curves) of ``panels``, four to a row; ``draw(ax, curves)`` plots a
+    panel's curves, each labelled by its method; the legend is on the first panel."""
+    n = len(panels)
+    cols = min(n, 4)
+    rows = (n + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 3.2 * rows), squeeze=False)
+    for ax in axes.flat[n:]:
+        ax.set_visible(False)
+    for ax, (label, curves) in zip(axes.flat, panels):
+        draw(ax, curves)
+        ax.set_title(label, fontsize=8)
+        ax.set_xlabel(xlabel, fontsize=8)
+        ax.set_ylabel(ylabel, fontsize=8)
+        ax.grid(alpha=0.3)
+    axes.flat[0].legend(fontsize=7)
+    fig.suptitle(title)
+    fig.tight_layout()
+    _save(fig, path)
+
+
+def survival_grid(panels: list[tuple[str, dict[str, tuple[list[float], list[float]]]]], cap: float, title: str,
+                  path: str | os.PathLike) -> None:
+    """Kaplan-Meier curves, one panel per case: ``panels`` is [(case label, {method: (times,
+    survival)})]; a curve is the share of trials that have not yet reached the goal after so many
+    steps, drawn as a step function up to the cap (where the unreached trials were censored)."""
+
+    def draw(ax, curves):
+        for method, (times, surv) in curves.items():
+            ax.step([1.0, *times, cap], [1.0, *surv, surv[-1] if surv else 1.0], where="post", label=method)
+        ax.set_xscale("log")
+        ax.set_ylim(-0.02, 1.02)
+
+    _panel_grid(panels, title, path, "steps of the first episode", "share not yet at the goal", draw)
+
+
+def curve_grid(panels: list[tuple[str, dict[str, list[float]]]], title: str, path: str | os.PathLike) -> None:
+    """Mean learning curves (steps per episode, log scale), one panel per case: ``panels`` is
+    [(case label, {method: mean steps per episode})]."""
+
+    def draw(ax, curves):
+        for method, mean in curves.items():
+            if mean:
+                ax.plot(np.arange(1, len(mean) + 1), mean, label=method)
+        ax.set_yscale("log")
+
+    _panel_grid(panels, title, path, "episode", "mean steps per episode", draw)

@@ -28,18 +28,20 @@ def t95(df: int) -> float:
 
 
 def mean_ci(values: Sequence[float | None]) -> tuple[float | None, list[float] | None]:
-    """Mean and 95% t-interval of the values that are not None (None when none are).
+    """Mean and 95% percentile-bootstrap interval of the values that are not None (None when
+    none are); the interval stays within the values' range.
 
     For quantities defined only for some trials (e.g. greedy path lengths of converged
     trials). Exploration steps are censored: use :func:`exploration_stats`."""
+    from armtransfer.experiments.survival import bootstrap_ci
+
     xs = np.array([v for v in values if v is not None], dtype=np.float64)
     if len(xs) == 0:
         return None, None
     m = float(xs.mean())
     if len(xs) == 1:
         return m, [m, m]
-    half = t95(len(xs) - 1) * float(xs.std(ddof=1)) / math.sqrt(len(xs))
-    return m, [m - half, m + half]
+    return m, bootstrap_ci(xs)
 
 
 def censor(values: Sequence[int | float | None], cap: float) -> np.ndarray:
@@ -66,32 +68,48 @@ def median_ci(xs: np.ndarray, level: float = 0.95) -> tuple[list[float] | None, 
     return [float(x[best - 1]), float(x[n - best])], coverage
 
 
+def median_is_lower_bound(censored: int, n: int) -> bool:
+    """Whether the median of ``n`` values of which ``censored`` are counted at the cap touches
+    a censored value (and so is only a lower bound): the upper of the middle order statistics
+    is censored once at least half of the values are (exactly half, for an even n, included)."""
+    return n > 0 and censored >= math.ceil(n / 2)
+
+
+def cap_share(values: Sequence[int | float | None], cap: float) -> float:
+    """The share of a censored mean's sum that the unreached trials contribute at ``cap``;
+    above one half the mean says more about the cap than about the method (cap-dominated)."""
+    xs = censor(values, cap)
+    total = float(xs.sum())
+    return float(cap * sum(v is None for v in values) / total) if total > 0 else 0.0
+
+
 def exploration_stats(values: Sequence[int | None], cap: int) -> dict:
     """Censoring-honest statistics of exploration steps (None: goal not reached in ``cap``).
 
-    mean and ci95 (t interval) are over all trials with unreached ones counted at ``cap``;
-    when any is unreached they are lower bounds (``mean_is_lower_bound``). The median and
-    its order-statistic interval are exact unless censoring reaches them
-    (``median_is_lower_bound``)."""
+    mean and ci95 are over all trials with unreached ones counted at ``cap``; when any is
+    unreached they are lower bounds (``mean_is_lower_bound``), and ``cap_dominated`` says the
+    unreached trials make up more than half of the mean. ci95 is a percentile bootstrap, so it
+    never leaves the range of the values (a t-interval of skewed step counts reached below
+    zero). The median and its order-statistic interval are exact unless censoring reaches them
+    (``median_is_lower_bound``, set from exactly half censored on)."""
     n = len(values)
     reached = sum(v is not None for v in values)
     out = {"n": n, "reached": reached, "censored": reached < n, "cap": cap,
            "mean": None, "ci95": None, "mean_is_lower_bound": reached < n,
            "median": None, "median_ci95": None, "median_ci_coverage": None,
-           "median_is_lower_bound": False}
+           "median_is_lower_bound": False, "cap_dominated": False}
     if n == 0:
         return out
+    from armtransfer.experiments.survival import bootstrap_ci
+
     xs = censor(values, cap)
     mean = float(xs.mean())
-    if n == 1:
-        ci = [mean, mean]
-    else:
-        half = t95(n - 1) * float(xs.std(ddof=1)) / math.sqrt(n)
-        ci = [mean - half, mean + half]
+    ci = [mean, mean] if n == 1 else bootstrap_ci(xs)
     med = float(np.median(xs))
     mci, cov = median_ci(xs)
     out.update(mean=mean, ci95=ci, median=med, median_ci95=mci, median_ci_coverage=cov,
-               median_is_lower_bound=bool(reached < n and med >= cap))
+               median_is_lower_bound=median_is_lower_bound(n - reached, n),
+               cap_dominated=cap_share(values, cap) > 0.5)
     return out
 
 
@@ -110,7 +128,9 @@ def paired_improvement(base: Sequence[int | None], other: Sequence[int | None], 
     ``paired``: trial i of both came from the same random stream (common random numbers,
     ``experiment.trial_rng``), so the interval is the delta method on the paired residuals
     d_i = o_i - r b_i (r the ratio of means), var(r) ~ var(d) / (n mean(b)^2), t with n-1
-    df. Otherwise the two samples are independent: delta method on both variances.
+    df. Otherwise the two samples are independent: delta method on both variances. The
+    interval is a t-interval on log r (standard error se(r)/r), so the ratio's stays positive
+    and the improvement's below 100%, which an interval on r itself did not.
     ``censored`` says a cap entered either mean (then the percent is that of the censored
     means, not of the true ones)."""
     b = censor(base, cap)
@@ -118,7 +138,8 @@ def paired_improvement(base: Sequence[int | None], other: Sequence[int | None], 
     if paired and len(b) != len(o):
         raise ValueError(f"a paired comparison needs as many trials in both ({len(b)} vs {len(o)})")
     out = {"percent": None, "ci95": None, "design": PAIRED_DESIGN if paired else INDEPENDENT_DESIGN,
-           "n": [len(b), len(o)], "censored": bool(any(v is None for v in base) or any(v is None for v in other))}
+           "n": [len(b), len(o)], "censored": bool(any(v is None for v in base) or any(v is None for v in other)),
+           "cap_dominated": bool(len(b) and len(o) and max(cap_share(base, cap), cap_share(other, cap)) > 0.5)}
     if len(b) == 0 or len(o) == 0 or b.mean() == 0:
         return out
     r = float(o.mean() / b.mean())
@@ -136,8 +157,10 @@ def paired_improvement(base: Sequence[int | None], other: Sequence[int | None], 
         se = r * math.sqrt(o.var(ddof=1) / len(o) / o.mean() ** 2 + b.var(ddof=1) / len(b) / b.mean() ** 2) \
             if o.mean() > 0 else math.sqrt(o.var(ddof=1) / len(o)) / b.mean()
         df = min(len(b), len(o)) - 1
-    half = t95(df) * se
-    out["ci95"] = [100.0 * (1.0 - (r + half)), 100.0 * (1.0 - (r - half))]
+    if r <= 0:
+        return out
+    half = t95(df) * se / r  # on log r: the ratio's interval stays positive, the percent below 100
+    out["ci95"] = [100.0 * (1.0 - r * math.exp(half)), 100.0 * (1.0 - r * math.exp(-half))]
     return out
 
 

@@ -50,6 +50,17 @@ def median_column(entries) -> tuple[str, object]:
     return "median [CI, coverage named when below 95%]", fmt_median
 
 
+CAP_MARK = "‡"
+CAP_NOTE = (f"{CAP_MARK}: unreached trials counted at the step cap make up more than half of a mean; that "
+            "improvement says more about the cap than about the method (read the medians).")
+
+
+def fmt_improvement(entry: dict) -> str:
+    """An improvement in percent, marked when a cap-dominated mean entered it."""
+    text = fmt_num(entry.get("improvement_percent"))
+    return text + CAP_MARK if entry.get("improvement_cap_dominated") else text
+
+
 def markdown_table(header: list[str], rows: list[list[str]]) -> str:
     widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(header)]
     line = lambda cells: "| " + " | ".join(c.ljust(w) for c, w in zip(cells, widths)) + " |"  # noqa: E731
@@ -86,7 +97,7 @@ def method_table(results: dict) -> str:
                 fmt_mean(r),
                 fmt_ci(r["ci95"]),
                 median_cell(r),
-                fmt_num(r.get("improvement_percent")),
+                fmt_improvement(r),
                 fmt_ci(r.get("improvement_ci95")),
                 fmt_num(r.get("greedy_mean")),
                 fmt_num(r.get("total_mean"), 0),
@@ -98,6 +109,8 @@ def method_table(results: dict) -> str:
     if any(r.get("mean_is_lower_bound") for r in results.values()):
         table += ("\n\n≥: some trials never reached the goal; they count at the step cap, so the mean "
                   "is a lower bound.")
+    if any(r.get("improvement_cap_dominated") for r in results.values()):
+        table += "\n\n" + CAP_NOTE
     if designs:
         table += "\n\nImprovement CIs: " + "; ".join(sorted(designs)) + "."
     return table

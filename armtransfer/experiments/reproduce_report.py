@@ -59,12 +59,29 @@ def _paper(x: float | None, digits: int = 1) -> str:
     return "NA" if x is None else f"{x:,.{digits}f}"
 
 
+CANNOT_TELL = "cannot tell"
+
+
+def detectable_difference(ci: list[float], power: float = 0.8) -> float:
+    """The smallest difference from the paper's value that an estimate with this 95% interval
+    detects with ``power`` (two-sided, 5%): (z_0.975 + z_power) standard errors, the standard
+    error read off the interval's half-width."""
+    from scipy import stats
+
+    z = float(stats.norm.ppf(0.975))
+    return (z + float(stats.norm.ppf(power))) * (ci[1] - ci[0]) / 2 / z
+
+
 def _verdict(ours: float | None, ci: list[float] | None, theirs: float | None) -> str:
-    """Compare our improvement with the paper's: better / within CI / worse."""
+    """Compare our improvement with the paper's: better / worse when our 95% interval excludes
+    its value; otherwise the run cannot tell, and says how large a difference it could detect
+    (an interval that holds the paper's value is no evidence of agreement)."""
     if ours is None or theirs is None:
         return ""
-    if ci is not None and ci[0] <= theirs <= ci[1]:
-        return "as paper (within CI)"
+    if ci is None:
+        return f"{CANNOT_TELL} (no interval)"
+    if ci[0] <= theirs <= ci[1]:
+        return f"{CANNOT_TELL} (80% power only for differences over {detectable_difference(ci):.0f} points)"
     return "better than paper" if ours > theirs else "**worse than paper**"
 
 
@@ -290,13 +307,16 @@ def _ratio_sentence(protocol: dict, base: dict, where: str) -> str:
 
 
 def _vs_paper(rows: list[tuple[int, dict, float | None]]) -> tuple[list[int], list[int], list[int]]:
-    """(tasks better than the paper, within CI, worse), from improvement CIs."""
+    """(tasks better than the paper, those this run cannot tell from it, worse), from improvement CIs."""
     better: list[int] = []
     same: list[int] = []
     worse: list[int] = []
     for t, r, theirs in rows:
         v = _verdict(r.get("improvement_percent"), r.get("improvement_ci95"), theirs)
-        {"as paper (within CI)": same, "better than paper": better, "**worse than paper**": worse}.get(v, []).append(t)
+        if v.startswith(CANNOT_TELL):
+            same.append(t)
+        else:
+            {"better than paper": better, "**worse than paper**": worse}.get(v, []).append(t)
     return better, same, worse
 
 
@@ -378,8 +398,9 @@ def differences_markdown(res: dict) -> list[str]:
     for key, ptab, col, name in (("table_ii", paper.TABLE_II, "C", "Table II C (coarse -> fine)"),
                                  ("table_v", paper.TABLE_V, "C", "Table V C (fine -> coarse)")):
         better, same, worse = _vs_paper([(t, res[key][t]["results"]["pseudo"], ptab[t][col]) for t in TASKS])
-        line = (f"- {name}, improvement of transfer over no transfer: as the paper (its value inside our 95% "
-                f"interval) on tasks {_tasks(same)}; better on {_tasks(better)}; worse on {_tasks(worse)}.")
+        line = (f"- {name}, improvement of transfer over no transfer: the paper's value inside our 95% "
+                f"interval, so this run cannot tell them apart (each row says how large a difference it "
+                f"could detect), on tasks {_tasks(same)}; better on {_tasks(better)}; worse on {_tasks(worse)}.")
         if worse:
             line += (" Where worse: with a negative step reward and Q = 0 the learner already explores "
                      "systematically without transfer, and the pseudo reward, kept below the farming limit "
@@ -390,7 +411,7 @@ def differences_markdown(res: dict) -> list[str]:
                                      ("mapping_fine_coarse", "E", "table_v", "Table V E (mapping, fine -> coarse)")):
         ptab = paper.TABLE_II if base_key == "table_ii" else paper.TABLE_V
         better, same, worse = _vs_paper([(t, res[key]["tasks"][t], ptab[t][col]) for t in TASKS if ptab[t][col] is not None])
-        out.append(f"- {name}: as the paper on tasks {_tasks(same)}; better on {_tasks(better)}; worse on "
+        out.append(f"- {name}: cannot tell from the paper on tasks {_tasks(same)}; better on {_tasks(better)}; worse on "
                    f"{_tasks(worse)}." + _ratio_sentence(res[key], res[base_key], name.split(", ")[-1].rstrip(")")))
     e_rows = [(t, res["mapping_coarse_fine"]["tasks"][t]["mapped_percent_mean"], paper.TABLE_II[t]["E"])
               for t in TASKS if paper.TABLE_II[t]["E"] is not None]
@@ -432,9 +453,10 @@ def report_markdown(res: dict, figures: dict[str, str]) -> str:
         f"{res['trials']} trials per cell (the paper: {paper.PAPER_TRIALS}), seed {res['seed']}. "
         "Exploration steps = steps until the goal is first reached. Every trial counts: one that never "
         f"reaches the goal within {cfg['max_total_steps']:,} steps counts at that cap, and its mean is "
-        "then a lower bound (≥, with reached k/n). Means with 95% t-intervals over trials; improvement "
-        "intervals by the delta method on paired trials (all methods share the random stream of trial i: "
-        "common random numbers).",
+        "then a lower bound (≥, with reached k/n). Means with 95% percentile-bootstrap intervals over trials "
+        "(they stay within the steps observed); improvement intervals by the delta method on the log of the "
+        "ratio of means, on paired trials (all methods share the random stream of trial i: common random "
+        "numbers).",
         "",
         f"Learner: SARSA(lambda), alpha {cfg['alpha']}, gamma {cfg['gamma']}, lambda {cfg['lam']}, "
         f"epsilon {cfg['epsilon']}, step reward {cfg['step_reward']}, goal reward {cfg['goal_reward']}, "

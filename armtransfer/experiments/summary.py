@@ -14,7 +14,8 @@ from __future__ import annotations
 
 from armtransfer.experiments import metrics
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.experiments.report import fmt_ci, fmt_mean, fmt_num, markdown_table, median_column
+from armtransfer.experiments.report import (CAP_NOTE, fmt_ci, fmt_improvement, fmt_mean, fmt_num, markdown_table,
+                                          median_column)
 from armtransfer.experiments.sweep import group_key
 
 
@@ -71,12 +72,17 @@ def summarize(records: list[dict]) -> list[dict]:
                 "improvement_percent": None,
                 "improvement_ci95": None,
                 "improvement_design": None,
+                "improvement_censored": None,
+                "improvement_cap_dominated": None,
+                "mean_cap_dominated": st["cap_dominated"],
             }
             if base is not None and label != "none":
                 imp = _improvement(base, col, cap)
                 row["improvement_percent"] = imp["percent"]
                 row["improvement_ci95"] = imp["ci95"]
                 row["improvement_design"] = imp["design"]
+                row["improvement_censored"] = imp["censored"]
+                row["improvement_cap_dominated"] = imp["cap_dominated"]
             rows.append(row)
     return rows
 
@@ -108,12 +114,14 @@ def summary_markdown(rows: list[dict]) -> str:
         _task_name(r), f"{r['source']} -> {r['target']}", f"{r['wind']:g}", f"{r['epsilon']:g}", f"{r['lam']:g}",
         r["method"], f"{r['reached']}/{r['trials']}", f"{fmt_mean(r)} {fmt_ci(r['ci95'])}",
         median_cell(r),
-        "" if r["method"] == "none" else f"{fmt_num(r['improvement_percent'])} {fmt_ci(r['improvement_ci95'])}",
+        "" if r["method"] == "none" else f"{fmt_improvement(r)} {fmt_ci(r['improvement_ci95'])}",
         fmt_num(r["greedy_mean"]), f"{r['converged']}/{r['trials']}",
     ] for r in rows]
     table = markdown_table(header, body)
     if any(r["mean_is_lower_bound"] for r in rows):
         table += "\n\n≥: some trials never reached the goal; they count at the step cap, so the mean is a lower bound."
+    if any(r.get("improvement_cap_dominated") for r in rows):
+        table += "\n\n" + CAP_NOTE
     designs = sorted({r["improvement_design"] for r in rows} - {None})
     if designs:
         table += "\n\nImprovement CIs: " + "; ".join(designs) + "."

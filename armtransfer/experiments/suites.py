@@ -1,0 +1,123 @@
+"""The benchmark's suites: fixed, versioned sets of transfer cases that ``armtransfer
+benchmark --suite NAME`` runs.
+
+A suite is one or more sections; a section is a list of cases (source robot, target robot,
+task, wind) and how each is run: how many source seeds (robot 1 learns the task again for
+each, and its converged greedy path is the trajectory handed over), how many trials of every
+method per source seed, the step cap of a trial, and the first-exposure budget of the
+success rate. A suite marked ``held_out`` was never used to choose a parameter of any method;
+parameters are chosen on ``dev`` only. Changing what a suite runs means a new ``version``, so
+a report's numbers always name the suite they came from.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+from armtransfer.errors import InvalidParameterError
+
+METHODS = ("none", "pseudo", "dense", "guided", "plan", "goal-only", "pseudo-plan")
+"""The methods every suite runs (those this build's registry has), each beside its baseline."""
+
+MIN_SEEDS_FOR_CLAIM = 10
+"""A report states that a method is faster or slower than its baseline only from at least this
+many paired source seeds; with fewer it gives the numbers and makes no claim."""
+
+BUDGET_FACTOR = 100
+"""Success within budget: the goal first reached within this many times the target robot's
+shortest path from start to goal (in its own steps)."""
+
+
+@dataclass(frozen=True)
+class Case:
+    source: str
+    target: str
+    task: int | None
+    """A Table I task number; None: start and goal drawn per source seed over all rooms."""
+    wind: float = 0.0
+
+    @property
+    def label(self) -> str:
+        task = "random task" if self.task is None else f"task {self.task}"
+        wind = f", wind {self.wind:g}" if self.wind else ""
+        return f"{self.source} -> {self.target}, {task}{wind}"
+
+
+@dataclass(frozen=True)
+class Section:
+    name: str
+    description: str
+    cases: tuple[Case, ...]
+    source_seeds: int
+    trials: int
+    """Trials of every method per source seed."""
+    max_total_steps: int
+    """A trial's step cap: a first exposure not reached by then is censored there."""
+
+
+@dataclass(frozen=True)
+class Suite:
+    name: str
+    version: int
+    held_out: bool
+    description: str
+    sections: tuple[Section, ...]
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "version": self.version, "held_out": self.held_out,
+                "description": self.description, "methods": list(METHODS), "budget_factor": BUDGET_FACTOR,
+                "sections": [asdict(s) for s in self.sections]}
+
+
+def _both_ways(pairs: list[tuple[str, str]], tasks: tuple[int | None, ...], wind: float = 0.0) -> tuple[Case, ...]:
+    return tuple(Case(a, b, t, wind) for s, d in pairs for a, b in ((s, d), (d, s)) for t in tasks)
+
+
+PAPER = Section(
+    "paper", "the paper's Table I tasks 1-4, coarse -> fine and fine -> coarse",
+    _both_ways([("coarse", "fine")], (1, 2, 3, 4)), source_seeds=10, trials=2, max_total_steps=2_000_000)
+RANDOM = Section(
+    "random", "start and goal drawn per source seed over all four rooms, coarse <-> fine",
+    _both_ways([("coarse", "fine")], (None,)), source_seeds=10, trials=2, max_total_steps=2_000_000)
+EMBODIMENT = Section(
+    "embodiment", "arms that move their joints (2-4 joints) and a generated planar arm, both directions",
+    _both_ways([("planar2:joint", "planar3:joint"), ("planar3:joint", "planar4:joint"),
+                ("gen:planar:3:1:joint", "planar2:joint")], (1,)),
+    source_seeds=10, trials=2, max_total_steps=1_000_000)
+WIND = Section(
+    "wind", "Table I tasks 1-4, coarse -> fine, with wind 0.01 (a move is blown one cell aside)",
+    tuple(Case("coarse", "fine", t, 0.01) for t in (1, 2, 3, 4)), source_seeds=10, trials=2,
+    max_total_steps=2_000_000)
+DEV = Section(
+    "dev", "the development cases parameters may be chosen on: tasks drawn apart from the held-out ones "
+    "(coarse -> fine), and the robot pairs earlier parameters were chosen on (ur5e_like:cartesian -> "
+    "planar2:joint task 3, planar3:joint -> planar4:cartesian task 4)",
+    (Case("coarse", "fine", None), Case("ur5e_like:cartesian", "planar2:joint", 3),
+     Case("planar3:joint", "planar4:cartesian", 4)),
+    source_seeds=10, trials=2, max_total_steps=2_000_000)
+FAST = Section(
+    "fast", "coarse -> fine task 1, two source seeds: checks the whole protocol in seconds",
+    (Case("coarse", "fine", 1),), source_seeds=2, trials=2, max_total_steps=300_000)
+
+SUITES: dict[str, Suite] = {
+    s.name: s
+    for s in (
+        Suite("paper", 1, True, PAPER.description, (PAPER,)),
+        Suite("random", 1, True, RANDOM.description, (RANDOM,)),
+        Suite("embodiment", 1, True, EMBODIMENT.description, (EMBODIMENT,)),
+        Suite("wind", 1, True, WIND.description, (WIND,)),
+        Suite("standard", 1, True, "the held-out union: paper, random, embodiment and wind",
+              (PAPER, RANDOM, EMBODIMENT, WIND)),
+        Suite("dev", 1, False, DEV.description, (DEV,)),
+        Suite("fast", 1, False, FAST.description, (FAST,)),
+    )
+}
+"""Every suite by name."""
+
+
+def get(name: str) -> Suite:
+    """The suite called ``name``; an unknown name is a one-line error listing the valid ones."""
+    try:
+        return SUITES[name]
+    except (KeyError, TypeError):
+        raise InvalidParameterError(f"unknown suite {name!r}; valid suites: {', '.join(SUITES)}") from None

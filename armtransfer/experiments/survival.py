@@ -1,0 +1,102 @@
+"""Statistics of censored step counts and intervals that stay inside the data.
+
+A trial that has not reached the goal when its step cap stops it has a *censored* first
+exposure: all we know is that it would have taken more than the cap. The Kaplan-Meier
+estimate (``scipy.stats.ecdf`` on ``scipy.stats.CensoredData``) uses such a trial for as long
+as it was observed, so neither the cap nor the failures distort the curve below the cap; its
+median is reported with the interval where the pointwise 95% band (log-log) crosses one half,
+and a median that the data cannot reach is ``None`` and flagged as lying beyond the cap.
+
+Intervals of summary statistics are percentile bootstraps (``scipy.stats.bootstrap`` with a
+fixed seed), so they are deterministic and never leave the range of the values resampled: a
+count's interval cannot go below zero, a ratio's cannot go below the smallest ratio seen.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable, Sequence
+
+import numpy as np
+from scipy import stats
+
+LEVEL = 0.95
+BOOTSTRAP_RESAMPLES = 2000
+BOOTSTRAP_SEED = 0
+
+
+def censored_data(values: Sequence[float | None], cap: float) -> stats.CensoredData:
+    """``values`` as right-censored data: None (never reached) is censored at ``cap``."""
+    seen = [float(v) for v in values if v is not None]
+    return stats.CensoredData(uncensored=seen, right=[float(cap)] * sum(v is None for v in values))
+
+
+def kaplan_meier(values: Sequence[float | None], cap: float) -> dict:
+    """The Kaplan-Meier survival curve of first-exposure steps (None: censored at ``cap``).
+
+    Returns ``times`` and ``survival`` (the step function: the share of trials still without
+    the goal just after each time), the 95% band (``low``, ``high``), ``median`` with its
+    interval ``median_ci95`` (None where the curve or band never falls to one half: the
+    median, or that end of its interval, lies beyond ``cap``), ``n`` and ``events``."""
+    n = len(values)
+    events = sum(v is not None for v in values)
+    out = {"n": n, "events": events, "cap": cap, "times": [], "survival": [], "low": [], "high": [],
+           "median": None, "median_beyond_cap": True, "median_ci95": [None, None]}
+    if events == 0:
+        return out
+    sf = stats.ecdf(censored_data(values, cap)).sf
+    with warnings.catch_warnings():  # undefined where the curve is 0: nan, set below
+        warnings.simplefilter("ignore", RuntimeWarning)
+        band = sf.confidence_interval(LEVEL, method="log-log")
+    times = [float(t) for t in sf.quantiles]
+    surv = [float(p) for p in sf.probabilities]
+    # the log-log band is undefined where the curve is 0 (after the last trial reached the goal):
+    # there it is 0 too, so the median's interval ends at most at the last time observed
+    empty = np.asarray(sf.probabilities) <= 0
+    low = [float(p) for p in np.where(empty, 0.0, np.nan_to_num(band.low.probabilities, nan=0.0))]
+    high = [float(p) for p in np.where(empty, 0.0, np.nan_to_num(band.high.probabilities, nan=1.0))]
+    median = first_time_at_or_below(times, surv, 0.5)
+    out.update(times=times, survival=surv, low=low, high=high, median=median,
+               median_beyond_cap=median is None,
+               median_ci95=[first_time_at_or_below(times, low, 0.5), first_time_at_or_below(times, high, 0.5)])
+    return out
+
+
+def first_time_at_or_below(times: Sequence[float], curve: Sequence[float], level: float) -> float | None:
+    """The first time at which the step function ``curve`` is at or below ``level`` (None: never)."""
+    for t, p in zip(times, curve):
+        if p <= level + 1e-12:
+            return float(t)
+    return None
+
+
+def bootstrap_ci(values: Sequence[float] | np.ndarray, statistic: Callable = np.mean, seed: int = BOOTSTRAP_SEED,
+                 resamples: int = BOOTSTRAP_RESAMPLES) -> list[float] | None:
+    """Percentile bootstrap 95% interval of ``statistic`` of ``values`` (a 1-d sample).
+
+    Deterministic (a generator seeded with ``seed``) and inside [min, max] of the values for
+    any statistic that is (mean, median, ...). None for fewer than two values; a sample whose
+    values are all equal gives that value twice."""
+    x = np.asarray(values, dtype=np.float64)
+    if len(x) < 2:
+        return None
+    if np.ptp(x) == 0:
+        return [float(x[0]), float(x[0])]
+    res = stats.bootstrap((x,), lambda a, axis: statistic(a, axis=axis), n_resamples=resamples,
+                          confidence_level=LEVEL, method="percentile", vectorized=True,
+                          random_state=np.random.default_rng(seed))
+    lo, hi = float(res.confidence_interval.low), float(res.confidence_interval.high)
+    return [max(lo, float(x.min())), min(hi, float(x.max()))]
+
+
+def ratio_summary(log_ratios: Sequence[float]) -> dict:
+    """Paired factors exp(log ratio), one per source seed: their geometric mean, its percentile
+    bootstrap interval over the seeds (on the log scale, so it stays positive and within the
+    smallest and largest factor), and the worst (smallest) and best factor."""
+    x = np.asarray(log_ratios, dtype=np.float64)
+    if len(x) == 0:
+        return {"n": 0, "factor": None, "ci95": None, "worst": None, "best": None}
+    ci = bootstrap_ci(x)
+    return {"n": int(len(x)), "factor": float(np.exp(x.mean())),
+            "ci95": None if ci is None else [float(np.exp(ci[0])), float(np.exp(ci[1]))],
+            "worst": float(np.exp(x.min())), "best": float(np.exp(x.max()))}

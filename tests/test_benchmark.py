@@ -1,0 +1,255 @@
+"""armtransfer benchmark: the fast suite end to end, its determinism, its errors, and the
+statistics it reports (Kaplan-Meier, intervals inside the data, paired factors)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from armtransfer.cli import main
+from armtransfer.errors import InvalidParameterError
+from armtransfer.experiments import benchmark, benchmark_report, benchmark_stats, metrics, suites, survival
+from armtransfer.learning import methods
+from armtransfer.tasks.grid_robots import grid_robot
+
+
+@pytest.fixture(scope="module")
+def fast_runs(tmp_path_factory):
+    """The fast suite, run twice with the same seed through the command."""
+    root = tmp_path_factory.mktemp("bench")
+    codes = [main(["benchmark", "--suite", "fast", "--out", str(root / name)]) for name in ("a", "b")]
+    return root, codes
+
+
+def test_fast_suite_writes_one_whole_report(fast_runs):
+    root, codes = fast_runs
+    assert codes == [0, 0]
+    out = root / "a"
+    names = {p.name for p in out.iterdir()}
+    assert names == {"report.md", "results.json", "timings.json", "survival_fast.png", "learning_curves_fast.png"}
+    data = json.loads((out / "results.json").read_text())
+    suite = suites.get("fast")
+    ran, _ = benchmark.methods_to_run()
+    section = suite.sections[0]
+    assert len(data["records"]) == len(section.cases) * section.source_seeds * len(ran)
+    for rec in data["records"]:
+        assert len(rec["first_exposure"]) == section.trials and rec["cap"] == section.max_total_steps
+    assert data["suite"]["held_out"] is False
+    timings = json.loads((out / "timings.json").read_text())
+    assert timings["total_seconds"] > 0 and "_seconds" not in (out / "results.json").read_text()
+
+
+def test_same_seed_same_results_bytes(fast_runs):
+    root, _ = fast_runs
+    assert (root / "a" / "results.json").read_bytes() == (root / "b" / "results.json").read_bytes()
+    assert (root / "a" / "report.md").read_bytes() == (root / "b" / "report.md").read_bytes()
+
+
+def test_report_names_each_methods_baseline(fast_runs):
+    root, _ = fast_runs
+    report = (root / "a" / "report.md").read_text()
+    data = json.loads((root / "a" / "results.json").read_text())
+    named = 0
+    for m in data["methods"]:
+        bases = list(benchmark.baselines_of(m))
+        assert data["baselines"][m] == bases
+        listed, row = [line for line in report.splitlines() if line.startswith(f"| {m} ")]  # methods, case
+        assert listed.split("|")[2].strip().startswith(", ".join(bases) or "-")
+        assert row.split("|")[2].strip() == (", ".join(bases) or "-")
+        for base in bases:
+            named += 1
+            assert f"`{m}` reached the goal first" in report and f"as fast as `{base}`" in report
+            assert f"{base}: " in row.split("|")[10]
+    assert named >= 3
+    # two source seeds: the numbers, but no claim
+    assert "too few pairs for a claim (2 < 10)" in report
+
+
+def test_a_bad_suite_name_is_one_line_listing_the_suites(tmp_path, capsys):
+    out = tmp_path / "never"
+    assert main(["benchmark", "--suite", "nope", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "unknown suite 'nope'" in err
+    for name in suites.SUITES:
+        assert name in err
+    assert not out.exists()
+
+
+def test_a_used_output_directory_is_refused_before_any_work(tmp_path, capsys):
+    (tmp_path / "keep.txt").write_text("x")
+    assert main(["benchmark", "--suite", "fast", "--out", str(tmp_path)]) == 2
+    assert "not empty" in capsys.readouterr().err
+    assert [p.name for p in tmp_path.iterdir()] == ["keep.txt"]
+
+
+def test_suites_are_versioned_and_marked_held_out_or_not():
+    for s in suites.SUITES.values():
+        assert s.version >= 1 and s.sections
+    assert not suites.get("dev").held_out and not suites.get("fast").held_out
+    standard = suites.get("standard")
+    assert standard.held_out
+    assert [x.name for x in standard.sections] == ["paper", "random", "embodiment", "wind"]
+    assert all(x.source_seeds >= 10 for x in standard.sections)
+    held = {c for x in standard.sections for c in x.cases}
+    dev = suites.get("dev").sections[0]
+    assert not {c for c in dev.cases if c.task is not None} & held
+    # a drawn case of dev draws other tasks than the held-out one of the same robots
+    fine, coarse = grid_robot("fine"), grid_robot("coarse")
+    for ci, case in enumerate(dev.cases):
+        if case.task is None:
+            rs = next(x for x in standard.sections if case in x.cases)
+            hi = rs.cases.index(case)
+            ours = [benchmark.case_cells(case, coarse, fine, 0, dev.name, ci, j) for j in range(5)]
+            theirs = [benchmark.case_cells(case, coarse, fine, 0, rs.name, hi, j) for j in range(5)]
+            assert not set(ours) & set(theirs)
+    with pytest.raises(InvalidParameterError, match="valid suites: paper, random"):
+        suites.get("Standard")
+
+
+def test_kaplan_meier_matches_a_hand_computed_example():
+    # reached at 3, 5, 5, 8; unreached (censored) at the cap 10 twice... and one censored at 6
+    # is not expressible with one cap, so: 3, 5, 5, 8 reached, two censored at 10.
+    km = survival.kaplan_meier([3, 5, 5, 8, None, None], cap=10)
+    # at 3: 5/6; at 5: two of five at risk -> 5/6 * 3/5 = 1/2; at 8: one of three -> 1/2 * 2/3 = 1/3
+    assert km["times"] == [3.0, 5.0, 8.0, 10.0]
+    assert km["survival"] == pytest.approx([5 / 6, 1 / 2, 1 / 3, 1 / 3])
+    assert km["median"] == 5.0 and not km["median_beyond_cap"]
+    lo, hi = km["median_ci95"]
+    assert lo == 3.0 and hi is None  # the upper band never falls to one half within the data
+    assert km["n"] == 6 and km["events"] == 4
+
+
+def test_kaplan_meier_of_all_reached_trials_stays_within_the_data():
+    km = survival.kaplan_meier([30, 10, 20, 40], cap=1000)
+    assert km["survival"][-1] == 0.0 and km["median"] == 20.0
+    lo, hi = km["median_ci95"]
+    assert 10.0 <= lo <= 20.0 <= hi <= 40.0
+
+
+def test_kaplan_meier_of_mostly_unreached_trials_has_no_median():
+    km = survival.kaplan_meier([4, None, None], cap=100)
+    assert km["median"] is None and km["median_beyond_cap"]
+    assert survival.kaplan_meier([None, None], cap=100)["median"] is None
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_intervals_stay_within_the_datas_range(seed):
+    rng = np.random.default_rng(seed)
+    x = rng.lognormal(3, 2, size=8)  # skewed, as step counts are
+    for stat in (np.mean, np.median):
+        lo, hi = survival.bootstrap_ci(x, stat)
+        assert x.min() <= lo <= stat(x) <= hi <= x.max()
+    mean, ci = metrics.mean_ci(list(x))
+    assert x.min() <= ci[0] <= mean <= ci[1] <= x.max()
+    r = survival.ratio_summary(np.log(x / x.mean()))
+    ratios = x / x.mean()
+    assert ratios.min() == pytest.approx(r["worst"]) and r["ci95"][0] >= r["worst"] - 1e-12
+    assert r["ci95"][1] <= ratios.max() + 1e-12 and r["ci95"][0] > 0
+
+
+def test_bootstrap_is_deterministic_and_handles_small_samples():
+    x = [5.0, 9.0, 1.0, 40.0]
+    assert survival.bootstrap_ci(x) == survival.bootstrap_ci(x)
+    assert survival.bootstrap_ci([3.0]) is None
+    assert survival.bootstrap_ci([2.0, 2.0, 2.0]) == [2.0, 2.0]
+
+
+def _rec(method, seed, fe, cap=1000, case=0, baseline="none"):
+    return {"section": "s", "case": case, "label": "c", "method": method, "baselines": [] if method == "none"
+            else [baseline], "source_seed": seed, "cap": cap, "budget": 100, "optimal": 10, "error": None,
+            "first_exposure": fe, "convergence_steps": [None] * len(fe), "area": [float(v or cap) for v in fe],
+            "curves": [[float(v or cap)] * 3 for v in fe]}
+
+
+def test_paired_factor_is_per_source_seed():
+    recs = []
+    for seed in range(10):
+        base = [100 * (seed + 1), 300 * (seed + 1)]
+        recs += [_rec("none", seed, base), _rec("pseudo", seed, [v // 4 for v in base])]
+    out = benchmark_stats.summarize(recs)
+    ab = out["s"]["cases"][0]["methods"]["pseudo"]["against"]["none"]
+    assert ab["factor"] == pytest.approx(4.0) and ab["ci95"] == pytest.approx([4.0, 4.0])
+    assert ab["transfer_ratio"] == pytest.approx(0.75)
+    # no trial converged in either: every convergence median is the cap, a bound and no gain
+    assert ab["convergence"]["factor"] == 1.0 and ab["convergence"]["seeds_with_censored_median"] == 10
+    pooled = out["s"]["pooled"]["pseudo"]["none"]
+    assert pooled["baseline"] == "none" and pooled["n"] == 10
+    assert benchmark_report.judgement(pooled) == "faster than its baseline"
+    text = benchmark_report.sentence("pseudo", pooled, "s")
+    assert "4.00x [4.00x, 4.00x] as fast as `none`" in text and "settled 1.00x" in text
+    assert "In 10 pairs a median convergence was at the step cap" in text
+
+
+def test_failures_are_counted_and_censored_medians_flagged():
+    recs = [_rec("none", s, [100, 200]) for s in range(10)]
+    recs += [_rec("pseudo", s, [None, None] if s < 3 else [50, 100]) for s in range(10)]
+    e = benchmark_stats.summarize(recs)["s"]["cases"][0]["methods"]["pseudo"]
+    assert e["failure_rate"] == pytest.approx(6 / 20)
+    assert e["first_exposure"]["worst_seed"] == 1000 and e["first_exposure"]["worst_seed_is_lower_bound"]
+    assert e["against"]["none"]["seeds_with_censored_median"] == 3
+    assert e["against"]["none"]["worst"] == pytest.approx(150 / 1000)
+    sentence = benchmark_report.sentence("pseudo", dict(e["against"]["none"], baseline="none"), "s")
+    assert "3 pairs a median first exposure was at the step cap" in sentence
+
+
+def test_an_interval_spanning_one_makes_no_claim():
+    ab = {"factor": 1.2, "ci95": [0.8, 1.7], "n": 10, "worst": 0.5, "baseline": "none"}
+    assert benchmark_report.judgement(ab).startswith("cannot be told apart")
+
+
+def test_baseline_comes_from_the_registry_when_it_names_one(monkeypatch):
+    class Named:
+        baselines = ("pseudo", "dense")
+
+    class Unnamed:
+        pass
+
+    assert benchmark.baseline_of("none") is None
+    monkeypatch.setitem(methods.METHODS, "guided", Named())
+    monkeypatch.setitem(methods.METHODS, "dense", Unnamed())
+    assert benchmark.baselines_of("guided") == ("pseudo", "dense") and benchmark.registered_baseline("guided")
+    assert benchmark.baselines_of("dense") == ("none",) and not benchmark.registered_baseline("dense")
+    ran, _ = benchmark.methods_to_run(("guided",))
+    assert ran == ["none", "pseudo", "dense", "guided"]  # and their own baselines
+
+
+def test_drawn_tasks_are_deterministic_and_long_enough():
+    fine, coarse = grid_robot("fine"), grid_robot("coarse")
+    draws = [benchmark.draw_task(coarse, fine, np.random.default_rng(7)) for _ in range(2)]
+    assert draws[0] == draws[1]
+    start, goal = draws[0]
+    paths = [r.shortest_path(r.start_state(start), goal) for r in (fine, coarse)]
+    assert all(p is not None for p in paths) and len(paths[0]) - 1 >= benchmark.MIN_DISTANCE
+    rooms = set()
+    for k in range(30):
+        s, g = benchmark.draw_task(coarse, fine, np.random.default_rng(k))
+        rooms |= {fine.layout.room_of(*fine.layout.xy(s)), fine.layout.room_of(*fine.layout.xy(g))}
+    assert rooms == {1, 2, 3, 4}
+    assert math.isfinite(benchmark.run_seed(0, "paper", 0, 0))
+
+
+def test_a_source_that_does_not_converge_is_counted_not_dropped(monkeypatch):
+    from dataclasses import replace
+
+    from armtransfer.experiments import experiment
+
+    def never(*args, **kwargs):
+        raise InvalidParameterError("did not converge")
+
+    monkeypatch.setattr(experiment, "source_trajectory", never)
+    section = replace(suites.FAST, source_seeds=1, trials=1, max_total_steps=50_000)
+    records, _ = benchmark.run_suite(suites.Suite("t", 1, False, "", (section,)), threads=1)
+    by = {r["method"]: r for r in records}
+    assert set(by) == set(benchmark.methods_to_run()[0])
+    for name, rec in by.items():
+        m = methods.get(name)
+        if m.shaped and getattr(m, "uses_trajectory", True):
+            assert rec["error"].startswith("no trajectory: robot 1 (coarse) did not converge")
+            assert rec["first_exposure"] == [None]
+        else:  # none (and a baseline that reads no trajectory) still runs
+            assert rec["error"] is None and rec["episodes"][0] > 0
+    stats = benchmark_stats.summarize(records)["fast"]["cases"][0]["methods"]
+    assert stats["pseudo"]["failure_rate"] == 1.0 and stats["pseudo"]["errors"]
