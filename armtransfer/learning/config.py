@@ -8,6 +8,7 @@ all made from these fields, so a new parameter is one field here.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import asdict, dataclass, field, fields
 
 from armtransfer.errors import InvalidParameterError
@@ -48,9 +49,12 @@ class LearnerConfig:
             value = getattr(self, f.name)
             lo, hi, lo_open = f.metadata["lo"], f.metadata["hi"], f.metadata["lo_open"]
             integer = f.type in (int, "int")
-            ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+            ok = isinstance(value, numbers.Real) and not isinstance(value, bool) and math.isfinite(value)
             if integer:
                 ok = ok and float(value).is_integer()
+            if ok:  # numpy scalars are numbers too; the config holds Python ones
+                value = int(value) if integer else float(value)
+                object.__setattr__(self, f.name, value)
             ok = ok and (value > lo if lo_open else value >= lo) and value <= hi and (f.name != "trace_cutoff" or value < 1)
             if not ok:
                 want = "an integer >= 1" if integer else (

@@ -13,6 +13,7 @@ configuration of every state, to replay paths with the position servos), ``tip``
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 import time
@@ -20,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+import armtransfer.checks as checks
 from armtransfer.ik import cache as _cache
 from armtransfer.ik.actions import ACTION_MODELS, action_model
 from armtransfer.ik.description import ArmDescription
@@ -32,6 +34,9 @@ from armtransfer.ik.workspace import DEFAULT_CELL, WALL_HEIGHT
 
 SIDECAR_FORMAT = "armtransfer-generated-arm/1"
 """The JSON ``armtransfer arms generate`` writes beside an arm: its mount and tool."""
+MAX_METRES = 100.0
+"""The largest size of a cell, tool offset or base position in metres: far past any arm on a
+table, small enough that the scene's numbers stay well inside MuJoCo's and mink's range."""
 COVERS = 0.95
 """A mount beside the table whose reach estimate is at least this share (with every Table I
 cell reached) is taken without trying mounts on the table."""
@@ -134,12 +139,29 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
     bring-your-own arm keeps its tool pointing down unless ``tip_down=False``.
     """
     model = action_model(actions)
-    if not (np.isfinite(cell_size) and cell_size > 0):
-        raise ArmModelError(f"cell size must be a positive number of metres, got {cell_size}")
-    if base_yaw is not None and not np.isfinite(base_yaw):
-        raise ArmModelError(f"the base yaw must be a finite number of radians, got {base_yaw!r}")
+    cell_size = checks.real(cell_size, "the cell size (metres)", 0.0, MAX_METRES, lo_open=True, error=ArmModelError)
+    if base_yaw is not None:
+        base_yaw = checks.real(base_yaw, "the base yaw (radians)", error=ArmModelError)
+    if base_pos is not None:
+        base_pos = checks.point(base_pos, "the base position (metres)", limit=MAX_METRES, error=ArmModelError)
+    if joint_step is not None:
+        joint_step = checks.real(joint_step, "the joint step (radians)", 0.0, math.pi, lo_open=True,
+                                 error=ArmModelError)
+    if tip_down is not None:
+        tip_down = checks.flag(tip_down, "tip_down", error=ArmModelError)
+    cache = checks.flag(cache, "cache", error=ArmModelError)
+    if xml_path is None:
+        given = [k for k, v in (("tip_site", tip_site), ("tip_body", tip_body), ("tip_offset", tip_offset),
+                                ("arm_name", arm_name)) if v is not None]
+        if given:
+            raise ArmModelError(f"{given[0]} goes with an arm file (xml_path), not the built-in arm {arm!r}")
     if xml_path is not None:
-        path = Path(xml_path)
+        path = Path(checks.path(xml_path, "the arm file (xml_path)", error=ArmModelError))
+        if tip_offset is not None:
+            tip_offset = checks.point(tip_offset, "the tip offset (metres)", limit=MAX_METRES, error=ArmModelError)
+        for what, value in (("tip_site", tip_site), ("tip_body", tip_body), ("arm_name", arm_name)):
+            if value is not None:
+                checks.name(value, what, error=ArmModelError)
         try:
             xml_bytes = path.read_bytes()
         except OSError as err:
