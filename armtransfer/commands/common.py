@@ -149,6 +149,36 @@ def transfer_kwargs(args: argparse.Namespace) -> dict:
     )
 
 
+def _flag(action: argparse.Action) -> str:
+    return action.option_strings[-1] if action.option_strings else action.metavar or action.dest
+
+
+def options_of(args: argparse.Namespace) -> list[argparse.Action]:
+    """The options and positionals of the parser that made ``args`` (none without one)."""
+    parser = getattr(args, "_parser", None)
+    return [a for a in (parser._actions if parser else []) if a.dest not in ("help", argparse.SUPPRESS)]
+
+
+def refuse_empty(args: argparse.Namespace) -> None:
+    """An empty or blank value is an error, never "not given" (``--json ''`` wrote nothing)."""
+    for action in options_of(args):
+        value = getattr(args, action.dest, None)
+        values = value if isinstance(value, list) else [value]
+        if any(isinstance(v, str) and not v.strip() for v in values):
+            raise InvalidParameterError(f"{_flag(action)} must not be empty")
+
+
+def refuse_other_options(args: argparse.Namespace, allowed: set[str], mode: str) -> None:
+    """Options given (different from their default) that ``mode`` does not use are an error
+    listing the options it does use, instead of being silently ignored."""
+    actions = options_of(args)
+    for action in actions:
+        if action.option_strings and action.dest not in allowed \
+                and getattr(args, action.dest, action.default) != action.default:
+            valid = ", ".join(_flag(a) for a in actions if a.dest in allowed and a.option_strings)
+            raise InvalidParameterError(f"{_flag(action)} does not apply to {mode}; its options: {valid}")
+
+
 def interactive() -> bool:
     """Progress output only on a terminal."""
     return sys.stderr.isatty()
