@@ -84,7 +84,7 @@ def transfer(
     baselines = checks.flag(baselines, "baselines")
     if baselines:
         method_names = registry.with_baselines(method_names)
-    trials = checks.whole(trials, "trials", 1)
+    trials = checks.whole(trials, "trials", 1, checks.MAX_TRIALS)
     seed = checks.whole(seed, "seed", 0)
     wind = checks.probability(wind, "wind")
     max_span = checks.whole(max_span, "max_span", 1)

@@ -19,6 +19,13 @@ MAX_COUNT = 10**12
 """The largest count (steps, episodes, trials, ...) any argument may name: far past any run
 this machine finishes, and well inside a 64-bit integer, so no count overflows downstream."""
 
+MAX_TRIALS = 100_000
+"""The most trials one run may have (each trial's results are kept in memory)."""
+MAX_METRES = 100.0
+"""The largest length in metres an arm's scene takes (a cell size, tool offset or base
+position): far past any arm on a table, small enough that the scene's numbers stay well
+inside MuJoCo's and mink's range (a tool offset of 1e300 overflowed in the IK)."""
+
 ErrorType = type[ArmTransferError]
 
 

@@ -7,6 +7,7 @@ import math
 import sys
 from dataclasses import fields
 
+from armtransfer.checks import MAX_COUNT
 from armtransfer.errors import ArmModelError, InvalidParameterError, InvalidTaskError
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.tasks.catalog import parse_xy
@@ -15,11 +16,11 @@ from armtransfer.tasks.catalog import parse_xy
 def _integer_at_least(lo: int, what: str):
     def parse(text: str) -> int:
         try:
-            value = int(text)
+            value = int(text) if len(text) <= 40 else None  # no 10,000-digit number is parsed
         except ValueError:
-            raise argparse.ArgumentTypeError(f"must be {what}, got {text!r}") from None
-        if value < lo:
-            raise argparse.ArgumentTypeError(f"must be {what}, got {text!r}")
+            value = None
+        if value is None or not lo <= value <= MAX_COUNT:
+            raise argparse.ArgumentTypeError(f"must be {what} (at most {MAX_COUNT:,}), got {text[:40]!r}")
         return value
 
     return parse

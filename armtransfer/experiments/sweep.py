@@ -285,6 +285,8 @@ def load(path: str | os.PathLike, max_runs: int = MAX_RUNS) -> Sweep:
         raise SweepFileError(f"cannot read {where}: {err.strerror}") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
         raise SweepFileError(f"{where} is not valid TOML: {str(err).splitlines()[0]}") from None
+    except RecursionError:
+        raise SweepFileError(f"{where} nests too deeply to be a sweep file") from None
     spec = normalise(raw, where, max_runs, base=p.parent)
     return Sweep(spec["name"], spec, tuple(expand(spec)))
 

@@ -34,9 +34,6 @@ from armtransfer.ik.workspace import DEFAULT_CELL, WALL_HEIGHT
 
 SIDECAR_FORMAT = "armtransfer-generated-arm/1"
 """The JSON ``armtransfer arms generate`` writes beside an arm: its mount and tool."""
-MAX_METRES = 100.0
-"""The largest size of a cell, tool offset or base position in metres: far past any arm on a
-table, small enough that the scene's numbers stay well inside MuJoCo's and mink's range."""
 COVERS = 0.95
 """A mount beside the table whose reach estimate is at least this share (with every Table I
 cell reached) is taken without trying mounts on the table."""
@@ -139,11 +136,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
     bring-your-own arm keeps its tool pointing down unless ``tip_down=False``.
     """
     model = action_model(actions)
-    cell_size = checks.real(cell_size, "the cell size (metres)", 0.0, MAX_METRES, lo_open=True, error=ArmModelError)
-    if base_yaw is not None:
-        base_yaw = checks.real(base_yaw, "the base yaw (radians)", error=ArmModelError)
-    if base_pos is not None:
-        base_pos = checks.point(base_pos, "the base position (metres)", limit=MAX_METRES, error=ArmModelError)
+    cell_size, base_pos, base_yaw = _checked_pose(cell_size, base_pos, base_yaw)
     if joint_step is not None:
         joint_step = checks.real(joint_step, "the joint step (radians)", 0.0, math.pi, lo_open=True,
                                  error=ArmModelError)
@@ -158,7 +151,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
     if xml_path is not None:
         path = Path(checks.path(xml_path, "the arm file (xml_path)", error=ArmModelError))
         if tip_offset is not None:
-            tip_offset = checks.point(tip_offset, "the tip offset (metres)", limit=MAX_METRES, error=ArmModelError)
+            tip_offset = checks.point(tip_offset, "the tip offset (metres)", limit=checks.MAX_METRES, error=ArmModelError)
         for what, value in (("tip_site", tip_site), ("tip_body", tip_body), ("arm_name", arm_name)):
             if value is not None:
                 checks.name(value, what, error=ArmModelError)
@@ -252,6 +245,17 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
         layout=layout,
         arm=description,
     )
+
+
+def _checked_pose(cell_size, base_pos, base_yaw) -> tuple:
+    """The cell size, base position and yaw checked: finite, in metres up to ``checks.MAX_METRES``."""
+    cell_size = checks.real(cell_size, "the cell size (metres)", 0.0, checks.MAX_METRES, lo_open=True,
+                            error=ArmModelError)
+    if base_yaw is not None:
+        base_yaw = checks.real(base_yaw, "the base yaw (radians)", error=ArmModelError)
+    if base_pos is not None:
+        base_pos = checks.point(base_pos, "the base position (metres)", limit=checks.MAX_METRES, error=ArmModelError)
+    return cell_size, base_pos, base_yaw
 
 
 def _builtin_mount(info, cell_size: float) -> tuple[float, float, float]:
@@ -472,6 +476,7 @@ def arm_scene(arm: str | None = None, *, cell_size: float = DEFAULT_CELL, xml_pa
               base_pos=None, base_yaw: float | None = None, layout: Layout = ROOMS):
     """The MuJoCo scene (``ik.scene.ArmScene``) a robot of this arm is compiled in (a
     bring-your-own arm without ``base_pos`` at the origin)."""
+    cell_size, base_pos, base_yaw = _checked_pose(cell_size, base_pos, base_yaw)
     if xml_path is not None:
         return _scene(Path(xml_path), make_tool(tip_site, tip_body, tip_offset), base_pos or (0.0, 0.0, 0.0),
                       base_yaw or 0.0, cell_size, layout)
