@@ -33,7 +33,7 @@ from armtransfer.tasks.layout import ROOMS
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.experiments import experiment, figures
 from armtransfer.tasks.specs import CUSTOM, resolve
-from armtransfer.io import check_writable, copy_atomic, staged_directory, write_json_atomic, write_text_atomic
+from armtransfer.io import check_distinct_outputs, check_writable, copy_atomic, staged_directory, write_json_atomic, write_text_atomic
 
 DEFAULT_SOURCE = "planar2:joint"
 DEFAULT_TARGET = "ur5e_like:cartesian"
@@ -84,6 +84,8 @@ def _fast_overrides(args: argparse.Namespace) -> dict:
 def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     out = Path(args.out) if args.out else Path("runs") / _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    check_distinct_outputs({"--json": args.json, "--render": args.render, "--mapping": args.mapping},
+                           {"--out": out})
     for extra in (args.json, args.render):
         if extra:
             check_writable(extra)

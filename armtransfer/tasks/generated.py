@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from armtransfer.errors import ArmModelError, ArmTransferError
-from armtransfer.io import staged_directory, write_json_atomic, write_text_atomic
+from armtransfer.io import check_output_dir, staged_directory, write_json_atomic, write_text_atomic
 from armtransfer.ik.workspace import DEFAULT_CELL
 from armtransfer.models.generate import ArmDraw, check_family, draw_arm, planar_tip_cells, with_home
 from armtransfer.tasks.arms import SIDECAR_FORMAT, read_sidecar
@@ -60,6 +60,7 @@ def generate_arm(family: str, dof: int, seed: int, out_dir: str | os.PathLike, *
         raise ArmModelError(f"seed must be an integer >= 0, got {seed!r}")
     name = arm_name(family, dof, seed)
     final = Path(out_dir) / name
+    check_output_dir(final, "--out")  # before the draws, not after
     rng = np.random.default_rng(seed)
     rejected: list[str] = []
     with tempfile.TemporaryDirectory(prefix="armgen-") as work:
