@@ -225,6 +225,54 @@ def _load_arm(path: Path) -> tuple[mujoco.MjSpec, mujoco.MjModel]:
     return spec, model
 
 
+def model_files(path: Path) -> list[Path]:
+    """Every file MuJoCo reads to build the arm file's model: the file itself, the files it
+    ``<include>``s (recursively), and the meshes, textures, height fields and skins its
+    parsed spec names, each resolved as MuJoCo resolves it (``meshdir``/``texturedir``
+    relative to the model file). Files that are missing are listed too: their absence is
+    part of what the model is. Nothing else is read, whatever the folders hold."""
+    path = Path(path)
+    files = [path, *_includes(path, path.parent, set())]
+    with _mujoco_warnings(), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            spec = mujoco.MjSpec.from_file(str(path))
+        except Exception as err:  # noqa: BLE001 - any parse failure is a bad input file
+            raise ArmModelError(f"cannot load arm MJCF {str(path)!r}: {_first_line(err)}") from None
+    base = Path(spec.modelfiledir or path.parent)
+    named = [(spec.meshdir, m.file) for m in spec.meshes] + [(spec.texturedir, t.file) for t in spec.textures]
+    named += [(spec.texturedir, f) for t in spec.textures for f in getattr(t, "cubefiles", ()) if f]
+    named += [(spec.meshdir, h.file) for h in spec.hfields] + [(spec.meshdir, k.file) for k in spec.skins]
+    for folder, name in named:
+        if name:
+            files.append(base / (folder or "") / name)
+    seen: set[Path] = set()
+    return [f for f in files if not (f in seen or seen.add(f))]
+
+
+def _includes(path: Path, root: Path, seen: set[Path]) -> list[Path]:
+    """The files ``path`` includes, recursively (relative names from the main file's folder)."""
+    import xml.etree.ElementTree as ET
+
+    out: list[Path] = []
+    try:
+        tree = ET.parse(path)
+    except (ET.ParseError, OSError):
+        return out  # MuJoCo's own parse says what is wrong
+    for element in tree.iter("include"):
+        name = element.get("file")
+        if not name:
+            continue
+        found = root / name
+        if found in seen:
+            continue
+        seen.add(found)
+        out.append(found)
+        if found.is_file():
+            out.extend(_includes(found, root, seen))
+    return out
+
+
 def _name(model: mujoco.MjModel, obj: mujoco.mjtObj, i: int) -> str:
     return mujoco.mj_id2name(model, obj, i) or ""
 

@@ -19,6 +19,7 @@ spec anywhere: ``out_dir/<name>/<name>.xml:cartesian`` (its mount is read from t
 from __future__ import annotations
 
 import os
+import shutil
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -178,6 +179,14 @@ def resolve_generated(spec: str, progress: bool = False):
     name = arm_name(family, dof, seed)
     root = cache_dir() / "generated"
     xml = root / name / f"{name}.xml"
-    if not xml.is_file():
+    try:
+        generated = read_sidecar(xml) if xml.is_file() else None
+    except ArmModelError:
+        generated = None
+    if generated is None:  # never made, or its files were changed or lost: drawn again (the same arm)
+        if os.path.lexists(root / name):
+            shutil.rmtree(root / name) if (root / name).is_dir() and not (root / name).is_symlink() \
+                else (root / name).unlink()
         generate_arm(family, dof, seed, root, progress=progress)
-    return robot_of(xml, read_sidecar(xml), actions, progress=progress)
+        generated = read_sidecar(xml)
+    return robot_of(xml, generated, actions, progress=progress)
