@@ -80,3 +80,20 @@ def test_a_finished_out_is_not_written_again(tmp_path, monkeypatch, capsys):
     capsys.readouterr()
     err = _refused([*FAST_ARMS, "--out", "D"], tmp_path, monkeypatch, capsys)
     assert "exists and is not empty" in err
+
+
+def test_the_same_sweep_writes_the_same_run_files(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "s.toml").write_text('[sweep]\nname = "d"\ntasks = [1]\npairs = [["coarse", "fine"]]\n'
+                                     'methods = ["none", "pseudo"]\nseeds = [0, 1]\ntrials = 1\n'
+                                     'trajectory = "optimal"\nmax_episodes = 30\n')
+    stores = []
+    for name in ("a", "b"):
+        assert main(["sweep", "s.toml", "--out", name, "--workers", "1"]) == 0
+        stores.append({p.relative_to(tmp_path / name): p.read_bytes()
+                       for p in (tmp_path / name).rglob("*") if p.is_file() and p.name != ".lock"})
+    runs = [{k: v for k, v in s.items() if k.parts[0] != "timings"} for s in stores]
+    assert runs[0] == runs[1] and len([k for k in runs[0] if k.parts[0] == "runs"]) == 4
+    timings = sorted(k for k in stores[0] if k.parts[0] == "timings")
+    assert [t.name for t in timings] == sorted(k.name for k in runs[0] if k.parts[0] == "runs")
+    assert b"elapsed_seconds" not in b"".join(runs[0].values())
