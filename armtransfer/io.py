@@ -148,27 +148,45 @@ def _process_start(pid: int) -> str | None:
     return stat.rpartition(")")[2].split()[19]
 
 
+def _running(pid: int, start: str) -> bool:
+    """Whether process ``pid`` that started at ``start`` still runs (a pid taken again by a
+    later process does not count; without /proc the pid alone is asked)."""
+    if start != "None":
+        return _process_start(pid) == start
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:
+        return True
+    return True
+
+
 def _mark_owner(tmp: Path) -> None:
     pid = os.getpid()
     (tmp / OWNER).write_text(f"{pid} {_process_start(pid)}\n")
 
 
 def clean_stale_staging(out: str | os.PathLike) -> list[Path]:
-    """Remove the staging directories of ``out`` whose run is gone (killed before it could
-    clean up); returns them. One whose process is alive is left alone."""
+    """Remove the staging directories beside ``out`` whose run is gone (killed before it could
+    clean up); returns them. A staging directory names its owner (:data:`OWNER`): one of any
+    output whose owner is no longer running is removed, one whose owner runs is left alone,
+    and one of ``out`` itself without an owner file (a run killed before it wrote it) is
+    removed once it is :data:`STALE_SECONDS` old."""
     out = Path(out)
     removed = []
-    for tmp in out.parent.glob(f".{glob_escape(out.name)}.*{STAGING_SUFFIX}"):
+    for tmp in out.parent.glob(f".*{STAGING_SUFFIX}"):
         if not tmp.is_dir() or tmp.is_symlink():
             continue
         try:
             pid, start = (tmp / OWNER).read_text().split()
-            alive = _process_start(int(pid)) == start
+            stale = not _running(int(pid), start)
         except (OSError, ValueError):
-            alive = False  # no owner yet: a run killed before it wrote one, or a foreign folder
-            if time.time() - tmp.stat().st_mtime < STALE_SECONDS:
-                continue
-        if not alive:
+            try:
+                stale = tmp.name.startswith(f".{out.name}.") and time.time() - tmp.stat().st_mtime > STALE_SECONDS
+            except OSError:
+                stale = False
+        if stale:
             shutil.rmtree(tmp, ignore_errors=True)
             removed.append(tmp)
     return removed
@@ -176,10 +194,6 @@ def clean_stale_staging(out: str | os.PathLike) -> list[Path]:
 
 STALE_SECONDS = 60.0
 """A staging directory without an owner file is taken for a killed run's after this long."""
-
-
-def glob_escape(name: str) -> str:
-    return "".join(f"[{c}]" if c in "*?[" else c for c in name)
 
 
 def check_distinct_outputs(files: dict[str, object], dirs: dict[str, object] | None = None) -> None:
