@@ -146,3 +146,49 @@ def test_a_living_run_keeps_its_staging(tmp_path):
     foreign = tmp_path / ".notes.tmp"
     foreign.mkdir()  # not a staging folder of ours: no owner, another name
     assert clean_stale_staging(tmp_path / "A") == [] and foreign.is_dir()
+
+
+def test_an_address_that_is_not_ray_is_named_at_once(tmp_path, monkeypatch, capsys):
+    pytest.importorskip("ray")
+    import http.server
+    import threading
+
+    from armtransfer.cli import main
+
+    class Quiet(http.server.SimpleHTTPRequestHandler):
+        def log_message(self, *args):
+            pass
+
+    server = http.server.HTTPServer(("127.0.0.1", 0), Quiet)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    try:
+        monkeypatch.chdir(tmp_path)
+        (tmp_path / "s.toml").write_text(SWEEP.format(seeds=[0]))
+        t0 = time.monotonic()
+        code = main(["sweep", "s.toml", "--out", "store", "--executor", "ray", "--address",
+                     f"127.0.0.1:{server.server_address[1]}"])
+        assert code == 2 and time.monotonic() - t0 < 30
+    finally:
+        server.shutdown()
+        server.server_close()
+    err = capsys.readouterr().err
+    assert "is not Ray (it answered '" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "store").exists()
+
+
+@pytest.mark.slow
+def test_a_killed_ray_sweep_takes_its_local_ray_with_it(tmp_path):
+    pytest.importorskip("ray")
+    (tmp_path / "s.toml").write_text(SWEEP.format(seeds=list(range(20))))
+    proc = start(["sweep", "s.toml", "--out", "store", "--executor", "ray", "--workers", "1"], tmp_path)
+    try:
+        deadline = time.time() + 180
+        while time.time() < deadline and len(session(proc.pid)) < 6:  # the driver and Ray's own processes
+            time.sleep(0.2)
+        assert len(session(proc.pid)) >= 6, "Ray never started"
+        time.sleep(2)
+        os.kill(proc.pid, signal.SIGKILL)  # the driver only
+        proc.wait()
+    finally:
+        left = settle(proc.pid, 30)
+    assert left == [], "Ray's processes outlived the killed sweep"

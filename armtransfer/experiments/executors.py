@@ -204,10 +204,45 @@ def _check_reachable(address: str) -> None:
     import socket
 
     try:
-        with socket.create_connection((host or "127.0.0.1", port_number), timeout=RAY_CONNECT_TIMEOUT):
-            pass
+        with socket.create_connection((host or "127.0.0.1", port_number), timeout=RAY_CONNECT_TIMEOUT) as conn:
+            answer = _http2_answer(conn)
     except OSError as err:
         raise ExecutorError(f"cannot reach Ray at {address!r}: {err.strerror or err}") from None
+    if answer is not None:
+        raise ExecutorError(f"what answers at {address!r} is not Ray ({answer}); give the address of a Ray "
+                            "head node (HOST:6379, or ray://HOST:10001 for Ray Client)")
+
+
+HTTP2_PREFACE = b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n" + b"\x00\x00\x00\x04\x00\x00\x00\x00\x00"
+"""What an HTTP/2 client sends first: the connection preface and an empty SETTINGS frame."""
+
+
+def _http2_answer(conn) -> str | None:
+    """None when the server on ``conn`` speaks HTTP/2 (gRPC, as Ray's head node and Ray Client
+    do: its first frame is a SETTINGS frame), else what it said instead, in a few words."""
+    conn.settimeout(RAY_ANSWER_TIMEOUT)
+    try:
+        conn.sendall(HTTP2_PREFACE)
+        head = b""
+        while len(head) < 9:
+            chunk = conn.recv(9 - len(head))
+            if not chunk:
+                break
+            head += chunk
+    except TimeoutError:
+        return f"it said nothing within {RAY_ANSWER_TIMEOUT:g} s"
+    except OSError as err:
+        return f"it closed the connection: {err.strerror or err}"
+    if len(head) == 9 and head[3] == 0x04:  # a frame header whose type is SETTINGS
+        return None
+    if not head:
+        return "it closed the connection without a word"
+    text = "".join(ch if ch.isprintable() else " " for ch in head.decode("latin-1")).strip()
+    return f"it answered {text!r}..." if text else "it answered in bytes that are not HTTP/2"
+
+
+RAY_ANSWER_TIMEOUT = 5.0
+"""Seconds to wait for the server at a Ray address to answer an HTTP/2 preface."""
 
 
 def run_ray(
@@ -219,15 +254,24 @@ def run_ray(
     Each robot is put in Ray's object store once and shared by every task that needs it."""
     ray = _import_ray()
     started_here = False
+    reaper = None
     if not ray.is_initialized():
         try:
             if address:
                 _check_reachable(address)
                 ray.init(address=address, log_to_driver=False, configure_logging=False)
-            else:
+            else:  # a local instance: its processes are stopped with the sweep, even a killed one
+                from armtransfer.experiments.reaper import Reaper, children_of
+
+                reaper = Reaper()
+                before = children_of(os.getpid())
                 ray.init(num_cpus=workers or os.cpu_count(), include_dashboard=False,
                          log_to_driver=False, configure_logging=False)
+                reaper.watch(children_of(os.getpid()) - before)
         except Exception as err:  # noqa: BLE001 - one line for the user
+            if reaper is not None:  # whatever the failed start left running goes
+                reaper.watch(children_of(os.getpid()) - {reaper.proc.pid})
+                reaper.close(stop=True)
             raise ExecutorError(f"cannot start or reach Ray ({address or 'local'}): {err}".splitlines()[0]) from None
         started_here = True
     try:
@@ -252,6 +296,8 @@ def run_ray(
     finally:
         if started_here:
             ray.shutdown()
+        if reaper is not None:
+            reaper.close()
 
 
 class _RobotRefs(dict):
