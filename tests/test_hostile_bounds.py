@@ -10,27 +10,13 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import armtransfer.checks as checks
-from armtransfer.cli import main
+from contract import refused
 from armtransfer.errors import ArmModelError, ArmTransferError, InvalidParameterError
 from armtransfer.ik.tool import Tool
 from armtransfer.learning.config import LearnerConfig
 
 SETTINGS = settings(max_examples=30, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.function_scoped_fixture])
-
-
-def _refused(argv, tmp_path, monkeypatch, capsys) -> str:
-    monkeypatch.chdir(tmp_path)
-    before = sorted(p.name for p in tmp_path.iterdir())
-    try:
-        code = main(argv)
-    except SystemExit as exc:
-        code = exc.code
-    err = capsys.readouterr().err
-    assert code == 2, f"{argv}: exit {code}: {err}"
-    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
-    assert sorted(p.name for p in tmp_path.iterdir()) == before
-    return err
 
 
 COUNT_FLAGS = ["--max-episode-steps", "--max-total-steps", "--max-episodes", "--patience", "--trials", "--seed",
@@ -40,7 +26,7 @@ COUNT_FLAGS = ["--max-episode-steps", "--max-total-steps", "--max-episodes", "--
 @SETTINGS
 @given(flag=st.sampled_from(COUNT_FLAGS), value=st.integers(min_value=checks.MAX_COUNT + 1, max_value=10**400))
 def test_a_count_past_any_run_is_refused_before_learning(flag, value, tmp_path, monkeypatch, capsys):
-    _refused(["rooms", flag, str(value), "--json", "o.json"], tmp_path, monkeypatch, capsys)
+    refused(["rooms", flag, str(value), "--json", "o.json"], tmp_path, monkeypatch, capsys)
 
 
 @SETTINGS
@@ -63,7 +49,7 @@ def test_counts_in_range_are_taken_whatever_their_integer_type(field, value, kin
                        st.floats(min_value=checks.MAX_METRES * 1.0001, max_value=1e308),
                        st.floats(max_value=-checks.MAX_METRES * 1.0001, min_value=-1e308)),
        axis=st.integers(0, 2))
-def test_a_tool_offset_far_past_any_arm_is_refused(value, axis):
+def test_a_tool_offset_far_past_any_arm_isrefused(value, axis):
     offset = [0.0, 0.0, 0.0]
     offset[axis] = value
     with pytest.raises(ArmModelError, match="tip offset"):
@@ -74,7 +60,7 @@ def test_a_tool_offset_far_past_any_arm_is_refused(value, axis):
 @given(value=st.floats(min_value=checks.MAX_METRES * 1.0001, max_value=1e308), sign=st.sampled_from([1, -1]))
 def test_a_base_position_far_past_any_table_is_refused_on_the_command_line(value, sign, tmp_path, monkeypatch,
                                                                            capsys, scara_xml):
-    err = _refused(["arms", "list", "--arm", "planar2", "--arm-xml", str(scara_xml), "--tip-site", "pen_tip",
+    err = refused(["arms", "list", "--arm", "planar2", "--arm-xml", str(scara_xml), "--tip-site", "pen_tip",
                     f"--base-pos=0,0,{sign * value!r}"], tmp_path, monkeypatch, capsys)
     assert "base position" in err
 
@@ -82,7 +68,7 @@ def test_a_base_position_far_past_any_table_is_refused_on_the_command_line(value
 @SETTINGS
 @given(hi=st.integers(min_value=5, max_value=10**30))
 def test_a_task_range_is_checked_before_it_is_listed(hi, tmp_path, monkeypatch, capsys):
-    err = _refused(["matrix", "--robots", "coarse,fine", "--tasks", f"1-{hi}", "--out", "m"], tmp_path, monkeypatch,
+    err = refused(["matrix", "--robots", "coarse,fine", "--tasks", f"1-{hi}", "--out", "m"], tmp_path, monkeypatch,
                    capsys)
     assert "unknown task" in err and "valid tasks: 1, 2, 3, 4" in err
 
@@ -93,7 +79,7 @@ def test_a_task_range_is_checked_before_it_is_listed(hi, tmp_path, monkeypatch, 
 def test_deeply_nested_toml_is_one_line(depth, brackets, tmp_path, monkeypatch, capsys):
     body = "[" * depth + "]" * depth if brackets == "[]" else "{a=" * depth + "1" + "}" * depth
     (tmp_path / "deep.toml").write_text(f"[sweep]\nx = {body}\n")
-    err = _refused(["sweep", "deep.toml", "--out", "st"], tmp_path, monkeypatch, capsys)
+    err = refused(["sweep", "deep.toml", "--out", "st"], tmp_path, monkeypatch, capsys)
     assert "nests too deeply" in err or "not valid TOML" in err
     (tmp_path / "deep.toml").unlink()
 

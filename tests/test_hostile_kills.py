@@ -15,6 +15,7 @@ import pytest
 
 from armtransfer.experiments import executors
 from armtransfer.io import clean_stale_staging, staged_directory
+from contract import session, settle
 
 pytestmark = pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc")
 
@@ -26,33 +27,6 @@ methods = ["none"]
 seeds = {seeds}
 trials = 2
 """
-
-
-def session(sid: int) -> list[int]:
-    """Live processes of session ``sid`` (field 6 of /proc/PID/stat)."""
-    out = []
-    for stat in Path("/proc").glob("[0-9]*/stat"):
-        try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
-        except OSError:
-            continue
-        if int(fields[3]) == sid and fields[0] != "Z":
-            out.append(int(stat.parent.name))
-    return out
-
-
-def settle(sid: int, seconds: float = 60.0) -> list[int]:
-    """The session's processes left once they had ``seconds`` to end; any left are killed."""
-    deadline = time.time() + seconds
-    while time.time() < deadline and session(sid):
-        time.sleep(0.2)
-    left = session(sid)
-    for pid in left:
-        try:
-            os.kill(pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
-    return left
 
 
 def start(argv, cwd) -> subprocess.Popen:

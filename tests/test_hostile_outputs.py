@@ -7,22 +7,12 @@ import os
 import pytest
 
 from armtransfer.cli import main
+from contract import refused
 from armtransfer.errors import OutputError
 from armtransfer.io import check_distinct_outputs, staged_directory
 
 FAST_ARMS = ["arms", "--fast", "--no-video", "--source", "coarse", "--target", "fine", "--trajectory", "optimal",
              "--trials", "1"]
-
-
-def _refused(argv, tmp_path, monkeypatch, capsys) -> str:
-    monkeypatch.chdir(tmp_path)
-    before = sorted(p.name for p in tmp_path.iterdir())
-    code = main(argv)
-    err = capsys.readouterr().err
-    assert code == 2, err
-    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
-    assert sorted(p.name for p in tmp_path.iterdir()) == before
-    return err
 
 
 @pytest.mark.parametrize("extra,message", [
@@ -31,13 +21,13 @@ def _refused(argv, tmp_path, monkeypatch, capsys) -> str:
     (["--render", "D/v.mp4"], "--render"),
     (["--method", "mapping", "--mapping", "D/map.json"], "--mapping"),
 ])
-def test_an_output_inside_the_output_directory_is_refused(extra, message, tmp_path, monkeypatch, capsys):
-    err = _refused([*FAST_ARMS, "--out", "D", *extra], tmp_path, monkeypatch, capsys)
+def test_an_output_inside_the_output_directory_isrefused(extra, message, tmp_path, monkeypatch, capsys):
+    err = refused([*FAST_ARMS, "--out", "D", *extra], tmp_path, monkeypatch, capsys)
     assert f"{message} " in err and "inside the output directory --out" in err
 
 
-def test_two_outputs_on_one_path_are_refused(tmp_path, monkeypatch, capsys):
-    err = _refused(["rooms", "--method", "mapping", "--mapping", "F", "--json", "./F", "--trials", "1"], tmp_path,
+def test_two_outputs_on_one_path_arerefused(tmp_path, monkeypatch, capsys):
+    err = refused(["rooms", "--method", "mapping", "--mapping", "F", "--json", "./F", "--trials", "1"], tmp_path,
                    monkeypatch, capsys)
     assert "--json and --mapping name the same path" in err
     (tmp_path / "real.json").write_text("{}")
@@ -78,7 +68,7 @@ def test_a_finished_out_is_not_written_again(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert main([*FAST_ARMS, "--out", "D"]) == 0
     capsys.readouterr()
-    err = _refused([*FAST_ARMS, "--out", "D"], tmp_path, monkeypatch, capsys)
+    err = refused([*FAST_ARMS, "--out", "D"], tmp_path, monkeypatch, capsys)
     assert "exists and is not empty" in err
 
 

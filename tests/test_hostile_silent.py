@@ -6,26 +6,11 @@ import json
 
 import pytest
 
-from armtransfer.cli import main
+from contract import refused
 from armtransfer.errors import InvalidTrajectoryError
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.tasks.catalog import table_task
 from armtransfer.tasks.grid_robots import grid_robot
-
-
-def refused(argv, tmp_path, monkeypatch, capsys) -> str:
-    """Exit 2 with one line on stderr, no traceback, nothing new in the working folder."""
-    monkeypatch.chdir(tmp_path)
-    before = sorted(p.name for p in tmp_path.iterdir())
-    try:
-        code = main(argv)
-    except SystemExit as exc:
-        code = exc.code
-    err = capsys.readouterr().err
-    assert code == 2, f"{argv}: exit {code}: {err}"
-    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
-    assert sorted(p.name for p in tmp_path.iterdir()) == before, f"{argv} wrote something"
-    return err
 
 
 @pytest.mark.parametrize("argv,flag", [
