@@ -112,3 +112,10 @@ def test_mujoco_xml_errors_keep_their_detail_and_leave_no_log(tmp_path, monkeypa
     err = refused(["arms", "list", "--arm", "planar2", "--arm-xml", "nan.xml"], tmp_path, monkeypatch, capsys)
     assert "not finite" in err and "NaN" in err
     assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+
+
+def test_a_ray_address_without_ray_is_refused(tmp_path, monkeypatch, capsys):
+    (tmp_path / "s.toml").write_text('[sweep]\ntasks = [1]\nmethods = ["none"]\ntrials = 1\n')
+    err = refused(["sweep", "s.toml", "--out", "store", "--address", "127.0.0.1:6379"], tmp_path, monkeypatch,
+                  capsys)
+    assert "--address goes with --executor ray" in err
