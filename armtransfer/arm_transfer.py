@@ -68,7 +68,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def arm_options(args: argparse.Namespace) -> dict:
     """The bring-your-own arm's options (for ``custom[:ACTIONS]`` or its name) and the cell size."""
-    options = dict(cell_size=args.cell_size)
+    options = dict(cell_size=args.cell_size, cache=not args.no_cache)
     if getattr(args, "arm_xml", None):
         options.update(common.arm_file_options(args))
     return options

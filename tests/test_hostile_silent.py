@@ -119,3 +119,9 @@ def test_a_ray_address_without_ray_is_refused(tmp_path, monkeypatch, capsys):
     err = refused(["sweep", "s.toml", "--out", "store", "--address", "127.0.0.1:6379"], tmp_path, monkeypatch,
                   capsys)
     assert "--address goes with --executor ray" in err
+
+
+def test_no_cache_is_honoured_by_a_built_in_arm_spec():
+    from armtransfer.tasks.specs import resolve
+
+    assert resolve("planar2:joint", cache=False).arm.cache == "off"

@@ -13,8 +13,8 @@ EXAMPLE = "armtransfer arms --fast --out runs/demo"
 
 
 ARM_FILE_OPTIONS = {"arm_xml", "tip_site", "tip_body", "tip_offset", "arm_name", "base_pos", "base_yaw", "cell_size"}
-LIST_ONLY = {"arm", "actions", "no_cache"}
-LIST_OPTIONS = LIST_ONLY | ARM_FILE_OPTIONS
+LIST_ONLY = {"arm", "actions"}
+LIST_OPTIONS = LIST_ONLY | ARM_FILE_OPTIONS | {"no_cache"}
 GENERATE_ONLY = {"family", "dof"}
 GENERATE_OPTIONS = GENERATE_ONLY | {"seed", "out"}
 
