@@ -84,7 +84,8 @@ def point(value: object, what: str, n: int = 3, limit: float = math.inf,
             isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(float(v))
             and abs(float(v)) <= limit for v in items):
         bound = f" of size at most {limit:g}" if math.isfinite(limit) else ""
-        raise error(f"{what} must be {n} finite numbers{bound}, got {value!r}")
+        count = {2: "two", 3: "three"}.get(n, str(n))
+        raise error(f"{what} must be {count} finite numbers{bound}, got {value!r}")
     return tuple(float(v) for v in items)
 
 
