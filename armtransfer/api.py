@@ -17,6 +17,7 @@ import numbers
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+import armtransfer.checks as checks
 from armtransfer.errors import InvalidParameterError, InvalidTaskError
 from armtransfer.learning import farming, potentials
 from armtransfer.experiments import experiment
@@ -27,7 +28,7 @@ from armtransfer.learning.mapping import DEFAULT_MAX_SPAN, ActionMapping
 from armtransfer.learning.mapping import load_for as load_mapping
 from armtransfer.experiments.results import MappingInfo, TransferResult
 from armtransfer.learning.trajectory import Trajectory
-from armtransfer.tasks.catalog import Task, custom_task, parse_xy, table_task
+from armtransfer.tasks.catalog import Task, as_xy, custom_task, table_task
 from armtransfer.tasks.layout import ROOMS
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.tasks.specs import resolve
@@ -80,22 +81,35 @@ def transfer(
     method_names = [registry.get(m).name for m in _as_sequence(methods, "methods")]
     if not method_names:
         raise InvalidParameterError(f"give at least one method; valid methods: {', '.join(registry.METHODS)}")
+    baselines = checks.flag(baselines, "baselines")
     if baselines:
         method_names = registry.with_baselines(method_names)
-    trials = _whole(trials, "trials", 1)
-    seed = _whole(seed, "seed", 0)
-    wind = _probability(wind, "wind")
-    max_span = _whole(max_span, "max_span", 1)
+    trials = checks.whole(trials, "trials", 1, checks.MAX_TRIALS)
+    seed = checks.whole(seed, "seed", 0)
+    wind = checks.probability(wind, "wind")
+    max_span = checks.whole(max_span, "max_span", 1)
+    controls = checks.flag(controls, "controls")
+    save_mapping = checks.flag(save_mapping, "save_mapping")
+    if progress is not None and not callable(progress):
+        raise InvalidParameterError(f"progress must be a function called after every trial, got {progress!r}")
+    if not (isinstance(K, str) and K == "auto"):
+        K = checks.real(K, "K", 0.0) if not isinstance(K, str) else _bad_k(K)
+    if beta is not None:
+        beta = checks.real(beta, "beta", 0.0)
+    if arm_xml is not None:
+        arm_xml = checks.path(arm_xml, "arm_xml")
+    options = _arm_options(arm_options)
     specs = list(_as_sequence(trajectory, "trajectory")) if trajectory is not None else ["learned"]
     uses_mapping = any(registry.get(m).macros for m in method_names)
     if mapping is not None and not uses_mapping:
         raise InvalidParameterError("a mapping goes with method 'mapping'")
+    if mapping is not None and not isinstance(mapping, ActionMapping):
+        mapping = checks.path(mapping, "mapping")
     if save_mapping and not isinstance(mapping, (str, Path)):
         raise InvalidParameterError("save_mapping needs the mapping's file path")
 
     the_task = _task(task, start, goal, specs)
     start_cell, goal_cell = the_task.cells()
-    options = dict(arm_options or {})
     src = resolve(source, xml_path=arm_xml, **options)
     tgt = resolve(target, xml_path=arm_xml, **options)
     for robot in (src, tgt):
@@ -190,7 +204,7 @@ def _task(task, start, goal, specs) -> Task:
             raise InvalidTaskError("give either a task or start/goal cells, not both")
         if start is None or goal is None:
             raise InvalidTaskError("start and goal go together")
-        return custom_task(_xy(start, "start"), _xy(goal, "goal"))
+        return custom_task(as_xy(start, "start"), as_xy(goal, "goal"))
     if task is None:
         files = [s for s in specs if isinstance(s, (str, Path)) and s not in TRAJECTORY_KINDS]
         if files:
@@ -202,18 +216,6 @@ def _task(task, start, goal, specs) -> Task:
     return table_task(int(task))
 
 
-def _xy(value, what: str) -> tuple[int, int]:
-    if isinstance(value, str):
-        return parse_xy(value, what)
-    try:
-        x, y = value
-    except (TypeError, ValueError):
-        raise InvalidTaskError(f"{what} must be a cell (x, y), got {value!r}") from None
-    if any(isinstance(v, bool) or not isinstance(v, numbers.Integral) for v in (x, y)):
-        raise InvalidTaskError(f"{what} must be a cell of two integers (x, y), got {value!r}")
-    return int(x), int(y)
-
-
 def _as_sequence(value, what: str) -> Sequence:
     if isinstance(value, (str, Path, Trajectory)):
         return [value]
@@ -223,13 +225,22 @@ def _as_sequence(value, what: str) -> Sequence:
         raise InvalidParameterError(f"{what} must be a name or a list of them, got {value!r}") from None
 
 
-def _whole(value, what: str, lo: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < lo:
-        raise InvalidParameterError(f"{what} must be an integer >= {lo}, got {value!r}")
-    return int(value)
+def _bad_k(K: str):
+    raise InvalidParameterError(f"K must be a non-negative number or 'auto', got {K!r}")
 
 
-def _probability(value, what: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0.0 <= float(value) <= 1.0:
-        raise InvalidParameterError(f"{what} must be a probability in [0, 1], got {value!r}")
-    return float(value)
+ARM_OPTIONS = ("tip_site", "tip_body", "tip_offset", "arm_name", "base_pos", "base_yaw", "cell_size", "joint_step",
+               "tip_down", "cache")
+"""The keys of ``arm_options``: how an arm file is mounted and where its tool point is."""
+
+
+def _arm_options(arm_options) -> dict:
+    """``arm_options`` checked: a dict of :data:`ARM_OPTIONS` keys (the arm's own checks follow)."""
+    if arm_options is None:
+        return {}
+    if not isinstance(arm_options, dict):
+        raise InvalidParameterError(f"arm_options must be a dict of {', '.join(ARM_OPTIONS)}, got {arm_options!r}")
+    unknown = sorted(str(k) for k in arm_options if k not in ARM_OPTIONS)
+    if unknown:
+        raise InvalidParameterError(f"unknown arm option {unknown[0]!r}; valid options: {', '.join(ARM_OPTIONS)}")
+    return dict(arm_options)

@@ -27,12 +27,13 @@ from pathlib import Path
 from armtransfer import api
 from armtransfer.commands import common
 from armtransfer.commands.rooms import print_results, results_table
-from armtransfer.errors import InvalidParameterError
+from armtransfer.learning import trajectory as trajectories
+from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.layout import ROOMS
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.experiments import experiment, figures
 from armtransfer.tasks.specs import CUSTOM, resolve
-from armtransfer.io import check_writable, copy_atomic, staged_directory, write_json_atomic, write_text_atomic
+from armtransfer.io import check_distinct_outputs, check_writable, copy_atomic, staged_directory, write_json_atomic, write_text_atomic
 
 DEFAULT_SOURCE = "planar2:joint"
 DEFAULT_TARGET = "ur5e_like:cartesian"
@@ -67,7 +68,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def arm_options(args: argparse.Namespace) -> dict:
     """The bring-your-own arm's options (for ``custom[:ACTIONS]`` or its name) and the cell size."""
-    options = dict(cell_size=args.cell_size)
+    options = dict(cell_size=args.cell_size, cache=not args.no_cache)
     if getattr(args, "arm_xml", None):
         options.update(common.arm_file_options(args))
     return options
@@ -83,6 +84,8 @@ def _fast_overrides(args: argparse.Namespace) -> dict:
 def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     out = Path(args.out) if args.out else Path("runs") / _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    check_distinct_outputs({"--json": args.json, "--render": args.render, "--mapping": args.mapping},
+                           {"--out": out})
     for extra in (args.json, args.render):
         if extra:
             check_writable(extra)
@@ -212,7 +215,11 @@ def _paths(out_json: dict, source: DiscreteRobot, target: DiscreteRobot) -> dict
     goal = ROOMS.cell(*out_json["task"]["goal"])
     steps = out_json["trajectory"]["steps"] if out_json["trajectory"] else []
     traj_cells = [ROOMS.cell(*s["cell"]) for s in steps]
-    source_states = _states_along(source, start, steps, goal) if steps else [source.start_state(start)]
+    if steps:
+        traj = Trajectory(tuple(traj_cells), tuple(s["action"] for s in steps), goal, source=source.name)
+        source_states = trajectories.states_along(source, traj)
+    else:
+        source_states = [source.start_state(start)]
     target_states = None
     for method, r in out_json["results"].items():
         if method != "none":
@@ -232,22 +239,6 @@ def _paths(out_json: dict, source: DiscreteRobot, target: DiscreteRobot) -> dict
         "target_states": target_states,
         "target_xy": [list(ROOMS.xy(int(target.label[s]))) for s in target_states],
     }
-
-
-def _states_along(robot: DiscreteRobot, start: int, steps: list[dict], goal: int) -> list[int]:
-    """Re-trace the transferred trajectory in the source's own states: the source is
-    deterministic, so its actions from the start state give its states back."""
-    s = robot.start_state(start)
-    states = [s]
-    for k, step in enumerate(steps):
-        if ROOMS.cell(*step["cell"]) != robot.label[s] or not 0 <= step["action"] < robot.n_actions:
-            raise InvalidParameterError(
-                f"the trajectory's step {k} is not a move of {robot.name}; cannot replay the source")
-        s = int(robot.next_state[s, step["action"]])
-        states.append(s)
-    if robot.label[s] != goal:
-        raise InvalidParameterError(f"the trajectory does not take {robot.name} to the goal; cannot replay it")
-    return states
 
 
 def _video(result: dict, args, path: Path, scenes: dict | None = None) -> dict:

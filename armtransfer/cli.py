@@ -58,7 +58,7 @@ def build_parser() -> argparse.ArgumentParser:
         p = sub.add_parser(name, description=module.HELP, epilog=f"example:\n  {module.EXAMPLE}",
                            formatter_class=argparse.RawDescriptionHelpFormatter)
         module.add_arguments(p)
-        p.set_defaults(_run=module.run)
+        p.set_defaults(_run=module.run, _parser=p)
     return parser
 
 
@@ -95,6 +95,9 @@ def _main(argv: list[str]) -> int:
     parser = build_parser()
     args = parser.parse_args(_join_xy_values(argv))
     try:
+        from armtransfer.commands.common import refuse_empty
+
+        refuse_empty(args)
         return int(args._run(args) or 0)
     except ArmTransferError as err:
         print(f"armtransfer {args.command}: error: {err}", file=sys.stderr)

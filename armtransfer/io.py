@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import fcntl
 import json
 import os
 import shutil
 import tempfile
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -77,33 +79,142 @@ def check_output_dir(out: str | os.PathLike, flag: str = "--out") -> None:
     check_writable(out / "results.json")
 
 
+STAGING_SUFFIX = ".tmp"
+"""A staging directory is ``.<out name>.<random>.tmp`` beside ``out``."""
+
+
 @contextmanager
 def staged_directory(out: str | os.PathLike, flag: str = "--out") -> Iterator[Path]:
     """A hidden temporary directory beside ``out`` to write every output into; renamed onto
     ``out`` when the block ends without an error, deleted otherwise. So an output directory
-    exists only complete, whatever stops the run (an error, Ctrl-C, a kill before the rename)."""
-    out = Path(out)
+    exists only complete, whatever stops the run (an error, Ctrl-C, a kill before the rename).
+
+    ``out`` is resolved first (a symlink to an empty folder is written through, into that
+    folder's place). While the block runs, ``out`` exists, empty and locked: a second run into
+    the same ``out`` is refused in one line at once, not after all its work. Staging
+    directories of runs that were killed are removed (see :func:`clean_stale_staging`)."""
+    out = Path(os.path.realpath(Path(out).expanduser()))
     check_output_dir(out, flag)
-    created = out.parent  # the highest directory this creates, removed again if the run fails
+    created = out  # the highest directory this creates, removed again if the run fails
     while not created.parent.exists():
         created = created.parent
     made = not created.exists()
     try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
+        out.mkdir(parents=True, exist_ok=True)
+        fd = os.open(out, os.O_RDONLY | os.O_DIRECTORY)
     except OSError as err:
         raise OutputError(f"cannot write {str(out)!r}: {err.strerror}") from None
+    tmp: Path | None = None
     done = False
     try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            made = False  # it is the other run's
+            raise OutputError(f"another run is writing into {str(out)!r}; choose a new {flag}") from None
+        check_output_dir(out, flag)  # a run that finished while this one waited filled it
+        clean_stale_staging(out)
+        try:
+            tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=STAGING_SUFFIX, dir=out.parent))
+        except OSError as err:
+            raise OutputError(f"cannot write {str(out)!r}: {err.strerror}") from None
+        _mark_owner(tmp)
         yield tmp
-        if out.exists():
-            out.rmdir()  # empty, checked before
-        os.replace(tmp, out)
+        try:
+            (tmp / OWNER).unlink()
+            os.chmod(tmp, 0o777 & ~_UMASK)  # as a directory made by mkdir, not mkdtemp's 0700
+            os.replace(tmp, out)  # onto the empty, locked directory: atomic
+        except OSError as err:
+            raise OutputError(f"cannot write {str(out)!r}: {err.strerror or err}") from None
         done = True
     finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+        os.close(fd)
+        if tmp is not None:
+            shutil.rmtree(tmp, ignore_errors=True)
         if made and not done:
             shutil.rmtree(created, ignore_errors=True)
+
+
+OWNER = ".owner"
+"""A staging directory's file naming the process that writes it (its pid and start time)."""
+
+
+def _process_start(pid: int) -> str | None:
+    """The start time of process ``pid`` (field 22 of /proc/PID/stat), None when it is gone."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return None
+    return stat.rpartition(")")[2].split()[19]
+
+
+def _running(pid: int, start: str) -> bool:
+    """Whether process ``pid`` that started at ``start`` still runs (a pid taken again by a
+    later process does not count; without /proc the pid alone is asked)."""
+    if start != "None":
+        return _process_start(pid) == start
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:
+        return True
+    return True
+
+
+def _mark_owner(tmp: Path) -> None:
+    pid = os.getpid()
+    (tmp / OWNER).write_text(f"{pid} {_process_start(pid)}\n")
+
+
+def clean_stale_staging(out: str | os.PathLike) -> list[Path]:
+    """Remove the staging directories beside ``out`` whose run is gone (killed before it could
+    clean up); returns them. A staging directory names its owner (:data:`OWNER`): one of any
+    output whose owner is no longer running is removed, one whose owner runs is left alone,
+    and one of ``out`` itself without an owner file (a run killed before it wrote it) is
+    removed once it is :data:`STALE_SECONDS` old."""
+    out = Path(out)
+    removed = []
+    for tmp in out.parent.glob(f".*{STAGING_SUFFIX}"):
+        if not tmp.is_dir() or tmp.is_symlink():
+            continue
+        try:
+            pid, start = (tmp / OWNER).read_text().split()
+            stale = not _running(int(pid), start)
+        except (OSError, ValueError):
+            try:
+                stale = tmp.name.startswith(f".{out.name}.") and time.time() - tmp.stat().st_mtime > STALE_SECONDS
+            except OSError:
+                stale = False
+        if stale:
+            shutil.rmtree(tmp, ignore_errors=True)
+            removed.append(tmp)
+    return removed
+
+
+STALE_SECONDS = 60.0
+"""A staging directory without an owner file is taken for a killed run's after this long."""
+
+
+def check_distinct_outputs(files: dict[str, object], dirs: dict[str, object] | None = None) -> None:
+    """Before any work: no two outputs on one path, and no output file inside an output
+    directory (whose staging would replace it, or which it would keep from being renamed into
+    place). ``files``/``dirs`` map a flag to its path (None: not given); paths are resolved,
+    symlinks included, so two spellings of one file are one file."""
+    resolved: list[tuple[str, Path, bool]] = []
+    for is_dir, group in ((False, files), (True, dirs or {})):
+        for flag, value in group.items():
+            if value is not None:
+                resolved.append((flag, Path(os.path.realpath(Path(str(value)).expanduser())), is_dir))
+    for i, (flag, path, is_dir) in enumerate(resolved):
+        for other, opath, other_dir in resolved[i + 1:]:
+            if path == opath:
+                raise OutputError(f"{flag} and {other} name the same path {str(path)!r}; give each its own")
+            for (f1, p1, d1), (f2, p2) in (((flag, path, is_dir), (other, opath)),
+                                           ((other, opath, other_dir), (flag, path))):
+                if d1 and p1 in p2.parents:
+                    raise OutputError(f"{f2} {str(p2)!r} is inside the output directory {f1} {str(p1)!r}; "
+                                      "put it elsewhere")
 
 
 def check_writable(path: str | os.PathLike) -> None:

@@ -49,7 +49,9 @@ class TransferReward(gym.Wrapper, gym.utils.RecordConstructorArgs):
             raise InvalidParameterError(
                 f"TransferReward needs one of armtransfer's environments (no {', '.join(missing)} on "
                 f"{type(base).__name__})")
-        self.transfer = TransferTerm(base.robot, trajectory, method, K, base.step_reward, gamma, beta)
+        start = getattr(base, "start_state", None)
+        task = (int(base.robot.label[start]), int(base.goal_cell)) if start is not None else None
+        self.transfer = TransferTerm(base.robot, trajectory, method, K, base.step_reward, gamma, beta, task=task)
         self.robot = base.robot
         self.goal_cell = int(base.goal_cell)
         self._state: int | None = None

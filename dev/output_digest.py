@@ -2,8 +2,8 @@
 
 A restructure that moves code but changes no result must leave this listing unchanged:
 run it before and after into the same OUTDIR (results name their own paths) and compare
-with ``diff``. Wall-clock files (``timings.json``) are listed by name only, and a store's run
-files are hashed without their ``elapsed_seconds``, since those hold times.
+with ``diff``. Wall-clock files (``timings.json``, a store's ``timings/``) are listed by name
+only, since those hold times.
 
     python dev/output_digest.py /tmp/digest examples/sweeps/quick.toml > digest.txt
 """
@@ -11,7 +11,6 @@ files are hashed without their ``elapsed_seconds``, since those hold times.
 from __future__ import annotations
 
 import hashlib
-import json
 import shutil
 import os
 import subprocess
@@ -51,11 +50,6 @@ def main(out: Path, sweep: str) -> None:
         rel = path.relative_to(out)
         if "timings" in rel.name or "timings" in rel.parts:
             print(f"{'(times)':64}  {rel}")
-        elif rel.parts[0] in ("sweep", "matrix") and rel.parts[1] == "runs":
-            run = json.loads(path.read_bytes())
-            run.pop("elapsed_seconds", None)
-            data = json.dumps(run, sort_keys=True).encode()
-            print(f"{hashlib.sha256(data).hexdigest()}  {rel} (without elapsed_seconds)")
         else:
             print(f"{hashlib.sha256(path.read_bytes()).hexdigest()}  {rel}")
 

@@ -21,7 +21,8 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
-FOUNDATION = ("armtransfer.errors", "armtransfer.io", "armtransfer.cpus", "armtransfer.registration")
+FOUNDATION = ("armtransfer.errors", "armtransfer.checks", "armtransfer.io", "armtransfer.cpus",
+              "armtransfer.registration")
 # the layers in the order data flows; the rest of armtransfer (API, wrappers, command) comes last
 LAYERS = ["foundation", "armtransfer.models", "armtransfer.ik", "armtransfer.tasks",
           "armtransfer.learning", "armtransfer.experiments", "armtransfer"]

@@ -6,7 +6,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from armtransfer.cli import main
+from contract import refused
 
 SETTINGS = settings(max_examples=40, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.function_scoped_fixture])
@@ -57,25 +57,12 @@ cells = st.one_of(
 malformed = st.one_of(text, st.sampled_from(["1", "1,2,3", "1.5,2", ",", "x,y"]))
 
 
-def _contract(argv, tmp_path, monkeypatch, capsys):
-    monkeypatch.chdir(tmp_path)
-    before = sorted(p.name for p in tmp_path.iterdir())
-    try:
-        code = main(argv)
-    except SystemExit as exc:  # argparse's own usage errors
-        code = exc.code
-    err = capsys.readouterr().err
-    assert code == 2, f"{argv}: exit {code}: {err}"
-    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, f"{argv}: {err}"
-    assert sorted(p.name for p in tmp_path.iterdir()) == before, f"{argv} wrote something"
-
-
 @SETTINGS
 @given(data=st.data())
 def test_rooms_bad_numbers(tmp_path, monkeypatch, capsys, data):
     flag = data.draw(st.sampled_from(sorted(LEARNING)))
     value = data.draw(LEARNING[flag])
-    _contract(["rooms", f"{flag}={value}", "--json", "out.json"], tmp_path, monkeypatch, capsys)
+    refused(["rooms", f"{flag}={value}", "--json", "out.json"], tmp_path, monkeypatch, capsys)
 
 
 @SETTINGS
@@ -83,48 +70,48 @@ def test_rooms_bad_numbers(tmp_path, monkeypatch, capsys, data):
 def test_arms_bad_numbers(tmp_path, monkeypatch, capsys, data):
     flag = data.draw(st.sampled_from(sorted(LEARNING)))
     value = data.draw(LEARNING[flag])
-    _contract(["arms", "--fast", f"{flag}={value}", "--out", "run"], tmp_path, monkeypatch, capsys)
+    refused(["arms", "--fast", f"{flag}={value}", "--out", "run"], tmp_path, monkeypatch, capsys)
 
 
 @SETTINGS
 @given(start=st.one_of(cells, malformed), goal=st.sampled_from(["-8,12", "0,0"]), which=st.booleans())
 def test_bad_cells(tmp_path, monkeypatch, capsys, start, goal, which):
     a, b = (start, goal) if which else (goal, start)
-    _contract(["rooms", f"--start={a}", f"--goal={b}", "--json", "o.json"], tmp_path, monkeypatch, capsys)
+    refused(["rooms", f"--start={a}", f"--goal={b}", "--json", "o.json"], tmp_path, monkeypatch, capsys)
 
 
 @SETTINGS
 @given(value=st.one_of(st.floats(-10, 0).map(repr), nonfinite, text))
 def test_arms_bad_cell_size_and_base(tmp_path, monkeypatch, capsys, value):
-    _contract(["arms", "--fast", f"--cell-size={value}", "--out", "run"], tmp_path, monkeypatch, capsys)
-    _contract(["arms", "list", "--arm", "planar2", f"--cell-size={value}"], tmp_path, monkeypatch, capsys)
+    refused(["arms", "--fast", f"--cell-size={value}", "--out", "run"], tmp_path, monkeypatch, capsys)
+    refused(["arms", "list", "--arm", "planar2", f"--cell-size={value}"], tmp_path, monkeypatch, capsys)
 
 
 @SETTINGS
 @given(value=st.one_of(nonfinite.map(lambda v: f"{v},0,0"), malformed))
 def test_bad_base_pos(tmp_path, monkeypatch, capsys, scara_xml, value):
-    _contract(["arms", "list", "--arm-xml", str(scara_xml), "--tip-site", "pen_tip", f"--base-pos={value}"],
+    refused(["arms", "list", "--arm-xml", str(scara_xml), "--tip-site", "pen_tip", f"--base-pos={value}"],
               tmp_path, monkeypatch, capsys)
 
 
 @SETTINGS
 @given(flag=st.sampled_from(["--trials", "--seeds"]), value=st.one_of(st.integers(max_value=-1).map(str), text))
 def test_matrix_bad_numbers(tmp_path, monkeypatch, capsys, flag, value):
-    _contract(["matrix", "--robots", "coarse,fine", f"{flag}={value}", "--out", "m"], tmp_path, monkeypatch, capsys)
+    refused(["matrix", "--robots", "coarse,fine", f"{flag}={value}", "--out", "m"], tmp_path, monkeypatch, capsys)
 
 
 @SETTINGS
 @given(flag=st.sampled_from(["--trials", "--seed", "--max-total-steps"]),
        value=st.one_of(st.integers(max_value=-1).map(str), text, nonfinite))
 def test_reproduce_bad_numbers(tmp_path, monkeypatch, capsys, flag, value):
-    _contract(["reproduce", f"{flag}={value}", "--out", "rep"], tmp_path, monkeypatch, capsys)
+    refused(["reproduce", f"{flag}={value}", "--out", "rep"], tmp_path, monkeypatch, capsys)
 
 
 @SETTINGS
 @given(flag=st.sampled_from(["--steps", "--repeats", "--seed", "--baseline-steps", "--baseline-repeats"]),
        value=st.one_of(st.integers(max_value=-1).map(str), text))
 def test_bench_bad_numbers(tmp_path, monkeypatch, capsys, flag, value):
-    _contract(["bench", f"{flag}={value}", "--json", "b.json"], tmp_path, monkeypatch, capsys)
+    refused(["bench", f"{flag}={value}", "--json", "b.json"], tmp_path, monkeypatch, capsys)
 
 
 @SETTINGS
@@ -132,7 +119,7 @@ def test_bench_bad_numbers(tmp_path, monkeypatch, capsys, flag, value):
        value=st.one_of(st.integers(max_value=-1).map(str), text))
 def test_sweep_bad_numbers(tmp_path, monkeypatch, capsys, flag, value):
     (tmp_path / "s.toml").write_text('[sweep]\ntasks = [1]\n')
-    _contract(["sweep", "s.toml", f"{flag}={value}", "--out", "store"], tmp_path, monkeypatch, capsys)
+    refused(["sweep", "s.toml", f"{flag}={value}", "--out", "store"], tmp_path, monkeypatch, capsys)
     (tmp_path / "s.toml").unlink()
 
 
@@ -149,12 +136,12 @@ def test_sweep_bad_numbers(tmp_path, monkeypatch, capsys, flag, value):
     ["summarize", "nowhere"],
 ])
 def test_bad_outputs(tmp_path, monkeypatch, capsys, argv):
-    _contract(argv, tmp_path, monkeypatch, capsys)
+    refused(argv, tmp_path, monkeypatch, capsys)
 
 
 def test_a_non_empty_out_is_refused(tmp_path, monkeypatch, capsys):
     (tmp_path / "run").mkdir()
     (tmp_path / "run" / "keep.txt").write_text("mine")
     for argv in (["arms", "--fast", "--out", "run"], ["reproduce", "--out", "run"]):
-        _contract(argv, tmp_path, monkeypatch, capsys)
+        refused(argv, tmp_path, monkeypatch, capsys)
     assert (tmp_path / "run" / "keep.txt").read_text() == "mine"

@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 
 from armtransfer.cli import main
+from contract import session
 from armtransfer.experiments import sweep as sweeps
 from armtransfer.experiments.store import ResultStore
 
@@ -116,19 +117,6 @@ def test_an_unreachable_ray_address_fails_fast_in_one_line(tmp_path, capsys):
     assert not out.exists()
 
 
-def _session_processes(sid: int) -> list[int]:
-    """Live processes of session ``sid`` (from /proc: field 6 of stat is the session)."""
-    out = []
-    for stat in Path("/proc").glob("[0-9]*/stat"):
-        try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
-        except OSError:
-            continue
-        if int(fields[3]) == sid and fields[0] != "Z":
-            out.append(int(stat.parent.name))
-    return out
-
-
 @pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc")
 def test_killing_only_the_sweep_leaves_no_orphaned_workers(tmp_path):
     path = tmp_path / "s.toml"
@@ -140,13 +128,13 @@ def test_killing_only_the_sweep_leaves_no_orphaned_workers(tmp_path):
     deadline = time.time() + 120
     while time.time() < deadline and len(list((out / "runs").glob("*.json"))) < 2:
         time.sleep(0.05)
-    assert len(_session_processes(proc.pid)) >= 3, "the driver and its two workers should be running"
+    assert len(session(proc.pid)) >= 3, "the driver and its two workers should be running"
     os.kill(proc.pid, signal.SIGKILL)  # the parent only, not its workers
     proc.wait()
     deadline = time.time() + 20
-    while time.time() < deadline and _session_processes(proc.pid):
+    while time.time() < deadline and session(proc.pid):
         time.sleep(0.2)
-    left = _session_processes(proc.pid)
+    left = session(proc.pid)
     for pid in left:  # do not leave them behind even when the check fails
         os.kill(pid, signal.SIGKILL)
     assert left == []

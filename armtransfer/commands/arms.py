@@ -12,6 +12,13 @@ HELP = ("Transfer a trajectory from one MuJoCo arm to another; write results, ta
 EXAMPLE = "armtransfer arms --fast --out runs/demo"
 
 
+ARM_FILE_OPTIONS = {"arm_xml", "tip_site", "tip_body", "tip_offset", "arm_name", "base_pos", "base_yaw", "cell_size"}
+LIST_ONLY = {"arm", "actions"}
+LIST_OPTIONS = LIST_ONLY | ARM_FILE_OPTIONS | {"no_cache"}
+GENERATE_ONLY = {"family", "dof"}
+GENERATE_OPTIONS = GENERATE_ONLY | {"seed", "out"}
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("action", nargs="?", choices=["list", "generate"],
                         help="'list': compile (or load) every arm robot and report it; 'generate': draw "
@@ -37,11 +44,15 @@ def run(args: argparse.Namespace) -> int:
     from armtransfer.errors import ArmModelError
 
     if args.action == "generate":
+        common.refuse_other_options(args, GENERATE_OPTIONS, "'arms generate'")
         return generate(args)
     if args.action != "list":
         from armtransfer import arm_transfer
 
+        common.refuse_other_options(args, {a.dest for a in common.options_of(args)} - LIST_ONLY - GENERATE_ONLY,
+                                    "an arm transfer ('arms' without list or generate)")
         return arm_transfer.run(args)
+    common.refuse_other_options(args, LIST_OPTIONS, "'arms list'")
     common.check_arm_flags(args)
     from armtransfer.tasks.arms import arm_robot, robot_specs
     from armtransfer.tasks.catalog import TABLE_I

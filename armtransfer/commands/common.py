@@ -7,6 +7,7 @@ import math
 import sys
 from dataclasses import fields
 
+from armtransfer.checks import MAX_COUNT
 from armtransfer.errors import ArmModelError, InvalidParameterError, InvalidTaskError
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.tasks.catalog import parse_xy
@@ -15,11 +16,11 @@ from armtransfer.tasks.catalog import parse_xy
 def _integer_at_least(lo: int, what: str):
     def parse(text: str) -> int:
         try:
-            value = int(text)
+            value = int(text) if len(text) <= 40 else None  # no 10,000-digit number is parsed
         except ValueError:
-            raise argparse.ArgumentTypeError(f"must be {what}, got {text!r}") from None
-        if value < lo:
-            raise argparse.ArgumentTypeError(f"must be {what}, got {text!r}")
+            value = None
+        if value is None or not lo <= value <= MAX_COUNT:
+            raise argparse.ArgumentTypeError(f"must be {what} (at most {MAX_COUNT:,}), got {text[:40]!r}")
         return value
 
     return parse
@@ -147,6 +148,36 @@ def transfer_kwargs(args: argparse.Namespace) -> dict:
         mapping=args.mapping, save_mapping=args.mapping is not None, max_span=args.max_span,
         **config_options(args),
     )
+
+
+def _flag(action: argparse.Action) -> str:
+    return action.option_strings[-1] if action.option_strings else action.metavar or action.dest
+
+
+def options_of(args: argparse.Namespace) -> list[argparse.Action]:
+    """The options and positionals of the parser that made ``args`` (none without one)."""
+    parser = getattr(args, "_parser", None)
+    return [a for a in (parser._actions if parser else []) if a.dest not in ("help", argparse.SUPPRESS)]
+
+
+def refuse_empty(args: argparse.Namespace) -> None:
+    """An empty or blank value is an error, never "not given" (``--json ''`` wrote nothing)."""
+    for action in options_of(args):
+        value = getattr(args, action.dest, None)
+        values = value if isinstance(value, list) else [value]
+        if any(isinstance(v, str) and not v.strip() for v in values):
+            raise InvalidParameterError(f"{_flag(action)} must not be empty")
+
+
+def refuse_other_options(args: argparse.Namespace, allowed: set[str], mode: str) -> None:
+    """Options given (different from their default) that ``mode`` does not use are an error
+    listing the options it does use, instead of being silently ignored."""
+    actions = options_of(args)
+    for action in actions:
+        if action.option_strings and action.dest not in allowed \
+                and getattr(args, action.dest, action.default) != action.default:
+            valid = ", ".join(_flag(a) for a in actions if a.dest in allowed and a.option_strings)
+            raise InvalidParameterError(f"{_flag(action)} does not apply to {mode}; its options: {valid}")
 
 
 def interactive() -> bool:

@@ -23,11 +23,18 @@ EXAMPLE = "armtransfer matrix --robots coarse,fine --tasks 1 --trials 5 --out ru
 
 def _task_list(text: str) -> list[int]:
     """'1-4', '1,3' or '2' -> task numbers."""
+    from armtransfer.tasks.catalog import TABLE_I
+
     out: list[int] = []
     try:
         for part in text.split(","):
             lo, _, hi = part.strip().partition("-")
-            out.extend(range(int(lo), int(hi or lo) + 1))
+            first, last = int(lo), int(hi or lo)
+            for t in (first, last):  # checked before the range is listed: '1-9999999999' lists nothing
+                if t not in TABLE_I:
+                    raise argparse.ArgumentTypeError(
+                        f"unknown task {t} in {text!r}; valid tasks: {', '.join(map(str, TABLE_I))}")
+            out.extend(range(first, last + 1))
     except ValueError:
         raise argparse.ArgumentTypeError(f"tasks are numbers or ranges like 1-4 or 1,3, got {text!r}") from None
     if not out:

@@ -99,10 +99,10 @@ def run(args: argparse.Namespace) -> int:
     check_output_dir(out)  # before the long run, not after
     config = LearnerConfig(max_total_steps=args.max_total_steps)
     t0 = time.perf_counter()
-    with common.progress_bar(rep.plan(args.trials), "reproduce") as bar:
-        res = rep.run_all(args.trials, args.seed, config, tick=bar.update,
-                          trajectory=args.trajectory, mapping_from=args.mapping_from)
-    with staged_directory(out) as tmp:  # out appears only complete
+    with staged_directory(out) as tmp:  # out appears only complete; a second run into it is refused now
+        with common.progress_bar(rep.plan(args.trials), "reproduce") as bar:
+            res = rep.run_all(args.trials, args.seed, config, tick=bar.update,
+                              trajectory=args.trajectory, mapping_from=args.mapping_from)
         _write(res, tmp)
     print(f"wrote {out / 'report.md'} ({time.perf_counter() - t0:.0f} s)")
     print(rr.table_ii_markdown(res["table_ii"], rr.paper.TABLE_II, "Table II A-C: coarse -> fine"))

@@ -6,7 +6,7 @@ import argparse
 
 from armtransfer import api
 from armtransfer.commands import common
-from armtransfer.io import check_writable, write_json_atomic
+from armtransfer.io import check_distinct_outputs, check_writable, write_json_atomic
 from armtransfer.experiments import experiment, report
 
 HELP = ("Transfer a trajectory between two grid robots of the paper's rooms world and print its "
@@ -24,6 +24,7 @@ def add_arguments(p: argparse.ArgumentParser, source: str = "coarse", target: st
 
 
 def run(args: argparse.Namespace) -> int:
+    check_distinct_outputs({"--json": args.json, "--mapping": args.mapping})
     if args.json:
         check_writable(args.json)
     total = experiment.count_trials(args.method, args.trials, not args.no_controls)

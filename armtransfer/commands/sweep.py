@@ -8,7 +8,7 @@ import os
 from armtransfer.commands import common
 from armtransfer.experiments.execute import robot_specs
 from armtransfer.tasks.catalog import custom_task
-from armtransfer.experiments.executors import _check_reachable, _import_ray, run_local, run_ray
+from armtransfer.experiments.executors import ExecutorError, _check_reachable, _import_ray, run_local, run_ray
 from armtransfer.tasks.specs import resolve
 from armtransfer.experiments import sweep as sweeps
 from armtransfer.learning.config import LearnerConfig
@@ -45,6 +45,8 @@ def run_sweep(sweep: sweeps.Sweep, args: argparse.Namespace) -> int:
     the arguments name; returns the exit code (1 when a run failed). The whole sweep is
     checked (every robot built, every task's cells checked for both robots) before anything
     is written."""
+    if args.address is not None and args.executor != "ray":
+        raise ExecutorError("--address goes with --executor ray (the local executor has no address)")
     if args.executor == "ray":
         _import_ray()  # say how to install Ray before anything is written
         if args.address:

@@ -31,7 +31,8 @@ class TransferShaping(dm_env.Environment):
             raise InvalidParameterError(
                 f"TransferShaping needs an environment of armtransfer.dmc.load, got {type(environment).__name__}")
         self._environment = environment
-        self.transfer = TransferTerm(task.robot, trajectory, method, K, task.step_reward, gamma, beta)
+        cells = (int(task.robot.label[task.start_state]), int(task.goal_cell))  # the trajectories must be of this task
+        self.transfer = TransferTerm(task.robot, trajectory, method, K, task.step_reward, gamma, beta, task=cells)
         self._state: int | None = None
 
     @property

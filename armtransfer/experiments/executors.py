@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import multiprocessing
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 
@@ -26,11 +27,13 @@ class ExecutorError(ArmTransferError):
     """An executor cannot start (e.g. Ray is not installed or unreachable)."""
 
 
-def _worker_init() -> None:
+def _worker_init(driver: int | None = None) -> None:
+    """A pool worker's first code: it ends when the driver ``driver`` (its parent's pid,
+    given by the driver itself) is gone, and runs its trials on one thread."""
+    _die_with_parent(driver)
     # one thread per worker process: the workers are the parallelism
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS", CPUS_ENV):
         os.environ.setdefault(var, "1")
-    _die_with_parent()
 
 
 def _execute_in_ray(run: dict, robots):
@@ -39,11 +42,18 @@ def _execute_in_ray(run: dict, robots):
     return execute(run, robots)
 
 
-def _die_with_parent() -> None:
+def _die_with_parent(driver: int | None = None) -> None:
     """A worker ends when the sweep that started it is killed (even by SIGKILL), instead of
     living on as an orphan: Linux's PR_SET_PDEATHSIG sends it SIGTERM when its parent dies.
-    Elsewhere a thread watches the parent's pid and ends the worker."""
-    parent = os.getppid()
+    Elsewhere a thread watches the parent's pid and ends the worker.
+
+    ``driver`` is the pid the driver had when it started the worker: a driver killed while
+    the worker was still starting (importing) is noticed here, since the worker's parent is
+    then already someone else (a worker that only read its own parent's pid here took that
+    adoptive parent for its driver, and lived on)."""
+    parent = os.getppid() if driver is None else driver
+    if os.getppid() != parent:
+        os._exit(1)
     try:
         import ctypes
         import signal
@@ -100,25 +110,34 @@ def run_local(
     while queue or suspects:
         if suspects:
             run = suspects.pop(0)
-            with ProcessPoolExecutor(max_workers=1, mp_context=ctx, initializer=_worker_init) as pool:
-                fut = pool.submit(fn, run, _robots_for([run], robots))
-                wait([fut])
-                if not finish(fut, run):
+            with _pool(1, ctx) as pool:
+                fut = _submit(pool, fn, run, _robots_for([run], robots))
+                if fut is not None:
+                    wait([fut])
+                if fut is None or not finish(fut, run):
                     attempts[run["key"]] += 1
                     if attempts[run["key"]] > retries:
                         on_failed(run, "worker process died", attempts[run["key"]])
                     else:
                         suspects.append(run)
             continue
-        with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init) as pool:
+        with _pool(workers, ctx) as pool:
             shared = _robots_for(queue, robots)
             in_flight: dict = {}
             while queue or in_flight:
+                broken = False
                 while queue and len(in_flight) < workers:
                     run = queue.pop(0)
-                    in_flight[pool.submit(fn, run, shared)] = run
+                    fut = _submit(pool, fn, run, shared)
+                    if fut is None:  # a worker died while this was handed over
+                        suspects.append(run)
+                        broken = True
+                        break
+                    in_flight[fut] = run
+                if broken:
+                    suspects.extend(in_flight.values())
+                    break
                 finished, _ = wait(list(in_flight), return_when=FIRST_COMPLETED)
-                broken = False
                 for fut in finished:
                     run = in_flight.pop(fut)
                     if not finish(fut, run):
@@ -127,6 +146,29 @@ def run_local(
                 if broken:  # every run still in flight may be the culprit
                     suspects.extend(in_flight.values())
                     break
+
+
+@contextmanager
+def _pool(workers: int, ctx) -> Iterator[ProcessPoolExecutor]:
+    """A process pool whose workers know the driver's pid from their first code; leaving it
+    waits for its workers, a broken pool included."""
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init,
+                               initargs=(os.getpid(),))
+    try:
+        yield pool
+    finally:
+        try:
+            pool.shutdown(wait=True, cancel_futures=True)
+        except BrokenProcessPool:
+            pass
+
+
+def _submit(pool: ProcessPoolExecutor, fn: Callable, run: dict, robots: dict):
+    """``pool.submit(fn, run, robots)``, or None when the pool broke (a worker died) meanwhile."""
+    try:
+        return pool.submit(fn, run, robots)
+    except (BrokenProcessPool, RuntimeError):  # RuntimeError: the pool shut down after breaking
+        return None
 
 
 def _robots_for(runs: list[dict], robots: dict[str, DiscreteRobot]) -> dict[str, DiscreteRobot]:
@@ -162,10 +204,45 @@ def _check_reachable(address: str) -> None:
     import socket
 
     try:
-        with socket.create_connection((host or "127.0.0.1", port_number), timeout=RAY_CONNECT_TIMEOUT):
-            pass
+        with socket.create_connection((host or "127.0.0.1", port_number), timeout=RAY_CONNECT_TIMEOUT) as conn:
+            answer = _http2_answer(conn)
     except OSError as err:
         raise ExecutorError(f"cannot reach Ray at {address!r}: {err.strerror or err}") from None
+    if answer is not None:
+        raise ExecutorError(f"what answers at {address!r} is not Ray ({answer}); give the address of a Ray "
+                            "head node (HOST:6379, or ray://HOST:10001 for Ray Client)")
+
+
+HTTP2_PREFACE = b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n" + b"\x00\x00\x00\x04\x00\x00\x00\x00\x00"
+"""What an HTTP/2 client sends first: the connection preface and an empty SETTINGS frame."""
+
+
+def _http2_answer(conn) -> str | None:
+    """None when the server on ``conn`` speaks HTTP/2 (gRPC, as Ray's head node and Ray Client
+    do: its first frame is a SETTINGS frame), else what it said instead, in a few words."""
+    conn.settimeout(RAY_ANSWER_TIMEOUT)
+    try:
+        conn.sendall(HTTP2_PREFACE)
+        head = b""
+        while len(head) < 9:
+            chunk = conn.recv(9 - len(head))
+            if not chunk:
+                break
+            head += chunk
+    except TimeoutError:
+        return f"it said nothing within {RAY_ANSWER_TIMEOUT:g} s"
+    except OSError as err:
+        return f"it closed the connection: {err.strerror or err}"
+    if len(head) == 9 and head[3] == 0x04:  # a frame header whose type is SETTINGS
+        return None
+    if not head:
+        return "it closed the connection without a word"
+    text = "".join(ch if ch.isprintable() else " " for ch in head.decode("latin-1")).strip()
+    return f"it answered {text!r}..." if text else "it answered in bytes that are not HTTP/2"
+
+
+RAY_ANSWER_TIMEOUT = 5.0
+"""Seconds to wait for the server at a Ray address to answer an HTTP/2 preface."""
 
 
 def run_ray(
@@ -177,15 +254,24 @@ def run_ray(
     Each robot is put in Ray's object store once and shared by every task that needs it."""
     ray = _import_ray()
     started_here = False
+    reaper = None
     if not ray.is_initialized():
         try:
             if address:
                 _check_reachable(address)
                 ray.init(address=address, log_to_driver=False, configure_logging=False)
-            else:
+            else:  # a local instance: its processes are stopped with the sweep, even a killed one
+                from armtransfer.experiments.reaper import Reaper, children_of
+
+                reaper = Reaper()
+                before = children_of(os.getpid())
                 ray.init(num_cpus=workers or os.cpu_count(), include_dashboard=False,
                          log_to_driver=False, configure_logging=False)
+                reaper.watch(children_of(os.getpid()) - before)
         except Exception as err:  # noqa: BLE001 - one line for the user
+            if reaper is not None:  # whatever the failed start left running goes
+                reaper.watch(children_of(os.getpid()) - {reaper.proc.pid})
+                reaper.close(stop=True)
             raise ExecutorError(f"cannot start or reach Ray ({address or 'local'}): {err}".splitlines()[0]) from None
         started_here = True
     try:
@@ -210,6 +296,8 @@ def run_ray(
     finally:
         if started_here:
             ray.shutdown()
+        if reaper is not None:
+            reaper.close()
 
 
 class _RobotRefs(dict):

@@ -3,6 +3,8 @@
     DIR/sweep.json          the sweep this directory belongs to (its normalised spec and key)
     DIR/runs/<key>.json     one finished run: its full configuration and its result
     DIR/failed/<key>.json   a run that failed every attempt, with the error
+    DIR/timings/<key>.json  how long the finished run took (wall clock, kept out of its run
+                            file so that the same sweep writes the same run files, byte for byte)
 
 A run file appears only by ``os.replace`` of a complete temporary file, so after a crash
 (even ``kill -9``) every run file present is whole, and a run without one is simply not
@@ -37,6 +39,7 @@ class ResultStore:
         self.root = Path(root)
         self.runs_dir = self.root / "runs"
         self.failed_dir = self.root / "failed"
+        self.timings_dir = self.root / "timings"
 
     # -- opening -----------------------------------------------------------------------
     @classmethod
@@ -61,7 +64,7 @@ class ResultStore:
         if not meta_path.exists():
             write_json_atomic(meta_path, {"format": STORE_FORMAT, "name": sweep.name, "key": sweep.key,
                                           "spec": sweep.spec})
-        for d in (store.runs_dir, store.failed_dir):
+        for d in (store.runs_dir, store.failed_dir, store.timings_dir):
             try:
                 d.mkdir(parents=True, exist_ok=True)
             except OSError as err:
@@ -155,8 +158,8 @@ class ResultStore:
 
     def write_run(self, run: dict, result: dict, elapsed: float) -> None:
         key = run["key"]
-        write_json_atomic(self.run_path(key), {"key": key, "config": run, "result": result,
-                                               "elapsed_seconds": round(elapsed, 3)})
+        write_json_atomic(self.timings_dir / f"{key}.json", {"key": key, "elapsed_seconds": round(elapsed, 3)})
+        write_json_atomic(self.run_path(key), {"key": key, "config": run, "result": result})
         (self.failed_dir / f"{key}.json").unlink(missing_ok=True)
 
     def write_failure(self, run: dict, error: str, attempts: int) -> None:

@@ -155,6 +155,24 @@ def _arms(raw: object, where: str, base: Path | None) -> dict:
     return out
 
 
+def _check_arm_names(arms: dict, pairs: list, where: str) -> None:
+    """Every ``[arms.NAME]`` table is used by a pair, and no NAME is a robot's name already
+    (a table named ``fine`` would silently lose to the grid robot)."""
+    from armtransfer.models import ARMS
+    from armtransfer.tasks.grid_robots import GRID_ROBOTS
+    from armtransfer.tasks.specs import CUSTOM
+
+    taken = {*GRID_ROBOTS, *ARMS, CUSTOM, "gen"}
+    used = {spec.partition(":")[0] for pair in pairs for spec in pair}
+    for name in arms:
+        if name in taken or name.endswith(".xml"):
+            raise SweepFileError(f"{where}: arms.{name} has the name of a robot already; choose a name other than "
+                                 f"{', '.join(sorted(taken))}")
+        if name not in used:
+            raise SweepFileError(f"{where}: arms.{name} is not used by any pair; pairs name "
+                                 f"{', '.join(sorted(used))}")
+
+
 def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, base: Path | None = None) -> dict:
     """Validate a parsed sweep file; returns the spec with every key filled in (``base``: the
     folder that relative arm files are found in)."""
@@ -199,6 +217,7 @@ def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, ba
     for p in spec["pairs"]:
         if not (isinstance(p, list) and len(p) == 2 and all(isinstance(x, str) and x for x in p)):
             raise SweepFileError(f"{w}: pairs entries must be [\"SOURCE\", \"TARGET\"], got {p!r}")
+    _check_arm_names(arms, spec["pairs"], w)
     for m in spec["methods"]:
         if m not in METHODS:
             raise SweepFileError(f"{w}: unknown method {m!r}; valid methods: {', '.join(METHODS)}")
@@ -266,6 +285,8 @@ def load(path: str | os.PathLike, max_runs: int = MAX_RUNS) -> Sweep:
         raise SweepFileError(f"cannot read {where}: {err.strerror}") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
         raise SweepFileError(f"{where} is not valid TOML: {str(err).splitlines()[0]}") from None
+    except RecursionError:
+        raise SweepFileError(f"{where} nests too deeply to be a sweep file") from None
     spec = normalise(raw, where, max_runs, base=p.parent)
     return Sweep(spec["name"], spec, tuple(expand(spec)))
 

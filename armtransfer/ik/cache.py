@@ -15,10 +15,13 @@ from __future__ import annotations
 
 import fcntl
 import hashlib
+import io
 import json
 import os
+import shutil
+import stat
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -62,13 +65,49 @@ def _checksum(arrays: dict[str, np.ndarray]) -> str:
     return h.hexdigest()
 
 
-def load(name: str, key: str) -> tuple[dict[str, np.ndarray] | None, str]:
-    """(arrays, status): status is "hit", "miss" (no entry) or "stale"/"corrupt"."""
-    path = entry_path(name, key)
-    if not path.exists():
-        return None, "miss"
+def read_regular(path: Path) -> bytes | None:
+    """The bytes of ``path`` when it is a regular file (symlinks followed), None otherwise:
+    a directory, a FIFO (which would hang a reader), a device, or nothing."""
     try:
-        with np.load(path, allow_pickle=False) as f:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    except OSError:
+        return None
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return None
+        with os.fdopen(fd, "rb", closefd=False) as f:
+            return f.read()
+    except OSError:
+        return None
+    finally:
+        os.close(fd)
+
+
+def clear(path: Path) -> None:
+    """Remove whatever is at ``path`` that is not a regular file (a directory, a FIFO, a
+    dangling link), so a new entry can be renamed onto it."""
+    try:
+        mode = os.lstat(path).st_mode
+    except FileNotFoundError:
+        return
+    if stat.S_ISDIR(mode):
+        shutil.rmtree(path, ignore_errors=True)
+    elif not stat.S_ISREG(mode):
+        path.unlink(missing_ok=True)
+
+
+def load(name: str, key: str, check: Callable[[dict[str, np.ndarray]], bool] | None = None,
+         ) -> tuple[dict[str, np.ndarray] | None, str]:
+    """(arrays, status): status is "hit", "miss" (no entry) or "stale"/"corrupt". An entry
+    that is not a regular file, or whose arrays ``check`` refuses, is "corrupt"."""
+    path = entry_path(name, key)
+    if not os.path.lexists(path):
+        return None, "miss"
+    raw = read_regular(path)
+    if raw is None:
+        return None, "corrupt"
+    try:
+        with np.load(io.BytesIO(raw), allow_pickle=False) as f:
             arrays = {k: f[k] for k in f.files}
         stored_key = str(arrays.pop("__key__"))
         stored_sum = str(arrays.pop("__checksum__"))
@@ -78,12 +117,18 @@ def load(name: str, key: str) -> tuple[dict[str, np.ndarray] | None, str]:
         return None, "stale"
     if stored_sum != _checksum(arrays):
         return None, "corrupt"
+    try:
+        if check is not None and not check(arrays):
+            return None, "corrupt"
+    except Exception:  # noqa: BLE001 - arrays of the wrong kind are as corrupt as wrong bytes
+        return None, "corrupt"
     return arrays, "hit"
 
 
 def save(name: str, key: str, arrays: dict[str, np.ndarray]) -> Path:
     path = entry_path(name, key)
     path.parent.mkdir(parents=True, exist_ok=True)
+    clear(path)
     payload = dict(arrays)
     payload["__key__"] = np.array(key)
     payload["__checksum__"] = np.array(_checksum(arrays))
@@ -104,7 +149,9 @@ def building(entry: Path) -> Iterator[None]:
     """Hold the build lock of cache entry ``entry`` (a file ``<entry>.lock`` beside it) for as
     long as the block runs; another process asking for the same lock waits until then."""
     entry.parent.mkdir(parents=True, exist_ok=True)
-    with open(entry.with_name(entry.name + ".lock"), "a") as lock:
+    lock_path = entry.with_name(entry.name + ".lock")
+    clear(lock_path)  # a FIFO there would hang the open
+    with open(lock_path, "a") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         try:
             yield

@@ -26,6 +26,8 @@ from __future__ import annotations
 import hashlib
 import math
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -179,21 +181,96 @@ def tool_reach(model: mujoco.MjModel, qpos: np.ndarray, tip_site: int, direction
 
 
 def _first_line(err: BaseException) -> str:
-    text = str(err).strip()
-    return text.splitlines()[0] if text else type(err).__name__
+    """MuJoCo's whole message on one line (its detail, such as the line of an XML error, comes
+    after a line break)."""
+    text = " ".join(str(err).split())
+    return text or type(err).__name__
+
+
+@contextmanager
+def _mujoco_warnings() -> Iterator[list[str]]:
+    """MuJoCo's warnings while the block runs, collected instead of printed and appended to a
+    ``MUJOCO_LOG.TXT`` in the working folder."""
+    caught: list[str] = []
+    previous = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(lambda message: caught.append(" ".join(str(message).split())))
+    try:
+        yield caught
+    finally:
+        mujoco.set_mju_user_warning(previous)
+
+
+FINITE_FIELDS = ("qpos0", "body_pos", "body_quat", "body_mass", "body_inertia", "jnt_pos", "jnt_axis", "jnt_range",
+                 "geom_pos", "geom_quat", "geom_size", "site_pos", "site_quat", "mesh_vert", "actuator_ctrlrange",
+                 "actuator_gainprm", "actuator_biasprm")
+"""The compiled model's numbers the scene and the IK use; each must be finite."""
 
 
 def _load_arm(path: Path) -> tuple[mujoco.MjSpec, mujoco.MjModel]:
     if not path.is_file():
         raise ArmModelError(f"cannot read arm MJCF {str(path)!r}: no such file")
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            spec = mujoco.MjSpec.from_file(str(path))
-            model = spec.compile()
-    except Exception as err:  # noqa: BLE001 - any parse failure is a bad input file
-        raise ArmModelError(f"cannot load arm MJCF {str(path)!r}: {_first_line(err)}") from None
+    with _mujoco_warnings() as caught:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                spec = mujoco.MjSpec.from_file(str(path))
+                model = spec.compile()
+        except Exception as err:  # noqa: BLE001 - any parse failure is a bad input file
+            raise ArmModelError(f"cannot load arm MJCF {str(path)!r}: {_first_line(err)}") from None
+    bad = [f for f in FINITE_FIELDS if not np.all(np.isfinite(getattr(model, f)))]
+    if bad:
+        said = f" (MuJoCo: {'; '.join(caught)})" if caught else ""
+        raise ArmModelError(f"arm MJCF {str(path)!r} has a number that is not finite (NaN or infinity) in "
+                            f"{bad[0]}{said}")
     return spec, model
+
+
+def model_files(path: Path) -> list[Path]:
+    """Every file MuJoCo reads to build the arm file's model: the file itself, the files it
+    ``<include>``s (recursively), and the meshes, textures, height fields and skins its
+    parsed spec names, each resolved as MuJoCo resolves it (``meshdir``/``texturedir``
+    relative to the model file). Files that are missing are listed too: their absence is
+    part of what the model is. Nothing else is read, whatever the folders hold."""
+    path = Path(path)
+    files = [path, *_includes(path, path.parent, set())]
+    with _mujoco_warnings(), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            spec = mujoco.MjSpec.from_file(str(path))
+        except Exception as err:  # noqa: BLE001 - any parse failure is a bad input file
+            raise ArmModelError(f"cannot load arm MJCF {str(path)!r}: {_first_line(err)}") from None
+    base = Path(spec.modelfiledir or path.parent)
+    named = [(spec.meshdir, m.file) for m in spec.meshes] + [(spec.texturedir, t.file) for t in spec.textures]
+    named += [(spec.texturedir, f) for t in spec.textures for f in getattr(t, "cubefiles", ()) if f]
+    named += [(spec.meshdir, h.file) for h in spec.hfields] + [(spec.meshdir, k.file) for k in spec.skins]
+    for folder, name in named:
+        if name:
+            files.append(base / (folder or "") / name)
+    seen: set[Path] = set()
+    return [f for f in files if not (f in seen or seen.add(f))]
+
+
+def _includes(path: Path, root: Path, seen: set[Path]) -> list[Path]:
+    """The files ``path`` includes, recursively (relative names from the main file's folder)."""
+    import xml.etree.ElementTree as ET
+
+    out: list[Path] = []
+    try:
+        tree = ET.parse(path)
+    except (ET.ParseError, OSError):
+        return out  # MuJoCo's own parse says what is wrong
+    for element in tree.iter("include"):
+        name = element.get("file")
+        if not name:
+            continue
+        found = root / name
+        if found in seen:
+            continue
+        seen.add(found)
+        out.append(found)
+        if found.is_file():
+            out.extend(_includes(found, root, seen))
+    return out
 
 
 def _name(model: mujoco.MjModel, obj: mujoco.mjtObj, i: int) -> str:
@@ -422,7 +499,7 @@ def build_scene(xml_path: Path, tool: Tool | str = "tip", mount_pos=(0.0, 0.0, 0
     _pedestal(scene_spec, model, q_all, mount_pos, mount_quat, layout.width * cell / 2)
     frame = scene_spec.worldbody.add_frame(pos=[float(v) for v in mount_pos], quat=mount_quat)
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), _mujoco_warnings():
             warnings.simplefilter("ignore")
             scene_spec.attach(spec, prefix=PREFIX, frame=frame)
             for j in unservoed:

@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import armtransfer.checks as checks
 from armtransfer.errors import ArmModelError
 
 
@@ -29,9 +30,8 @@ class Tool:
     def __post_init__(self) -> None:
         if (self.site is None) == (self.body is None):
             raise ArmModelError("the tool point needs exactly one of a tip site or a tip body")
-        if len(self.offset) != 3 or not all(math.isfinite(v) for v in self.offset):
-            raise ArmModelError(f"a tip offset is three finite numbers (metres), got {self.offset!r}")
-        object.__setattr__(self, "offset", tuple(float(v) for v in self.offset))
+        offset = checks.point(self.offset, "a tip offset (metres)", limit=checks.MAX_METRES, error=ArmModelError)
+        object.__setattr__(self, "offset", offset)
 
     @property
     def has_offset(self) -> bool:

@@ -8,8 +8,10 @@ all made from these fields, so a new parameter is one field here.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import asdict, dataclass, field, fields
 
+import armtransfer.checks as checks
 from armtransfer.errors import InvalidParameterError
 
 
@@ -34,12 +36,13 @@ class LearnerConfig:
     trace_cutoff: float = _param(1e-3, "eligibility traces below this are dropped", 0.0, 1.0, cli=False)
     """With gamma*lambda = 0.891 a trace of 1 falls below 1e-3 after 60 steps. 0 keeps every
     trace until it underflows, which is exactly the dense Algorithm 1."""
-    max_episodes: int = _param(2000, "episodes per trial at most", 1)
+    max_episodes: int = _param(2000, "episodes per trial at most", 1, 1_000_000)
     max_total_steps: int = _param(20_000_000, "steps per trial at most (a trial that has not reached the goal by "
-                                  "then counts as unreached)", 1)
-    max_episode_steps: int = _param(200_000, "steps per episode at most, after the first", 1)
+                                  "then counts as unreached)", 1, checks.MAX_COUNT)
+    max_episode_steps: int = _param(200_000, "steps per episode at most, after the first", 1, checks.MAX_COUNT)
     """Cap on every episode but the first (the first runs until the goal or the total cap)."""
-    patience: int = _param(20, "episodes the greedy path must stay the same to count as converged", 1)
+    patience: int = _param(20, "episodes the greedy path must stay the same to count as converged", 1,
+                            1_000_000)
     """The greedy path has converged when it reaches the goal and stays the same for this
     many consecutive episodes."""
 
@@ -47,18 +50,16 @@ class LearnerConfig:
         for f in fields(self):
             value = getattr(self, f.name)
             lo, hi, lo_open = f.metadata["lo"], f.metadata["hi"], f.metadata["lo_open"]
-            integer = f.type in (int, "int")
-            ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-            if integer:
-                ok = ok and float(value).is_integer()
-            ok = ok and (value > lo if lo_open else value >= lo) and value <= hi and (f.name != "trace_cutoff" or value < 1)
-            if not ok:
-                want = "an integer >= 1" if integer else (
-                    f"in {'(' if lo_open else '['}{lo:g}, {hi:g}]" if math.isfinite(hi) and math.isfinite(lo)
-                    else "a finite number")
-                if f.name == "trace_cutoff":
-                    want = "in [0, 1)"
-                raise InvalidParameterError(f"{f.name} must be {want}, got {value!r}")
+            if f.type in (int, "int"):
+                if isinstance(value, numbers.Real) and not isinstance(value, (bool, numbers.Integral)) \
+                        and math.isfinite(value) and float(value).is_integer():
+                    value = int(value)  # 3.0 from a TOML or JSON file is 3
+                value = checks.whole(value, f.name, int(lo), int(hi))
+            else:
+                value = checks.real(value, f.name, lo, hi, lo_open=lo_open)
+                if f.name == "trace_cutoff" and value >= 1:
+                    raise InvalidParameterError(f"trace_cutoff must be in [0, 1), got {value!r}")
+            object.__setattr__(self, f.name, value)  # numpy scalars are numbers; the config holds Python ones
 
     def to_dict(self) -> dict:
         return asdict(self)

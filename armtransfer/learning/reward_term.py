@@ -15,6 +15,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+import armtransfer.checks as checks
 from armtransfer.errors import InvalidParameterError, InvalidTrajectoryError
 from armtransfer.learning import methods as registry
 from armtransfer.learning import trajectory as trajectories
@@ -33,21 +34,22 @@ class TransferTerm:
     ``trajectory``: a :class:`Trajectory`, a trajectory JSON file, or a list of them.
     ``step_reward`` is the environment's (K='auto' scales with it); ``gamma`` is the discount
     of the potential-based methods' F = gamma*phi(s') - phi(s): set it to the learner's.
+    ``task`` (start cell, goal cell): the trajectories must be of that task.
     Call :meth:`reset` at the start of every episode, then ``term(s, s2, terminated)`` for
     every move from state ``s`` to ``s2``.
     """
 
     def __init__(self, robot: DiscreteRobot, trajectory: TrajectoryLike | Sequence[TrajectoryLike],
                  method: str = "pseudo", K: float | str = "auto", step_reward: float = LearnerConfig().step_reward,
-                 gamma: float = LearnerConfig().gamma, beta: float | None = None) -> None:
+                 gamma: float = LearnerConfig().gamma, beta: float | None = None,
+                 task: tuple[int, int] | None = None) -> None:
         m = registry.get(method)
         if m.name not in registry.REWARD_ONLY:
             why = "adds no reward" if not m.shaped else "changes how the learner chooses actions, not a reward"
             raise InvalidParameterError(f"method {method!r} {why}; valid methods: {', '.join(registry.REWARD_ONLY)}")
-        if isinstance(gamma, bool) or not (isinstance(gamma, (int, float)) and 0.0 <= gamma <= 1.0):
-            raise InvalidParameterError(f"gamma must be in [0, 1], got {gamma!r}")
+        gamma = checks.real(gamma, "gamma", 0.0, 1.0)
         self.robot = robot
-        self.trajectories = [self._load(t) for t in _as_list(trajectory)]
+        self.trajectories = [self._load(t, task) for t in _as_list(trajectory)]
         self.method = m.name
         self.gamma = float(gamma)
         self.shaping = registry.build_shaping(m.name, robot, self.trajectories, K, step_reward, beta=beta,
@@ -57,11 +59,18 @@ class TransferTerm:
         self._episode = -1
         self._best = 0.0
 
-    def _load(self, t: TrajectoryLike) -> Trajectory:
-        traj = t if isinstance(t, Trajectory) else trajectories.load(t)
-        n_cells = self.robot.layout.n_cells
+    def _load(self, t: TrajectoryLike, task: tuple[int, int] | None) -> Trajectory:
+        """A trajectory on the robot's layout and, with ``task`` (start cell, goal cell), of that
+        task: the shaping pays towards the trajectory's goal, so it must be the task's."""
+        if not isinstance(t, (Trajectory, str, os.PathLike)):
+            raise InvalidTrajectoryError(f"a trajectory is a Trajectory or a trajectory JSON file, got {t!r}")
+        layout = self.robot.layout
+        traj = t if isinstance(t, Trajectory) else trajectories.load(t, layout)
+        n_cells = layout.n_cells
         if any(not 0 <= c < n_cells for c in (*traj.cells, traj.goal)):
             raise InvalidTrajectoryError(f"the trajectory names cells outside this robot's layout (0..{n_cells - 1})")
+        if task is not None:
+            trajectories.check_task(traj, task[0], task[1], layout)
         return traj
 
     @property
@@ -89,7 +98,11 @@ class TransferTerm:
 def _as_list(trajectory) -> list:
     if isinstance(trajectory, (Trajectory, str, os.PathLike)):
         return [trajectory]
-    out = list(trajectory)
+    try:
+        out = list(trajectory)
+    except TypeError:
+        raise InvalidTrajectoryError(
+            f"a trajectory is a Trajectory, a trajectory JSON file or a list of them, got {trajectory!r}") from None
     if not out:
         raise InvalidParameterError("transfer shaping needs at least one trajectory")
     return out

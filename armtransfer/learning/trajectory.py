@@ -165,12 +165,36 @@ def load(path: str | os.PathLike, layout: Layout = ROOMS) -> Trajectory:
 
 
 def check_source(traj: Trajectory, robot: DiscreteRobot) -> None:
-    """The trajectory's action indices are actions of the robot said to have made it."""
+    """The trajectory is one the robot said to have made it can make: its action indices are
+    the robot's, and each step's action takes it from the step's cell to the next one (the
+    last to the goal), as :func:`states_along` retraces it."""
     bad = [a for a in traj.actions if not 0 <= a < robot.n_actions]
     if bad:
         raise InvalidTrajectoryError(
             f"the trajectory has action index {bad[0]} but the source robot {robot.name} has "
             f"{robot.n_actions} actions (0..{robot.n_actions - 1})")
+    states_along(robot, traj)
+
+
+def states_along(robot: DiscreteRobot, traj: Trajectory) -> list[int]:
+    """The robot's states along the trajectory, from its start state: the robot is
+    deterministic, so the trajectory's actions give its states back. A step whose cell is not
+    where the robot is, or an end that is not the goal, is an error naming the step."""
+    layout = robot.layout
+    s = robot.start_state(traj.start)
+    states = [s]
+    for k, (cell, a) in enumerate(zip(traj.cells, traj.actions)):
+        if int(robot.label[s]) != cell or not 0 <= a < robot.n_actions:
+            raise InvalidTrajectoryError(
+                f"the trajectory's step {k} at {layout.xy(cell)} is not where {robot.name} is after step "
+                f"{k - 1} ({layout.xy(int(robot.label[s]))}): the trajectory is not a path of {robot.name}")
+        s = int(robot.next_state[s, a])
+        states.append(s)
+    if int(robot.label[s]) != traj.goal:
+        raise InvalidTrajectoryError(
+            f"the trajectory's last step takes {robot.name} to {layout.xy(int(robot.label[s]))}, not to its goal "
+            f"{layout.xy(traj.goal)}")
+    return states
 
 
 def check_task(traj: Trajectory, start_cell: int, goal_cell: int, layout: Layout = ROOMS) -> None:

@@ -13,6 +13,7 @@ configuration of every state, to replay paths with the position servos), ``tip``
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 import time
@@ -20,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+import armtransfer.checks as checks
 from armtransfer.ik import cache as _cache
 from armtransfer.ik.actions import ACTION_MODELS, action_model
 from armtransfer.ik.description import ArmDescription
@@ -134,12 +136,25 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
     bring-your-own arm keeps its tool pointing down unless ``tip_down=False``.
     """
     model = action_model(actions)
-    if not (np.isfinite(cell_size) and cell_size > 0):
-        raise ArmModelError(f"cell size must be a positive number of metres, got {cell_size}")
-    if base_yaw is not None and not np.isfinite(base_yaw):
-        raise ArmModelError(f"the base yaw must be a finite number of radians, got {base_yaw!r}")
+    cell_size, base_pos, base_yaw = _checked_pose(cell_size, base_pos, base_yaw)
+    if joint_step is not None:
+        joint_step = checks.real(joint_step, "the joint step (radians)", 0.0, math.pi, lo_open=True,
+                                 error=ArmModelError)
+    if tip_down is not None:
+        tip_down = checks.flag(tip_down, "tip_down", error=ArmModelError)
+    cache = checks.flag(cache, "cache", error=ArmModelError)
+    if xml_path is None:
+        given = [k for k, v in (("tip_site", tip_site), ("tip_body", tip_body), ("tip_offset", tip_offset),
+                                ("arm_name", arm_name)) if v is not None]
+        if given:
+            raise ArmModelError(f"{given[0]} goes with an arm file (xml_path), not the built-in arm {arm!r}")
     if xml_path is not None:
-        path = Path(xml_path)
+        path = Path(checks.path(xml_path, "the arm file (xml_path)", error=ArmModelError))
+        if tip_offset is not None:
+            tip_offset = checks.point(tip_offset, "the tip offset (metres)", limit=checks.MAX_METRES, error=ArmModelError)
+        for what, value in (("tip_site", tip_site), ("tip_body", tip_body), ("arm_name", arm_name)):
+            if value is not None:
+                checks.name(value, what, error=ArmModelError)
         try:
             xml_bytes = path.read_bytes()
         except OSError as err:
@@ -193,10 +208,11 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
         arrays = build()
     else:
         _check_cache_dir()
-        arrays, status = _cache.load(robot_name, key)
+        check = _arrays_check(layout)
+        arrays, status = _cache.load(robot_name, key, check)
         if arrays is None:
             with _cache.building(_cache.entry_path(robot_name, key)):
-                meanwhile, again = _cache.load(robot_name, key)  # built by another process while we waited
+                meanwhile, again = _cache.load(robot_name, key, check)  # built by another process while we waited
                 if meanwhile is None:
                     arrays = build()
                     _cache.save(robot_name, key, arrays)
@@ -230,6 +246,36 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
         layout=layout,
         arm=description,
     )
+
+
+def _arrays_check(layout: Layout):
+    """Whether a cache entry's arrays make a robot on ``layout``: every array there with
+    its shape, states and cells in range, positions finite."""
+    def check(arrays: dict[str, np.ndarray]) -> bool:
+        nxt, wind, label, qpos, tip = (arrays[k] for k in ("next_state", "wind_state", "label", "qpos", "tip"))
+        canonical = arrays["canonical"]
+        n = len(label)
+        ints = all(np.issubdtype(a.dtype, np.integer) for a in (nxt, wind, label, canonical))
+        return (ints and n > 0 and nxt.ndim == 2 and nxt.shape[0] == n and nxt.shape[1] > 0
+                and wind.shape == (n,) and label.shape == (n,) and qpos.ndim == 2 and qpos.shape[0] == n
+                and tip.shape == (n, 3) and canonical.shape == (layout.n_cells,)
+                and bool(np.all((nxt >= 0) & (nxt < n))) and bool(np.all((wind >= 0) & (wind < n)))
+                and bool(np.all((label >= 0) & (label < layout.n_cells)))
+                and bool(np.all((canonical >= -1) & (canonical < n)))
+                and bool(np.all(np.isfinite(qpos))) and bool(np.all(np.isfinite(tip))))
+
+    return check
+
+
+def _checked_pose(cell_size, base_pos, base_yaw) -> tuple:
+    """The cell size, base position and yaw checked: finite, in metres up to ``checks.MAX_METRES``."""
+    cell_size = checks.real(cell_size, "the cell size (metres)", 0.0, checks.MAX_METRES, lo_open=True,
+                            error=ArmModelError)
+    if base_yaw is not None:
+        base_yaw = checks.real(base_yaw, "the base yaw (radians)", error=ArmModelError)
+    if base_pos is not None:
+        base_pos = checks.point(base_pos, "the base position (metres)", limit=checks.MAX_METRES, error=ArmModelError)
+    return cell_size, base_pos, base_yaw
 
 
 def _builtin_mount(info, cell_size: float) -> tuple[float, float, float]:
@@ -329,8 +375,7 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
     (``ik.diagnose``). The choice is cached under the arm file's content (meshes included),
     tool, cell size and layout, so it is made once.
     """
-    import json
-
+    from armtransfer.errors import UnreachableTableError
     from armtransfer.ik import mount as _mount
 
     parts = {"version": 11, "what": "mount", "compiles": COMPILES, "covers": COVERS,
@@ -342,13 +387,15 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
     entry = _cache.cache_dir() / f"mount-{key[:16]}.json"
     if cache:
         _check_cache_dir()
-        try:
-            data = json.loads(entry.read_text())
-            if data.get("key") == key:
-                return _mount.Pose(tuple(data["pos"]), float(data["yaw"]))
-        except (OSError, ValueError, KeyError, TypeError):
-            pass
-    from armtransfer.errors import UnreachableTableError
+        cached = _cached_pose(entry, key)
+        if cached is not None:  # checked by what it claims: the compiled pose solves and reaches as stored
+            pose, rank = _mount.Pose(*cached[0]), cached[1]
+            try:
+                robot = _mount_robot(path, tool, pose, cell_size, layout, cache)
+                if (tasks_solvable(robot), round(robot.arm.reach, 9)) == rank:
+                    return pose
+            except (ArmModelError, UnreachableTableError):
+                pass
 
     def unreachable(best) -> UnreachableTableError:
         """The error, with the cause measured at the best pose tried (``ik.diagnose``)."""
@@ -374,9 +421,7 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
         if progress:
             print(f"  mount candidate: {pose.describe()} (estimated reach {share:.0%})", file=sys.stderr, flush=True)
         try:
-            robot = arm_robot(None, "cartesian", cell_size=cell_size, xml_path=path, tip_site=tool.site,
-                              tip_body=tool.body, tip_offset=tool.offset, base_pos=pose.pos,
-                              base_yaw=pose.yaw, layout=layout, cache=cache)
+            robot = _mount_robot(path, tool, pose, cell_size, layout, cache)
         except ArmModelError:
             continue
         best = ((tasks_solvable(robot), robot.arm.reach), pose)
@@ -387,9 +432,37 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
     if cache:
         from armtransfer.io import write_json_atomic
 
+        _cache.clear(entry)
         write_json_atomic(entry, {"key": key, "pos": list(pose.pos), "yaw": pose.yaw,
-                                  "solvable": best[0][0], "reach": best[0][1]})
+                                  "solvable": best[0][0], "reach": round(best[0][1], 9)})
     return pose
+
+
+def _mount_robot(path: Path, tool: Tool, pose, cell_size: float, layout: Layout, cache: bool) -> DiscreteRobot:
+    """The 1-cell cartesian robot of the arm file at ``pose``: how the automatic mount ranks it."""
+    return arm_robot(None, "cartesian", cell_size=cell_size, xml_path=path, tip_site=tool.site, tip_body=tool.body,
+                     tip_offset=tool.offset, base_pos=pose.pos, base_yaw=pose.yaw, layout=layout, cache=cache)
+
+
+def _cached_pose(entry: Path, key: str) -> tuple[tuple[tuple[float, float, float], float], tuple[int, float]] | None:
+    """((position, yaw), (tasks solvable, reach)) of the mount choice cached in ``entry`` for
+    ``key``, or None when there is none or it is not one (not a regular file, not JSON,
+    another key, numbers of the wrong kind or out of range): it is then chosen again."""
+    from armtransfer.errors import ArmTransferError
+    from armtransfer.io import parse_json_bytes
+    from armtransfer.tasks.catalog import TABLE_I
+
+    raw = _cache.read_regular(entry)
+    try:
+        data = parse_json_bytes(raw) if raw is not None else None
+        if not isinstance(data, dict) or data.get("key") != key:
+            return None
+        pos = checks.point(data.get("pos"), "pos", limit=checks.MAX_METRES)
+        yaw = checks.real(data.get("yaw"), "yaw")
+        rank = checks.whole(data.get("solvable"), "solvable", 0, len(TABLE_I)), checks.real(data.get("reach"), "reach", 0, 1)
+        return ((pos[0], pos[1], pos[2]), yaw), rank
+    except (ValueError, ArmTransferError):
+        return None
 
 
 def _check_cache_dir() -> None:
@@ -408,15 +481,32 @@ def _check_cache_dir() -> None:
 
 
 def read_sidecar(xml_path: str | os.PathLike) -> dict | None:
-    """The generator's JSON beside an arm file, or None when there is none."""
+    """The generator's JSON beside an arm file, checked, or None when there is none (a file
+    of the generator's format that is malformed is a one-line error naming it)."""
     from armtransfer.io import parse_json_bytes
 
     path = Path(xml_path).with_suffix(".json")
+    raw = _cache.read_regular(path)
     try:
-        data = parse_json_bytes(path.read_bytes())
-    except (OSError, ValueError):
+        data = parse_json_bytes(raw) if raw is not None else None
+    except ValueError:
         return None
-    return data if isinstance(data, dict) and data.get("format") == SIDECAR_FORMAT else None
+    if not (isinstance(data, dict) and data.get("format") == SIDECAR_FORMAT):
+        return None  # not the generator's: the arm is mounted as any other
+    where = f"the generated arm's file {str(path)!r}"
+    try:
+        data["mount_pos"] = list(checks.point(data.get("mount_pos"), "mount_pos", limit=checks.MAX_METRES,
+                                              error=ArmModelError))
+        data["mount_yaw"] = checks.real(data.get("mount_yaw"), "mount_yaw", error=ArmModelError)
+        data["tip_down"] = checks.flag(data.get("tip_down"), "tip_down", error=ArmModelError)
+        if data.get("joint_step") is not None:
+            data["joint_step"] = checks.real(data["joint_step"], "joint_step", 0.0, math.pi, lo_open=True,
+                                             error=ArmModelError)
+        else:
+            data["joint_step"] = None
+    except ArmModelError as err:
+        raise ArmModelError(f"{where}: {err}; write it again with 'armtransfer arms generate' or delete it") from None
+    return data
 
 
 def _sha(data: bytes) -> str:
@@ -425,23 +515,19 @@ def _sha(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
-def _assets_sha(path: Path) -> str | None:
-    """A hash of the files in the arm file's ``meshdir`` and ``texturedir`` (its meshes shape
-    its collisions), or None when it names neither."""
+def _assets_sha(path: Path) -> str:
+    """A hash of every file MuJoCo reads for the arm file but the file itself (its includes,
+    meshes, textures: ``ik.scene.model_files``), names and contents; a missing one counts as
+    missing. Only those files are read, never a whole folder."""
     import hashlib
-    import re
 
-    head = path.read_text(errors="replace")[:20000]
-    dirs = sorted(set(re.findall(r'(?:meshdir|texturedir|assetdir)\s*=\s*"([^"]*)"', head)))
-    if not dirs:
-        return None
+    from armtransfer.ik.scene import model_files
+
     h = hashlib.sha256()
-    for d in dirs:
-        root = (path.parent / d).resolve()
-        if root.is_dir():
-            for f in sorted(p for p in root.rglob("*") if p.is_file()):
-                h.update(str(f.relative_to(root)).encode())
-                h.update(f.read_bytes())
+    for f in model_files(path)[1:]:
+        h.update(str(f.relative_to(path.parent) if f.is_relative_to(path.parent) else f).encode() + b"\0")
+        data = _cache.read_regular(f)
+        h.update(b"missing" if data is None else hashlib.sha256(data).digest())
     return h.hexdigest()
 
 
@@ -450,6 +536,7 @@ def arm_scene(arm: str | None = None, *, cell_size: float = DEFAULT_CELL, xml_pa
               base_pos=None, base_yaw: float | None = None, layout: Layout = ROOMS):
     """The MuJoCo scene (``ik.scene.ArmScene``) a robot of this arm is compiled in (a
     bring-your-own arm without ``base_pos`` at the origin)."""
+    cell_size, base_pos, base_yaw = _checked_pose(cell_size, base_pos, base_yaw)
     if xml_path is not None:
         return _scene(Path(xml_path), make_tool(tip_site, tip_body, tip_offset), base_pos or (0.0, 0.0, 0.0),
                       base_yaw or 0.0, cell_size, layout)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
 
 from armtransfer.errors import InvalidTaskError
@@ -53,6 +54,16 @@ def parse_xy(text: str, what: str) -> tuple[int, int]:
         return int(parts[0]), int(parts[1])
     except ValueError:
         raise InvalidTaskError(f"{what} must be two integers 'X,Y', got {text!r}") from None
+
+
+def as_xy(value: object, what: str) -> tuple[int, int]:
+    """A cell given as 'X,Y' or as two integers (numpy's included), with a one-line error."""
+    if isinstance(value, str):
+        return parse_xy(value, what)
+    xy = list(value) if isinstance(value, (tuple, list)) else None
+    if xy is None or len(xy) != 2 or any(isinstance(v, bool) or not isinstance(v, numbers.Integral) for v in xy):
+        raise InvalidTaskError(f"{what} must be a cell of two integers (x, y), got {value!r}")
+    return int(xy[0]), int(xy[1])
 
 
 def custom_task(start: tuple[int, int], goal: tuple[int, int], layout: Layout = ROOMS) -> Task:

@@ -9,14 +9,16 @@ task=1, robot="fine")``. The observation is the robot's own state index, the act
 
 from __future__ import annotations
 
+import numbers
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from armtransfer.tasks.catalog import Task, custom_task, table_task
-from armtransfer.errors import InvalidParameterError
+import armtransfer.checks as checks
+from armtransfer.errors import InvalidParameterError, InvalidTaskError
+from armtransfer.tasks.catalog import Task, as_xy, custom_task, table_task
 from armtransfer.registration import register_envs  # noqa: F401  (kept importable from here)
 from armtransfer.tasks.robot import DiscreteRobot
 
@@ -34,7 +36,9 @@ class RoomsRules:
 
     def _set_rules(self, robot: DiscreteRobot, task: Task, wind: float, step_reward: float,
                    goal_reward: float) -> None:
-        check_wind(wind)
+        wind = check_wind(wind)
+        step_reward = checks.real(step_reward, "step_reward")
+        goal_reward = checks.real(goal_reward, "goal_reward")
         self.robot = robot
         self.task = task
         self.start_state, self.goal_cell = task_states(robot, task)
@@ -90,6 +94,10 @@ class RobotRoomsEnv(RoomsRules, gym.Env):
         return int(self.state), {"label": int(self.robot.label[self.state])}
 
     def step(self, action):
+        if isinstance(action, (bool, np.bool_)) or not self.action_space.contains(action):  # as Gymnasium's own
+            raise InvalidParameterError(
+                f"action must be an integer in 0..{self.robot.n_actions - 1} (the action space "
+                f"{self.action_space}), got {action!r}")
         s = self._move(int(action), self.np_random)
         reward, terminated = self._outcome()
         return s, reward, terminated, False, {"label": int(self.robot.label[s])}
@@ -138,9 +146,8 @@ def grid_image(layout, robot_cell: int, goal_cell: int, cell_pixels: int = CELL_
     return np.ascontiguousarray(image)
 
 
-def check_wind(wind: float) -> None:
-    if not 0.0 <= wind <= 1.0:
-        raise InvalidParameterError(f"wind must be a probability in [0, 1], got {wind}")
+def check_wind(wind: float) -> float:
+    return checks.probability(wind, "wind")
 
 
 def task_states(robot: DiscreteRobot, task: Task) -> tuple[int, int]:
@@ -154,8 +161,14 @@ def task_states(robot: DiscreteRobot, task: Task) -> tuple[int, int]:
 
 def rooms_task(task: int | None = 1, start: tuple[int, int] | None = None,
                goal: tuple[int, int] | None = None) -> Task:
-    """A Table I task, or the custom task from ``start`` to ``goal`` when both are given."""
-    return custom_task(start, goal) if start is not None and goal is not None else table_task(task)
+    """A Table I task, or the custom task from ``start`` to ``goal`` (cells (x, y) or 'X,Y')."""
+    if start is None and goal is None:
+        if isinstance(task, bool) or not isinstance(task, numbers.Integral):
+            raise InvalidTaskError(f"a task is a Table I task number (1-4), got {task!r}")
+        return table_task(int(task))
+    if start is None or goal is None:
+        raise InvalidTaskError("start and goal go together")
+    return custom_task(as_xy(start, "start"), as_xy(goal, "goal"))
 
 
 def make_rooms_env(
@@ -168,7 +181,20 @@ def make_rooms_env(
     """Entry point of ``armtransfer/Rooms-v0``: a grid robot on a Table I or custom task."""
     from armtransfer.tasks.grid_robots import grid_robot
 
+    check_options(kwargs)
     return RobotRoomsEnv(grid_robot(robot), rooms_task(task, start, goal), **kwargs)
+
+
+TASK_OPTIONS = ("wind", "step_reward", "goal_reward", "render_mode")
+"""The keywords of an environment that set up its task (beside task, start and goal)."""
+
+
+def check_options(kwargs: dict, extra: tuple[str, ...] = ()) -> None:
+    """An unknown keyword is a one-line error listing the valid ones."""
+    unknown = sorted(k for k in kwargs if k not in TASK_OPTIONS + extra)
+    if unknown:
+        raise InvalidParameterError(
+            f"unknown environment option {unknown[0]!r}; valid options: {', '.join(TASK_OPTIONS + extra)}")
 
 
 ARM_OPTIONS = ("cell_size", "xml_path", "tip_site", "tip_body", "tip_offset", "arm_name", "base_pos", "base_yaw",
@@ -184,6 +210,10 @@ def rooms_arm(arm: str | None, actions: str, options: dict[str, Any]) -> Discret
 
     robot_kwargs = {k: options.pop(k) for k in ARM_OPTIONS if k in options}
     if robot_kwargs.get("xml_path") is None:  # a built-in arm, planar2 by default
+        if arm is not None and not isinstance(arm, str):
+            raise InvalidParameterError(f"arm must be an arm's name, got {arm!r}")
+        if not isinstance(actions, str):
+            raise InvalidParameterError(f"actions must be an action model's name, got {actions!r}")
         arm, actions = parse_robot_spec(f"{arm or 'planar2'}:{actions}")
     return arm_robot(arm, actions, **robot_kwargs)
 
@@ -194,5 +224,6 @@ def make_arm_rooms_env(arm: str | None = None, actions: str = "joint", task: int
     """Entry point of ``armtransfer/ArmRooms-v0``: an arm robot (compiled or loaded from the
     cache) on a Table I or custom task. Bring-your-own arms: ``xml_path=`` with ``tip_site=`` or
     ``tip_body=``, ``tip_offset=``, ``arm_name=``, ``base_pos=``/``base_yaw=`` (automatic without)."""
+    check_options(kwargs, ARM_OPTIONS)
     the_task = rooms_task(task, start, goal)  # a bad task fails before any compiling
     return RobotRoomsEnv(rooms_arm(arm, actions, kwargs), the_task, **kwargs)

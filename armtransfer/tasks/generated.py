@@ -19,6 +19,7 @@ spec anywhere: ``out_dir/<name>/<name>.xml:cartesian`` (its mount is read from t
 from __future__ import annotations
 
 import os
+import shutil
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from armtransfer.errors import ArmModelError, ArmTransferError
-from armtransfer.io import staged_directory, write_json_atomic, write_text_atomic
+from armtransfer.io import check_output_dir, staged_directory, write_json_atomic, write_text_atomic
 from armtransfer.ik.workspace import DEFAULT_CELL
 from armtransfer.models.generate import ArmDraw, check_family, draw_arm, planar_tip_cells, with_home
 from armtransfer.tasks.arms import SIDECAR_FORMAT, read_sidecar
@@ -60,6 +61,7 @@ def generate_arm(family: str, dof: int, seed: int, out_dir: str | os.PathLike, *
         raise ArmModelError(f"seed must be an integer >= 0, got {seed!r}")
     name = arm_name(family, dof, seed)
     final = Path(out_dir) / name
+    check_output_dir(final, "--out")  # before the draws, not after
     rng = np.random.default_rng(seed)
     rejected: list[str] = []
     with tempfile.TemporaryDirectory(prefix="armgen-") as work:
@@ -177,6 +179,14 @@ def resolve_generated(spec: str, progress: bool = False):
     name = arm_name(family, dof, seed)
     root = cache_dir() / "generated"
     xml = root / name / f"{name}.xml"
-    if not xml.is_file():
+    try:
+        generated = read_sidecar(xml) if xml.is_file() else None
+    except ArmModelError:
+        generated = None
+    if generated is None:  # never made, or its files were changed or lost: drawn again (the same arm)
+        if os.path.lexists(root / name):
+            shutil.rmtree(root / name) if (root / name).is_dir() and not (root / name).is_symlink() \
+                else (root / name).unlink()
         generate_arm(family, dof, seed, root, progress=progress)
-    return robot_of(xml, read_sidecar(xml), actions, progress=progress)
+        generated = read_sidecar(xml)
+    return robot_of(xml, generated, actions, progress=progress)

@@ -56,7 +56,7 @@ def resolve(spec: str | DiscreteRobot, *, xml_path=None, progress: bool = False,
         from armtransfer.tasks.arms import arm_robot, parse_robot_spec
 
         arm, actions = parse_robot_spec(spec)
-        sized = {"cell_size": arm_options["cell_size"]} if arm_options.get("cell_size") is not None else {}
+        sized = {k: arm_options[k] for k in ("cell_size", "cache") if arm_options.get(k) is not None}
         return arm_robot(arm, actions, progress=progress, **sized)
     file_arm = f"{CUSTOM} or {given} (the arm of --arm-xml)" if given else f"or {CUSTOM} with --arm-xml"
     if actions:

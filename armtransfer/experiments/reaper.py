@@ -1,0 +1,101 @@
+"""Processes that end with the sweep that started them, however it ends.
+
+A local Ray instance's processes (its GCS server, raylet, agents and workers) are the
+sweep's children, but a sweep killed with SIGKILL cannot stop them, and they lived on for
+minutes. :class:`Reaper` starts a small watcher process before anything else is started and
+tells it the pids to stop; the watcher waits on a pipe from the sweep. When the sweep says
+``done`` (it stopped them itself) the watcher just exits; when the pipe closes without it
+(the sweep died), the watcher kills those processes and every process they started.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+DONE = "done"
+
+
+def _stat(pid: int) -> list[str] | None:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()
+    except OSError:
+        return None
+
+
+def start_time(pid: int) -> str | None:
+    """Process ``pid``'s start time (so a pid taken again by a new process is told apart)."""
+    fields = _stat(pid)
+    return fields[19] if fields else None
+
+
+def descendants(pids: set[int]) -> set[int]:
+    """``pids`` and every living process below them."""
+    children: dict[int, list[int]] = {}
+    for entry in Path("/proc").glob("[0-9]*"):
+        fields = _stat(int(entry.name))
+        if fields and fields[0] != "Z":
+            children.setdefault(int(fields[1]), []).append(int(entry.name))
+    out, todo = set(), list(pids)
+    while todo:
+        pid = todo.pop()
+        if pid not in out:
+            out.add(pid)
+            todo.extend(children.get(pid, ()))
+    return out
+
+
+class Reaper:
+    """The watcher of one sweep: :meth:`watch` the pids to stop if the sweep dies; :meth:`close`
+    when they were stopped."""
+
+    def __init__(self) -> None:
+        self.proc = subprocess.Popen([sys.executable, "-c", "from armtransfer.experiments.reaper import main; main()"],
+                                     stdin=subprocess.PIPE, text=True, start_new_session=True,
+                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+    def watch(self, pids) -> None:
+        for pid in pids:
+            start = start_time(pid)
+            if start is not None and pid != self.proc.pid:
+                self.proc.stdin.write(f"{pid} {start}\n")
+        self.proc.stdin.flush()
+
+    def close(self, stop: bool = False) -> None:
+        """End the watcher; with ``stop`` it kills the watched processes first."""
+        try:
+            if not stop:
+                self.proc.stdin.write(DONE + "\n")
+            self.proc.stdin.close()
+        except OSError:
+            pass
+        self.proc.wait()
+
+
+def children_of(pid: int) -> set[int]:
+    """Every living process below ``pid``."""
+    return descendants({pid}) - {pid}
+
+
+def main() -> None:
+    """The watcher: read "PID START" lines until the pipe closes; then, unless the last line
+    was ``done``, kill each listed process that still is the one listed, with everything below."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # a Ctrl-C to the sweep's group is the sweep's
+    listed: dict[int, str] = {}
+    last = ""
+    for line in sys.stdin:
+        last = line.strip()
+        parts = last.split()
+        if len(parts) == 2 and parts[0].isdigit():
+            listed[int(parts[0])] = parts[1]
+    if last == DONE:
+        return
+    alive = {pid for pid, start in listed.items() if start_time(pid) == start}
+    for pid in descendants(alive):
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass

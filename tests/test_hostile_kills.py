@@ -1,0 +1,168 @@
+"""A kill at any moment leaves nothing behind: a sweep or matrix killed while its workers
+start leaves no worker (nor Python's resource tracker) running; a worker that dies while the
+driver hands out work costs only a retry; an `arms` run killed mid-way leaves a staging
+folder that the next run into the same --out removes. Every test here kills only processes
+it started, and kills whatever it finds left over even when its check fails."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from armtransfer.experiments import executors
+from armtransfer.io import clean_stale_staging, staged_directory
+from contract import session, settle
+
+pytestmark = pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc")
+
+SWEEP = """[sweep]
+name = "kills"
+tasks = [1]
+pairs = [["coarse", "fine"]]
+methods = ["none"]
+seeds = {seeds}
+trials = 2
+"""
+
+
+def start(argv, cwd) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", "armtransfer.cli", *argv], cwd=cwd, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, start_new_session=True)
+
+
+@pytest.mark.parametrize("command", ["sweep", "matrix"])
+def test_a_kill_while_workers_start_leaves_no_process(command, tmp_path):
+    (tmp_path / "s.toml").write_text(SWEEP.format(seeds=list(range(8))))
+    argv = (["sweep", "s.toml", "--out", "store", "--workers", "2"] if command == "sweep" else
+            ["matrix", "--robots", "coarse,fine", "--tasks", "1-4", "--methods", "none", "pseudo", "--trials", "1",
+             "--out", "store", "--workers", "2"])
+    proc = start(argv, tmp_path)
+    try:
+        deadline = time.time() + 120
+        while time.time() < deadline and len(session(proc.pid)) < 3:  # the driver and its first workers
+            time.sleep(0.01)
+        assert len(session(proc.pid)) >= 3, "the workers never started"
+        os.kill(proc.pid, signal.SIGKILL)  # the driver only, while its workers import
+        proc.wait()
+    finally:
+        left = settle(proc.pid)
+    assert left == [], "processes outlived the killed driver"
+
+
+def _dies_on_first(run, robots):
+    """A worker that dies at once the first time it runs (a marker file says it did)."""
+    marker = Path(os.environ["HOSTILE_MARKER"])
+    if not marker.exists():
+        marker.write_text("died")
+        os._exit(9)
+    return {"ok": run["key"]}, 0.0
+
+
+def test_a_worker_dying_while_work_is_handed_out_costs_a_retry(tmp_path, monkeypatch):
+    monkeypatch.setenv("HOSTILE_MARKER", str(tmp_path / "marker"))
+    runs = [{"key": f"r{i}", "source": "coarse", "target": "fine"} for i in range(12)]
+    done, failed = [], []
+    executors.run_local(runs, {}, 3, lambda run, result, secs: done.append(run["key"]),
+                        lambda run, error, attempts: failed.append(run["key"]), retries=2, fn=_dies_on_first)
+    assert sorted(done) == sorted(r["key"] for r in runs) and failed == []
+
+
+def test_a_broken_pool_at_submit_is_a_retry_not_a_traceback(tmp_path, monkeypatch):
+    from concurrent.futures.process import BrokenProcessPool
+
+    calls = {"n": 0}
+    real = executors.ProcessPoolExecutor.submit
+
+    def flaky(self, *a, **k):
+        calls["n"] += 1
+        if calls["n"] == 2:
+            raise BrokenProcessPool("a worker died while work was handed out")
+        return real(self, *a, **k)
+
+    monkeypatch.setattr(executors.ProcessPoolExecutor, "submit", flaky)
+    monkeypatch.setenv("HOSTILE_MARKER", str(tmp_path / "never"))
+    (tmp_path / "never").write_text("")  # _dies_on_first never dies
+    runs = [{"key": f"r{i}", "source": "coarse", "target": "fine"} for i in range(4)]
+    done = []
+    executors.run_local(runs, {}, 2, lambda run, result, secs: done.append(run["key"]),
+                        lambda *a: pytest.fail(f"failed: {a}"), fn=_dies_on_first)
+    assert sorted(done) == sorted(r["key"] for r in runs)
+
+
+def test_a_killed_arms_run_leaves_staging_that_the_next_run_removes(tmp_path):
+    base = ["arms", "--source", "coarse", "--target", "fine", "--trajectory", "optimal", "--no-video",
+            "--no-controls", "--out", "D"]
+    proc = start([*base, "--trials", "50"], tmp_path)
+    try:
+        deadline = time.time() + 120
+        while time.time() < deadline and not list(tmp_path.glob(".D.*.tmp")):
+            time.sleep(0.05)
+        assert list(tmp_path.glob(".D.*.tmp")), "the run never staged"
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+    finally:
+        assert settle(proc.pid, 10) == []
+    assert list(tmp_path.glob(".D.*.tmp")), "a SIGKILL leaves the staging folder (nothing could remove it)"
+    again = start([*base, "--trials", "1"], tmp_path)
+    assert again.wait(timeout=300) == 0
+    settle(again.pid, 5)
+    assert not list(tmp_path.glob(".*.tmp")), "the next run left the killed run's staging folder"
+    assert (tmp_path / "D" / "results.json").is_file()
+
+
+def test_a_living_run_keeps_its_staging(tmp_path):
+    with staged_directory(tmp_path / "A") as tmp:
+        assert clean_stale_staging(tmp_path / "B") == [] and tmp.is_dir()
+    foreign = tmp_path / ".notes.tmp"
+    foreign.mkdir()  # not a staging folder of ours: no owner, another name
+    assert clean_stale_staging(tmp_path / "A") == [] and foreign.is_dir()
+
+
+def test_an_address_that_is_not_ray_is_named_at_once(tmp_path, monkeypatch, capsys):
+    pytest.importorskip("ray")
+    import http.server
+    import threading
+
+    from armtransfer.cli import main
+
+    class Quiet(http.server.SimpleHTTPRequestHandler):
+        def log_message(self, *args):
+            pass
+
+    server = http.server.HTTPServer(("127.0.0.1", 0), Quiet)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    try:
+        monkeypatch.chdir(tmp_path)
+        (tmp_path / "s.toml").write_text(SWEEP.format(seeds=[0]))
+        t0 = time.monotonic()
+        code = main(["sweep", "s.toml", "--out", "store", "--executor", "ray", "--address",
+                     f"127.0.0.1:{server.server_address[1]}"])
+        assert code == 2 and time.monotonic() - t0 < 30
+    finally:
+        server.shutdown()
+        server.server_close()
+    err = capsys.readouterr().err
+    assert "is not Ray (it answered '" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "store").exists()
+
+
+@pytest.mark.slow
+def test_a_killed_ray_sweep_takes_its_local_ray_with_it(tmp_path):
+    pytest.importorskip("ray")
+    (tmp_path / "s.toml").write_text(SWEEP.format(seeds=list(range(20))))
+    proc = start(["sweep", "s.toml", "--out", "store", "--executor", "ray", "--workers", "1"], tmp_path)
+    try:
+        deadline = time.time() + 180
+        while time.time() < deadline and len(session(proc.pid)) < 6:  # the driver and Ray's own processes
+            time.sleep(0.2)
+        assert len(session(proc.pid)) >= 6, "Ray never started"
+        time.sleep(2)
+        os.kill(proc.pid, signal.SIGKILL)  # the driver only
+        proc.wait()
+    finally:
+        left = settle(proc.pid, 30)
+    assert left == [], "Ray's processes outlived the killed sweep"
