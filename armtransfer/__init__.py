@@ -45,9 +45,9 @@ _LAZY = {
 __all__ = sorted(_LAZY)
 
 
-from armtransfer.registration import register_envs as _register_envs  # noqa: E402
+from armtransfer.registration import register_on_import as _register_on_import  # noqa: E402
 
-_register_envs()
+_register_on_import()
 
 
 def __getattr__(name: str):

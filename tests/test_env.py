@@ -56,12 +56,16 @@ def test_rooms_rgb_array_shows_the_robot_and_goal():
     assert np.all(env.render()[24 * 6 + 3, 25 * 6 + 3] == (40, 90, 230))
 
 
-def test_importing_armtransfer_registers_the_environments():
-    """As in Gymnasium's ecosystem: the import alone registers, in a fresh process."""
+@pytest.mark.parametrize("imports", ["import gymnasium as gym, armtransfer",
+                                     "import armtransfer, sys; assert 'gymnasium' not in sys.modules; "
+                                     "import gymnasium as gym"])
+def test_importing_armtransfer_registers_the_environments(imports):
+    """As in Gymnasium's ecosystem: the import alone registers, in a fresh process, in either
+    order (imported first, armtransfer waits for Gymnasium rather than loading it)."""
     import subprocess
     import sys
 
-    code = ("import gymnasium as gym, armtransfer\n"
+    code = (f"{imports}\n"
             "env = gym.make('armtransfer/Rooms-v0', task=1, robot='fine')\n"
             "print(env.spec.id, type(env.unwrapped).__name__, env.unwrapped.robot.name, env.spec.max_episode_steps)\n")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
