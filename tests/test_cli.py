@@ -203,6 +203,7 @@ def test_bench_kernels_fast_mode_times_both_kernels_and_refuses_a_bad_revision()
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr
 
 
+@pytest.mark.slow  # the fast mode of bench_kernels runs by default
 def test_bench_kernels_loads_a_kernel_of_the_old_tree_and_of_todays():
     """--against reads the learner from transfer/ (before the move) or armtransfer/learning/, with
     its guide as one file or as a package."""

@@ -100,6 +100,7 @@ def test_bad_matrix_input_is_one_line_and_writes_nothing(tmp_path, capsys, args,
     assert not out.exists()
 
 
+@pytest.mark.slow  # the store's resume after SIGKILL runs by default in test_sweep's kill -9 test
 def test_sigkill_mid_matrix_then_resume_gives_the_same_matrix(tmp_path):
     whole = tmp_path / "whole"
     assert main(["matrix", *ARGS, "--out", str(whole), "--workers", "1"]) == 0
@@ -119,6 +120,7 @@ def test_sigkill_mid_matrix_then_resume_gives_the_same_matrix(tmp_path):
     assert _cells(out) == _cells(whole)
 
 
+@pytest.mark.slow  # Ray against the local pool runs by default in test_sweep
 def test_ray_executor_gives_the_same_matrix(tmp_path):
     ray = pytest.importorskip("ray")
     local, remote = tmp_path / "local", tmp_path / "ray"
