@@ -54,6 +54,7 @@ def exit_with(main: Callable[[], int | None]) -> NoReturn:
     raised while a C extension runs Python code marks the interpreter, which then ends itself
     with SIGINT at shutdown even though ``main`` caught it, and the shell would see a signal
     instead of code 130."""
+    code: str | int | None
     try:
         try:
             code = main()

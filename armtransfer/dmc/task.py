@@ -38,6 +38,7 @@ class RoomsTask(RoomsRules, base.Task):
                  goal_reward: float = 0.0, random: int | np.random.Generator | None = None) -> None:
         if robot.arm is None:
             raise UnknownRobotError(f"robot {robot.name} is not an arm robot; a dm_control task needs ARM:ACTIONS")
+        self._arm = robot.arm
         super().__init__(random=0)  # base state (reward colours); the RandomState is replaced below
         self._set_rules(robot, task, wind, step_reward, goal_reward)
         if not (random is None or isinstance(random, np.random.Generator)
@@ -80,7 +81,7 @@ class RoomsTask(RoomsRules, base.Task):
         self._move(self._action(action), self._random)
 
     def after_step(self, physics: ArmPhysics) -> None:
-        physics.set_configuration(self.robot.arm.qpos[self.state])
+        physics.set_configuration(self._arm.qpos[self.state])
 
     def get_observation(self, physics: ArmPhysics) -> collections.OrderedDict:
         return collections.OrderedDict(

@@ -130,7 +130,7 @@ def run_method(
     target: DiscreteRobot,
     start_cell: int,
     goal_cell: int,
-    traj: Trajectory | Sequence[Trajectory] | None,
+    traj: Trajectory | Sequence[Trajectory] | Callable[[int], Sequence[Trajectory]] | None,
     trials: int,
     seed: int,
     config: LearnerConfig,
@@ -143,7 +143,8 @@ def run_method(
     threads: int | None = None,
 ) -> MethodResult:
     """``trials`` independent trials of one method on the target robot, on ``threads``
-    threads (None: :func:`trial_threads`); the results do not depend on how many."""
+    threads (None: :func:`trial_threads`); the results do not depend on how many. ``traj``:
+    the transferred trajectories, or a function giving each trial its own."""
     if trials < 1:
         raise InvalidParameterError(f"trials must be a positive integer, got {trials}")
     start_state = target.start_state(start_cell)
@@ -297,7 +298,6 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int 
 
     by_name = {r.label: r for r in results}
     base = by_name.get(baseline)
-    base_ex = base.column("exploration_steps") if base else None
     out: dict = {}
     for r in results:
         ex = r.column("exploration_steps")
@@ -309,6 +309,7 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int 
         g_mean, g_ci = metrics.mean_ci(greedy)
         imp = None
         if r.label != baseline and base is not None:
+            base_ex = base.column("exploration_steps")
             imp = metrics.paired_improvement(base_ex, ex, c, paired=len(base_ex) == len(ex))
         against = {}
         known = methods.METHODS.get(r.method)  # None: a result made outside the registry
@@ -394,7 +395,7 @@ def add_transfer_metrics(summary: dict, optimal: int, baseline: str = "none") ->
             lm.trial_metrics(ep, g, optimal, ref_first, ref_area)
             for ep, g in zip(entry["episode_steps"], entry["greedy_steps"])
         ]
-        block = {}
+        block: dict[str, object] = {}
         for name in ("jumpstart", "time_to_threshold", "area", "transfer_ratio", "asymptotic"):
             values = [m[name] for m in per_trial]
             mean, ci = metrics.mean_ci(values)

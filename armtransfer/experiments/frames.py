@@ -45,7 +45,7 @@ def pandas():
 def settings_columns(settings: dict) -> dict:
     """A run's settings as flat columns: a cell (x, y) becomes ``NAME_x``, ``NAME_y``; a nested
     value (e.g. a sweep's arm definitions) becomes its JSON text."""
-    out = {}
+    out: dict[str, object] = {}
     for name, value in settings.items():
         if name in ("start", "goal") and isinstance(value, (list, tuple)) and len(value) == 2:
             out[f"{name}_x"], out[f"{name}_y"] = int(value[0]), int(value[1])
@@ -67,7 +67,7 @@ def trial_rows(method: str, control: str | None, per_trial: dict[str, Sequence],
     flat = settings_columns(settings)
     rows = []
     for trial in range(n):
-        row = {"method": method, "control": control, "trial": trial}
+        row: dict[str, object] = {"method": method, "control": control, "trial": trial}
         for name, value in per_trial.items():
             row[name] = value[trial] if name in lists else value
         row["reached"] = row["exploration_steps"] is not None

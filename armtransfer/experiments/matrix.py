@@ -136,7 +136,7 @@ def robots_of(records: list[dict]) -> list[str]:
 
 
 def _fmt(c: Cell | None) -> str:
-    if c is None or c.improvement is None:
+    if c is None or c.improvement is None or c.ci95 is None:
         return "—"
     text = f"{round(c.improvement):d}% [{round(c.ci95[0]):d}, {round(c.ci95[1]):d}]"
     return text if c.reached == c.trials else f"{text} ({c.reached}/{c.trials} reached)"
@@ -149,22 +149,25 @@ def family_rows(all_cells: list[Cell]) -> list[dict]:
     95% confidence (CI above or below 0)."""
     rows = []
     for method in sorted({c.method for c in all_cells}):
-        groups: dict[str, list[Cell]] = {"self": [], "within family": [], "across families": []}
+        # each pair's improvement and its CI
+        groups: dict[str, list[tuple[float, tuple[float, float]]]] = {
+            "self": [], "within family": [], "across families": []}
         for c in all_cells:
-            if c.method != method or c.improvement is None:
+            if c.method != method or c.improvement is None or c.ci95 is None:
                 continue
             if c.source == c.target:
-                groups["self"].append(c)
+                group = "self"
             elif family(c.source) == family(c.target):
-                groups["within family"].append(c)
+                group = "within family"
             else:
-                groups["across families"].append(c)
+                group = "across families"
+            groups[group].append((c.improvement, c.ci95))
         for name, members in groups.items():
-            values = [c.improvement for c in members]
+            values = [imp for imp, _ in members]
             rows.append({"method": method, "group": name, "pairs": len(members),
                          "median_improvement": float(np.median(values)) if values else None,
-                         "helped": sum(c.ci95[0] > 0 for c in members),
-                         "hurt": sum(c.ci95[1] < 0 for c in members)})
+                         "helped": sum(ci[0] > 0 for _, ci in members),
+                         "hurt": sum(ci[1] < 0 for _, ci in members)})
     return rows
 
 

@@ -94,10 +94,11 @@ def exploration_stats(values: Sequence[int | None], cap: int) -> dict:
     (``median_is_lower_bound``, set from exactly half censored on)."""
     n = len(values)
     reached = sum(v is not None for v in values)
-    out = {"n": n, "reached": reached, "censored": reached < n, "cap": cap,
-           "mean": None, "ci95": None, "mean_is_lower_bound": reached < n,
-           "median": None, "median_ci95": None, "median_ci_coverage": None,
-           "median_is_lower_bound": False, "cap_dominated": False}
+    out: dict[str, object] = {
+        "n": n, "reached": reached, "censored": reached < n, "cap": cap,
+        "mean": None, "ci95": None, "mean_is_lower_bound": reached < n,
+        "median": None, "median_ci95": None, "median_ci_coverage": None,
+        "median_is_lower_bound": False, "cap_dominated": False}
     if n == 0:
         return out
     from armtransfer.experiments.survival import bootstrap_ci
@@ -120,7 +121,7 @@ def improvement_percent(baseline: float | None, value: float | None) -> float | 
     return 100.0 * (baseline - value) / baseline
 
 
-def paired_improvement(base: Sequence[int | None], other: Sequence[int | None], cap: int,
+def paired_improvement(base: Sequence[float | None], other: Sequence[float | None], cap: int,
                        paired: bool = True) -> dict:
     """Improvement in percent of ``other``'s mean over ``base``'s, 100 (1 - mean(o)/mean(b)),
     both censored at ``cap``, with a 95% interval.
@@ -137,9 +138,10 @@ def paired_improvement(base: Sequence[int | None], other: Sequence[int | None], 
     o = censor(other, cap)
     if paired and len(b) != len(o):
         raise ValueError(f"a paired comparison needs as many trials in both ({len(b)} vs {len(o)})")
-    out = {"percent": None, "ci95": None, "design": PAIRED_DESIGN if paired else INDEPENDENT_DESIGN,
-           "n": [len(b), len(o)], "censored": bool(any(v is None for v in base) or any(v is None for v in other)),
-           "cap_dominated": bool(len(b) and len(o) and max(cap_share(base, cap), cap_share(other, cap)) > 0.5)}
+    out: dict[str, object] = {
+        "percent": None, "ci95": None, "design": PAIRED_DESIGN if paired else INDEPENDENT_DESIGN,
+        "n": [len(b), len(o)], "censored": bool(any(v is None for v in base) or any(v is None for v in other)),
+        "cap_dominated": bool(len(b) and len(o) and max(cap_share(base, cap), cap_share(other, cap)) > 0.5)}
     if len(b) == 0 or len(o) == 0 or b.mean() == 0:
         return out
     r = float(o.mean() / b.mean())

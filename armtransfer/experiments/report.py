@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
+
 
 def fmt_num(x: float | None, digits: int = 1) -> str:
     return "n/a" if x is None else f"{x:,.{digits}f}"
@@ -29,9 +31,9 @@ def fmt_median(entry: dict, digits: int = 1, note: bool = True) -> str:
     """Median [order-statistic CI]; with ``note`` the CI's coverage is named when below 95%
     (fewer than 6 trials), and ``≥`` marks a median that censoring reached."""
     cov = entry.get("median_ci_coverage")
-    note = f" ({100 * cov:.0f}% CI)" if note and cov is not None and cov < 0.95 else ""
+    remark = f" ({100 * cov:.0f}% CI)" if note and cov is not None and cov < 0.95 else ""
     return (("≥ " if entry.get("median_is_lower_bound") else "")
-            + f"{fmt_num(entry.get('median'), digits)} {fmt_ci(entry.get('median_ci95'), digits)}{note}")
+            + f"{fmt_num(entry.get('median'), digits)} {fmt_ci(entry.get('median_ci95'), digits)}{remark}")
 
 
 def _coverage(entry: dict) -> str | None:
@@ -39,7 +41,7 @@ def _coverage(entry: dict) -> str | None:
     return None if cov is None else ("95%" if cov >= 0.95 else f"{100 * cov:.0f}%")
 
 
-def median_column(entries) -> tuple[str, object]:
+def median_column(entries: Iterable[dict]) -> tuple[str, Callable[[dict], str]]:
     """(header, cell formatter) of a median column: the header names the coverage its CIs hold
     (``median [75% CI]`` for 3 trials, ``median [95% CI]`` from 6 on); only where the rows'
     coverages differ does each cell name its own."""

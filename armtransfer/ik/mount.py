@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -140,7 +141,7 @@ def _lattice(layout: Layout, extra: list[int]) -> list[int]:
 
 
 def estimate_reach(xml_path, tool: Tool, pose: Pose, layout: Layout, cell: float, *,
-                   must: list[int] = (), rng: np.random.Generator | None = None,
+                   must: Sequence[int] = (), rng: np.random.Generator | None = None,
                    light: bool = False) -> tuple[float, int]:
     """(share of the sparse lattice's free cells reached, how many of ``must`` were reached),
     with the quick IK (``ik.quick.QuickIK``) and the compile's contact check. The first cell
@@ -181,13 +182,13 @@ def estimate_reach(xml_path, tool: Tool, pose: Pose, layout: Layout, cell: float
     while queue:
         i = queue.popleft()
         near = np.flatnonzero(np.linalg.norm(xy - xy[i], axis=1) <= spacing)
-        for n in near:
-            n = int(n)
-            if n in found or tries[n] >= 2:
+        for k in near:
+            j = int(k)
+            if j in found or tries[j] >= 2:
                 continue
-            tries[n] += 1
-            if attempt(n, found[i]):
-                queue.append(n)
+            tries[j] += 1
+            if attempt(j, found[i]):
+                queue.append(j)
     share = len(found) / max(1, len(cells))
     must_set = {int(c) for c in must}
     reached_must = sum(1 for i in found if cells[i] in must_set)

@@ -39,7 +39,7 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Sequence
+from typing import TYPE_CHECKING, Sequence
 
 import mujoco  # after armtransfer.ik named the backend
 import numpy as np
@@ -50,12 +50,19 @@ from armtransfer.ik.replay import Replay, replay
 from armtransfer.ik.workspace import WALL_HEIGHT
 from armtransfer.io import OutputError, check_writable
 
+if TYPE_CHECKING:
+    from imageio.core.format import Format
+    from imageio.plugins.pillow import PillowPlugin
+
 FORMATS = {".mp4": "mp4", ".gif": "gif"}
 TRAJECTORY_RGBA = (1.0, 0.55, 0.1, 1.0)
 GOAL_RGBA = (0.1, 0.75, 0.2, 1.0)
 START_RGBA = (0.15, 0.35, 0.9, 1.0)
 TIP_PATH_RGBA = (0.85, 0.1, 0.6, 1.0)
 TIP_PATH_POINTS = 40
+
+Marker = tuple[int, np.ndarray | float, np.ndarray | tuple[np.ndarray, np.ndarray], np.ndarray]
+"""A decor geom: (geom type, size, pos, rgba); a line's size is its width and its pos its two ends."""
 """The tool tip's path is drawn as this many line segments."""
 MAX_SIZE = 4096
 
@@ -191,7 +198,7 @@ def _spans(replay_or_scene, elevation: float) -> tuple[np.ndarray, np.ndarray, n
     for axis in (right, up, forward):
         c = points @ axis
         out.append(np.array([float(np.min(c - radii)), float(np.max(c + radii))]))
-    return tuple(out)
+    return out[0], out[1], out[2]
 
 
 def table_camera(replay_or_scene, width: int = 320, height: int = 240, *,
@@ -231,7 +238,7 @@ def offscreen_model(replay_or_scene, width: int, height: int, samples: int = 4) 
 
 
 def render_with_markers(renderer: mujoco.Renderer, model: mujoco.MjModel, data: mujoco.MjData,
-                        camera: mujoco.MjvCamera, qpos: np.ndarray, markers: Sequence[tuple],
+                        camera: mujoco.MjvCamera, qpos: np.ndarray, markers: Sequence[Marker],
                         shadows: bool = False) -> np.ndarray:
     """[height, width, 3] uint8 image of the arm at ``qpos`` with decor ``markers``
     (geom type, size, pos, rgba; a size of length 2 draws a line between two points)."""
@@ -285,7 +292,7 @@ class PanelRenderer:
         self.close()
 
 
-def _markers(panel: RolloutPanel) -> list[tuple[int, np.ndarray, np.ndarray, np.ndarray]]:
+def _markers(panel: RolloutPanel) -> list[Marker]:
     rp = panel.replay
     cell, layout = rp.cell, rp.scene.layout
     thin = cell * 0.05
@@ -295,7 +302,7 @@ def _markers(panel: RolloutPanel) -> list[tuple[int, np.ndarray, np.ndarray, np.
         return np.array([x * cell, y * cell, z])
 
     box = int(mujoco.mjtGeom.mjGEOM_BOX)
-    out = []
+    out: list[Marker] = []
     if panel.show_start and len(rp.planned_xy):
         x, y = rp.planned_xy[0]
         out.append((box, np.array([0.45 * cell, 0.45 * cell, thin]), np.array([x, y, thin]),
@@ -328,25 +335,30 @@ class _Writer:
         import imageio
 
         self.fmt = fmt
+        self._mp4: Format.Writer | None = None  # one of the two is set
+        self._gif: PillowPlugin | None = None
         if fmt == "mp4":
-            self._w = imageio.v2.get_writer(
+            self._mp4 = imageio.v2.get_writer(
                 tmp, format="FFMPEG", mode="I", fps=fps, codec="libx264",
                 pixelformat="yuv420p", macro_block_size=1, quality=quality or 7,
                 ffmpeg_log_level="error", output_params=["-preset", "veryfast"])
         else:
             import imageio.v3 as iio
 
-            self._w = iio.imopen(tmp, "w", plugin="pillow", extension=".gif")
+            self._gif = iio.imopen(tmp, "w", plugin="pillow", extension=".gif")
             self._duration = 1000.0 / fps
 
     def append(self, frame: np.ndarray) -> None:
-        if self.fmt == "mp4":
-            self._w.append_data(_pad_even(frame))
-        else:
-            self._w.write(frame, duration=self._duration, loop=0)
+        if self._mp4 is not None:
+            self._mp4.append_data(_pad_even(frame))
+        elif self._gif is not None:
+            self._gif.write(frame, duration=self._duration, loop=0)
 
     def close(self) -> None:
-        self._w.close()
+        if self._mp4 is not None:
+            self._mp4.close()
+        elif self._gif is not None:
+            self._gif.close()
 
 
 def render_rollouts(panels: Sequence[RolloutPanel] | RolloutPanel, path: str | os.PathLike, *,

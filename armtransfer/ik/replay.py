@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Sequence
 
 import mujoco
@@ -188,7 +189,7 @@ def arm_of(robot) -> ArmDescription:
 def robot_scene(robot) -> ArmScene:
     """The MuJoCo scene ``robot`` (a discrete arm robot) was compiled in, rebuilt from its arm."""
     arm = arm_of(robot)
-    return build_scene(arm.xml_path, arm.tool, arm.mount, arm.yaw, arm.cell_size, layout=arm.layout)
+    return build_scene(Path(arm.xml_path), arm.tool, arm.mount, arm.yaw, arm.cell_size, layout=arm.layout)
 
 
 def check_replayable(robot) -> ArmScene:
@@ -230,15 +231,18 @@ def replay(robot, path_states: Sequence[int], *, goal_cell: int | None = None,
     """
     if servos not in SERVOS:
         raise ReplayError(f"unknown servos {servos!r}; valid: {', '.join(SERVOS)}")
-    options = dict(goal_cell=goal_cell, segment_seconds=segment_seconds, settle_seconds=settle_seconds,
-                   bandwidth_hz=bandwidth_hz, feedforward=feedforward, scene=scene)
+
+    def simulate(own_servos: bool, scene: ArmScene | None) -> Replay:
+        return _simulate(robot, path_states, goal_cell=goal_cell, segment_seconds=segment_seconds,
+                         settle_seconds=settle_seconds, bandwidth_hz=bandwidth_hz, feedforward=feedforward,
+                         scene=scene, own_servos=own_servos)
+
     if servos == "scene":
-        return _simulate(robot, path_states, own_servos=True, **options)
-    first = _simulate(robot, path_states, own_servos=False, **options)
+        return simulate(True, scene)
+    first = simulate(False, scene)
     if servos == "file" or (first.reached_goal and first.max_tracking_error_cells <= TRACKING_LIMIT):
         return first
-    options["scene"] = first.scene
-    second = _simulate(robot, path_states, own_servos=True, **options)
+    second = simulate(True, first.scene)
     second.settings["file_servos"] = {"reached_goal": first.reached_goal,
                                       "max_tracking_error_cells": round(first.max_tracking_error_cells, 4)}
     return second

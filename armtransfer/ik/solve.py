@@ -139,12 +139,14 @@ class TipIK:
         lo = np.maximum(self.scene.lower, -np.pi)
         hi = np.minimum(self.scene.upper, np.pi)
         seeds = [q0, self.scene.home] + [rng.uniform(lo, hi) for _ in range(restarts)]
-        best = None
-        for seed in seeds:
+        best = self.solve(xy, seeds[0])
+        if self.ok(best):
+            return best
+        for seed in seeds[1:]:
             res = self.solve(xy, seed)
             if self.ok(res):
                 return res
-            if best is None or res.error < best.error:
+            if res.error < best.error:
                 best = res
         return best
 

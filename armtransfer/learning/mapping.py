@@ -299,9 +299,9 @@ class ActionMapping:
             raise InvalidMappingError(f"{where}: expected a JSON object")
         if data.get("format") != FORMAT:
             raise InvalidMappingError(f"{where}: 'format' must be {FORMAT!r}, got {data.get('format')!r}")
-        for key in ("source", "target"):
-            if not isinstance(data.get(key), str) or not data[key]:
-                raise InvalidMappingError(f"{where}: {key!r} must name a robot")
+        for side in ("source", "target"):
+            if not isinstance(data.get(side), str) or not data[side]:
+                raise InvalidMappingError(f"{where}: {side!r} must name a robot")
 
         def names(key: str) -> tuple[str, ...]:
             v = data.get(key, [])

@@ -261,9 +261,12 @@ def build_shaping(
     potential-based method's potential is bounded for ``gamma`` (``potentials.bounded``), so
     that none of its self-loops pays."""
     m = get(method)
-    if not m.shaped:
+    build = m.build
+    if build is None:
         raise InvalidParameterError(f"method {method!r} has no shaping")
-    trajs = as_list(trajs) if m.uses_trajectory else []
+    if m.uses_trajectory and trajs is None:
+        raise InvalidParameterError(f"method {method!r} needs at least one trajectory")
+    trajs = as_list(trajs) if trajs is not None and m.uses_trajectory else []
     k = m.resolve_k(K, step_reward, trajs)
     if m.farmable:
         n = longest_n(trajs)
@@ -273,7 +276,7 @@ def build_shaping(
                 f"n*K = {n}*{k:g} >= 0; use K < {farming_bound(step_reward, trajs):.6g} "
                 f"(-step_reward/n) or the method 'first-visit'"
             )
-    sh = m.build(robot, trajs, k, potentials.DENSE_BETA if beta is None else float(beta))
+    sh = build(robot, trajs, k, potentials.DENSE_BETA if beta is None else float(beta))
     if sh.mode == modes.MODE_POTENTIAL:
         sh = replace(sh, phi=potentials.bounded(sh.phi, gamma, step_reward))
     return sh

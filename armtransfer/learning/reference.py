@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from armtransfer.errors import InvalidParameterError
 from armtransfer.learning import guide as guide_module
 from armtransfer.learning.guide import Guide
 from armtransfer.tasks.robot import DiscreteRobot
@@ -385,6 +386,8 @@ class GuideModel:
         if self.tip:
             x0, y0 = tip.at(tip.features(g.tq[s]))
             if g.params.tip_anchor:  # anchored: the tip model's estimate, kept inside the cell
+                if tip.first is None:
+                    raise InvalidParameterError("the anchored tip model chose before it learned from any state")
                 lx, ly = g.lxy[s]
                 x = min(max(tip.first[0] + x0, lx - 0.5), lx + 0.5)
                 y = min(max(tip.first[1] + y0, ly - 0.5), ly + 0.5)

@@ -25,7 +25,7 @@ class Planner(NamedTuple):
 
     succ: np.ndarray
     """int64 [S*A, SUCCESSORS]: the distinct states observed after each pair s * A + a."""
-    count: np.ndarray
+    count: np.ndarray  # type: ignore[assignment]  # a field shadowing tuple.count: the name is read in numba-compiled bodies
     """int64 [S*A, SUCCESSORS]: how often each was observed."""
     n_succ: np.ndarray
     """int64 [S*A]: how many distinct successors each pair has."""

@@ -20,7 +20,7 @@ import numpy as np
 class Progress(NamedTuple):
     """Where robot 2 is along each trajectory (``new``)."""
 
-    index: np.ndarray
+    index: np.ndarray  # type: ignore[assignment]  # a field shadowing tuple.index: the name is read in numba-compiled bodies
     """int64 [n_traj]: the progress index of each trajectory (into the guide's tx, ty, trem)."""
     wait: np.ndarray
     """int64 [n_traj]: moves without progress on each trajectory."""
