@@ -115,11 +115,12 @@ def transfer(
     for robot in (src, tgt):
         robot.start_state(start_cell)
         robot.start_state(goal_cell, what="goal")
-    paths = {}
+    paths: dict[str, list[tuple[int, int]]] = {}
     for robot in (tgt, src):  # the source must solve the task too, to hand over its path
-        paths[robot.name] = robot.shortest_path(robot.start_state(start_cell), goal_cell)
-        if paths[robot.name] is None:
+        found = robot.shortest_path(robot.start_state(start_cell), goal_cell)
+        if found is None:
             raise InvalidTaskError(f"robot {robot.name} cannot reach the goal {the_task.goal} from {the_task.start}")
+        paths[robot.name] = found
     path = paths[tgt.name]
 
     mapping_obj, mapping_path = None, None
@@ -159,10 +160,12 @@ def transfer(
             by_control.setdefault(r.control, {})[r.method] = r
     info = None
     if uses_mapping:
+        assert learned is not None  # run_all returns the learned mapping whenever a method uses one
         info = MappingInfo(path=mapping_path, entries_before=entries_before, entries_after=len(learned),
                            macro_states=int(by_method["mapping"].extra["macro_states"]),
                            saved=bool(save_mapping))
         if save_mapping:
+            assert mapping_path is not None  # save_mapping was refused above without the mapping's file path
             learned.save(mapping_path)
     return TransferResult(
         task=the_task, source=src, target=tgt, distance=len(path) - 1, trajectories=trajs, seed=seed,

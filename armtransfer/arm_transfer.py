@@ -22,6 +22,7 @@ import datetime as _dt
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 
 from armtransfer import api
@@ -116,11 +117,11 @@ def run(args: argparse.Namespace) -> int:
             write_json_atomic(args.json, result["json"])
         if args.render and result["video"]:
             tmp_video = tmp / result["video"]
-            target = Path(args.render)
-            if target.suffix.lower() == tmp_video.suffix.lower():
-                copy_atomic(tmp_video, target)
+            render = Path(args.render)
+            if render.suffix.lower() == tmp_video.suffix.lower():
+                copy_atomic(tmp_video, render)
             else:
-                result["no_video"] = _try_video(result, args, target, scenes)
+                result["no_video"] = _try_video(result, args, render, scenes)
     print(f"wrote {out}/ ({', '.join(sorted(p.name for p in out.iterdir()))}) in {time.perf_counter() - t0:.0f} s")
     if result["no_video"]:
         print(f"armtransfer arms: wrote the results, table and figures but not the video: {result['no_video']}",
@@ -181,7 +182,7 @@ def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target
                           f"{source.name} (dashed) -> {target.name} (solid)", tmp / "map.png")
     video, no_video = None, None
     if not args.no_video:
-        rendered = {"paths": paths, "source": source, "target": target}
+        rendered: dict[str, Any] = {"paths": paths, "source": source, "target": target}
         no_video = _try_video(rendered, args, tmp / "rollout.mp4", scenes)
     if not args.no_video and no_video is None:
         video, stats = "rollout.mp4", rendered["stats"]
@@ -202,6 +203,7 @@ def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target
 def arm_json(robot: DiscreteRobot) -> dict:
     """What results.json says of an arm robot: its name, joints, tool, mount and reach."""
     arm = robot.arm
+    assert arm is not None  # results.json describes arm robots only
     return {"name": arm.name, "robot": robot.name, "dof": arm.dof, "chain": list(arm.chain),
             "held": {n: v for n, v in arm.held}, "tool": arm.tool.key(), "mount": list(arm.mount),
             "yaw": arm.yaw, "mount_source": arm.mount_source, "reach": round(arm.reach, 6),
@@ -231,6 +233,7 @@ def _paths(out_json: dict, source: DiscreteRobot, target: DiscreteRobot) -> dict
             break
     if target_states is None:
         path = target.shortest_path(target.start_state(start), goal)
+        assert path is not None  # run_transfer has checked that the target reaches the goal
         target_states = [s for s, _ in path]
     return {
         "trajectory_cells": traj_cells,

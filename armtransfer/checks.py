@@ -40,11 +40,12 @@ def whole(value: object, what: str, lo: int = 0, hi: int = MAX_COUNT,
 def real(value: object, what: str, lo: float = -math.inf, hi: float = math.inf, *, lo_open: bool = False,
          error: ErrorType = InvalidParameterError) -> float:
     """``value`` as a finite Python float in [lo, hi] (``(lo, hi]`` with ``lo_open``)."""
-    ok = isinstance(value, numbers.Real) and not isinstance(value, bool)
-    if ok:
+    f: float | None = None
+    if isinstance(value, numbers.Real) and not isinstance(value, bool):
         f = float(value)
-        ok = math.isfinite(f) and (f > lo if lo_open else f >= lo) and f <= hi
-    if not ok:
+        if not (math.isfinite(f) and (f > lo if lo_open else f >= lo) and f <= hi):
+            f = None
+    if f is None:
         if math.isfinite(lo) and math.isfinite(hi):
             want = f"in {'(' if lo_open else '['}{lo:g}, {hi:g}]"
         elif math.isfinite(lo):
@@ -52,7 +53,7 @@ def real(value: object, what: str, lo: float = -math.inf, hi: float = math.inf, 
         else:
             want = "a finite number"
         raise error(f"{what} must be {want}, got {value!r}")
-    return float(value)
+    return f
 
 
 def probability(value: object, what: str, error: ErrorType = InvalidParameterError) -> float:

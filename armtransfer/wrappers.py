@@ -18,6 +18,7 @@ The term is also in ``info["shaping"]``. Per-episode state (which trajectory cel
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import gymnasium as gym
 
@@ -43,7 +44,7 @@ class TransferReward(gym.Wrapper, gym.utils.RecordConstructorArgs):
         gym.utils.RecordConstructorArgs.__init__(self, trajectory=trajectory, method=method, K=K, gamma=gamma,
                                                  beta=beta)
         gym.Wrapper.__init__(self, env)
-        base = env.unwrapped
+        base: Any = env.unwrapped  # any env with the attributes checked below
         missing = [a for a in ("robot", "step_reward", "goal_cell") if not hasattr(base, a)]
         if missing:
             raise InvalidParameterError(

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+from typing import Any
 
 from armtransfer.commands import common
 
@@ -72,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
         for a in arms:
             if a not in ARMS:
                 raise ArmModelError(f"unknown arm {a!r}; valid arms: {', '.join(ARMS)}")
-    jobs = []
+    jobs: list[dict[str, Any]] = []
     for spec in robot_specs():
         arm, actions = spec.split(":")
         if (wanted is None or actions in wanted) and (arms is None or arm in arms):
@@ -129,7 +130,8 @@ def generate(args: argparse.Namespace) -> int:
 
     if args.family is None or args.out is None:
         raise ArmModelError(f"arms generate needs --family ({', '.join(FAMILIES)}), --dof and --out DIR")
-    dof = args.dof if args.dof is not None else FAMILIES.get(args.family, (None,))[0]
+    known = FAMILIES.get(args.family)  # None: an unknown family, which check_family names before any dof
+    dof = args.dof if args.dof is not None or known is None else known[0]
     check_family(args.family, dof)
     with common.phase("drawing and compiling"):
         arm = generate_arm(args.family, dof, args.seed, args.out, progress=common.interactive())

@@ -151,7 +151,7 @@ def transfer_kwargs(args: argparse.Namespace) -> dict:
 
 
 def _flag(action: argparse.Action) -> str:
-    return action.option_strings[-1] if action.option_strings else action.metavar or action.dest
+    return action.option_strings[-1] if action.option_strings else str(action.metavar or action.dest)
 
 
 def options_of(args: argparse.Namespace) -> list[argparse.Action]:

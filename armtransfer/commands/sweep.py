@@ -51,7 +51,7 @@ def run_sweep(sweep: sweeps.Sweep, args: argparse.Namespace) -> int:
         _import_ray()  # say how to install Ray before anything is written
         if args.address:
             _check_reachable(args.address)
-    robots = check_runs(sweep.runs)
+    robots = check_runs(list(sweep.runs))
     store = ResultStore.open_for(args.out, sweep)
     try:
         return _run_into(store, sweep, robots, args)

@@ -9,6 +9,7 @@ function). Per-episode state starts afresh at every FIRST step.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import dm_env
 
@@ -26,7 +27,7 @@ class TransferShaping(dm_env.Environment):
     def __init__(self, environment: dm_env.Environment, trajectory: TrajectoryLike | Sequence[TrajectoryLike],
                  method: str = "pseudo", K: float | str = "auto", gamma: float = LearnerConfig().gamma,
                  beta: float | None = None) -> None:
-        task = getattr(environment, "task", None)
+        task: Any = getattr(environment, "task", None)  # any task with these attributes
         if not all(hasattr(task, a) for a in ("robot", "step_reward", "goal_cell")):
             raise InvalidParameterError(
                 f"TransferShaping needs an environment of armtransfer.dmc.load, got {type(environment).__name__}")
@@ -55,6 +56,8 @@ class TransferShaping(dm_env.Environment):
         if timestep.first():  # stepped after the end of an episode (or before any): a new one
             return self._first(timestep)
         s2 = int(timestep.observation["state"])
+        if self._state is None:  # no FIRST step seen, so the term was never reset either
+            raise InvalidParameterError("call reset() before step()")
         term = self.transfer.term(self._state, s2, timestep.last() and timestep.discount == 0.0)
         self._state = s2
         return timestep._replace(reward=timestep.reward + term)

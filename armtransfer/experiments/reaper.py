@@ -14,6 +14,7 @@ import os
 import signal
 import subprocess
 import sys
+from typing import IO
 from pathlib import Path
 
 DONE = "done"
@@ -56,20 +57,22 @@ class Reaper:
         self.proc = subprocess.Popen([sys.executable, "-c", "from armtransfer.experiments.reaper import main; main()"],
                                      stdin=subprocess.PIPE, text=True, start_new_session=True,
                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        assert self.proc.stdin is not None  # stdin=PIPE always opens it
+        self.stdin: IO[str] = self.proc.stdin
 
     def watch(self, pids) -> None:
         for pid in pids:
             start = start_time(pid)
             if start is not None and pid != self.proc.pid:
-                self.proc.stdin.write(f"{pid} {start}\n")
-        self.proc.stdin.flush()
+                self.stdin.write(f"{pid} {start}\n")
+        self.stdin.flush()
 
     def close(self, stop: bool = False) -> None:
         """End the watcher; with ``stop`` it kills the watched processes first."""
         try:
             if not stop:
-                self.proc.stdin.write(DONE + "\n")
-            self.proc.stdin.close()
+                self.stdin.write(DONE + "\n")
+            self.stdin.close()
         except OSError:
             pass
         self.proc.wait()

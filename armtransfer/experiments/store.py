@@ -17,7 +17,7 @@ import fcntl
 import os
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 from armtransfer.errors import ArmTransferError
 from armtransfer.io import OutputError, parse_json_bytes, write_json_atomic
@@ -89,11 +89,12 @@ class ResultStore:
             os.close(fd)
             raise StoreError(f"store {str(self.root)!r} is in use by another sweep; wait for it or choose "
                              "another --out") from None
-        self._lock_fd = fd
+        self._lock_fd: int | None = fd
 
     def unlock(self) -> None:
-        if getattr(self, "_lock_fd", None) is not None:
-            os.close(self._lock_fd)  # closing the descriptor releases the flock
+        fd = getattr(self, "_lock_fd", None)
+        if fd is not None:
+            os.close(fd)  # closing the descriptor releases the flock
             self._lock_fd = None
 
     @classmethod
@@ -132,15 +133,18 @@ class ResultStore:
         except FileNotFoundError:
             return None
         except OSError as err:
-            return self._set_aside(path, f"cannot be read ({err.strerror})")
+            self._set_aside(path, f"cannot be read ({err.strerror})")
+            return None
         try:
             record = parse_json_bytes(raw)
         except ValueError as err:
-            return self._set_aside(path, str(err))
+            self._set_aside(path, str(err))
+            return None
         problem = _run_problem(record, key)
         if problem:
-            return self._set_aside(path, problem)
-        return record
+            self._set_aside(path, problem)
+            return None
+        return cast(dict, record)  # _run_problem found it a whole run record
 
     def _set_aside(self, path: Path, why: str) -> None:
         bad = self.root / "bad"

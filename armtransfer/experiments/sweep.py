@@ -54,7 +54,7 @@ METHODS = tuple(name for name, m in _methods.METHODS.items() if not m.macros)
 to task) is not a grid of independent runs: use `armtransfer rooms --method mapping --mapping PATH`."""
 
 # key -> (default, is a list axis)
-_AXES = {
+_AXES: dict[str, list] = {
     "tasks": [],
     "start_goal": [],
     "pairs": [["coarse", "fine"]],
@@ -97,11 +97,11 @@ def _as_list(name: str, value: object) -> list:
 
 
 def _check_number(where: str, value: object, lo: float, hi: float, integer: bool = False) -> float | int:
-    ok_type = isinstance(value, int) if integer else isinstance(value, (int, float))
-    if isinstance(value, bool) or not ok_type or not lo <= value <= hi:
-        kind = "an integer" if integer else "a number"
-        raise SweepFileError(f"{where}: must be {kind} in [{lo:g}, {hi:g}], got {value!r}")
-    return value
+    if not isinstance(value, bool) and (isinstance(value, int) or (not integer and isinstance(value, float))) \
+            and lo <= value <= hi:
+        return value
+    kind = "an integer" if integer else "a number"
+    raise SweepFileError(f"{where}: must be {kind} in [{lo:g}, {hi:g}], got {value!r}")
 
 
 MAX_RUNS = 100_000
@@ -117,7 +117,7 @@ def size(spec: dict) -> int:
     return n
 
 
-ARM_KEYS = {"xml": str, "tip_site": str, "tip_body": str, "tip_offset": list, "base_pos": list,
+ARM_KEYS: dict[str, type | tuple[type, ...]] = {"xml": str, "tip_site": str, "tip_body": str, "tip_offset": list, "base_pos": list,
             "base_yaw": (int, float)}
 """The keys of an ``[arms.NAME]`` table and their types."""
 

@@ -24,6 +24,7 @@ import tempfile
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -129,7 +130,7 @@ def save(name: str, key: str, arrays: dict[str, np.ndarray]) -> Path:
     path = entry_path(name, key)
     path.parent.mkdir(parents=True, exist_ok=True)
     clear(path)
-    payload = dict(arrays)
+    payload: dict[str, Any] = dict(arrays)  # np.savez's keywords are arrays, not its own options
     payload["__key__"] = np.array(key)
     payload["__checksum__"] = np.array(_checksum(arrays))
     fd, tmp = tempfile.mkstemp(prefix=path.stem + ".", suffix=".tmp", dir=path.parent)

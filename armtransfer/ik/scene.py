@@ -246,8 +246,7 @@ def model_files(path: Path) -> list[Path]:
     for folder, name in named:
         if name:
             files.append(base / (folder or "") / name)
-    seen: set[Path] = set()
-    return [f for f in files if not (f in seen or seen.add(f))]
+    return list(dict.fromkeys(files))  # each file once, in order
 
 
 def _includes(path: Path, root: Path, seen: set[Path]) -> list[Path]:

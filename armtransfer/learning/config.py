@@ -53,7 +53,8 @@ class LearnerConfig:
             if f.type in (int, "int"):
                 if isinstance(value, numbers.Real) and not isinstance(value, (bool, numbers.Integral)) \
                         and math.isfinite(value) and float(value).is_integer():
-                    value = int(value)  # 3.0 from a TOML or JSON file is 3
+                    # typeshed's numbers.Real has no __int__, though every real number here (numpy's too) has one
+                    value = int(value)  # type: ignore[call-overload]  # 3.0 from a TOML or JSON file is 3
                 value = checks.whole(value, f.name, int(lo), int(hi))
             else:
                 value = checks.real(value, f.name, lo, hi, lo_open=lo_open)

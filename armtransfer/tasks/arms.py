@@ -17,6 +17,7 @@ import math
 import os
 import sys
 import time
+from typing import cast
 from pathlib import Path
 
 import numpy as np
@@ -172,7 +173,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
             pose = automatic_mount(path, tool, cell_size=cell_size, layout=layout, yaw=base_yaw,
                                    cache=cache, progress=progress)
             base_pos, base_yaw, source = pose.pos, pose.yaw, "automatic"
-        mount = tuple(float(v) for v in base_pos)
+        mount = cast(tuple[float, float, float], tuple(float(v) for v in base_pos))
         yaw = float(base_yaw or 0.0)
         step = joint_step  # None: the compile picks the finest step its lattice allows
     else:
@@ -184,7 +185,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
         xml_bytes = path.read_bytes()
         mount, source = _builtin_mount(info, cell_size), "built-in"
         if base_pos is not None:
-            mount, source = tuple(float(v) for v in base_pos), "given"
+            mount, source = cast(tuple[float, float, float], tuple(float(v) for v in base_pos)), "given"
         yaw = info.mount_yaw if base_pos is None else float(base_yaw or 0.0)
         kind, tip_down = info.kind, info.tip_down
         step = joint_step or info.joint_step
@@ -209,8 +210,10 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
     else:
         _check_cache_dir()
         check = _arrays_check(layout)
-        arrays, status = _cache.load(robot_name, key, check)
-        if arrays is None:
+        loaded, status = _cache.load(robot_name, key, check)
+        if loaded is not None:
+            arrays = loaded
+        else:
             with _cache.building(_cache.entry_path(robot_name, key)):
                 meanwhile, again = _cache.load(robot_name, key, check)  # built by another process while we waited
                 if meanwhile is None:
@@ -392,6 +395,7 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
             pose, rank = _mount.Pose(*cached[0]), cached[1]
             try:
                 robot = _mount_robot(path, tool, pose, cell_size, layout, cache)
+                assert robot.arm is not None  # an arm file compiles to an arm robot
                 if (tasks_solvable(robot), round(robot.arm.reach, 9)) == rank:
                     return pose
             except (ArmModelError, UnreachableTableError):
@@ -424,6 +428,7 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
             robot = _mount_robot(path, tool, pose, cell_size, layout, cache)
         except ArmModelError:
             continue
+        assert robot.arm is not None  # an arm file compiles to an arm robot
         best = ((tasks_solvable(robot), robot.arm.reach), pose)
         break
     if best is None:

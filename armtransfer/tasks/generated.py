@@ -189,4 +189,5 @@ def resolve_generated(spec: str, progress: bool = False):
                 else (root / name).unlink()
         generate_arm(family, dof, seed, root, progress=progress)
         generated = read_sidecar(xml)
+        assert generated is not None  # generate_arm has just written it
     return robot_of(xml, generated, actions, progress=progress)

@@ -4,6 +4,8 @@ as ``PATH.xml[:ACTIONS]``, and ``custom[:ACTIONS]`` or ``NAME[:ACTIONS]`` (the f
 
 from __future__ import annotations
 
+from typing import Any
+
 from armtransfer.errors import UnknownArmError, UnknownRobotError
 from armtransfer.tasks.grid_robots import GRID_ROBOTS, grid_robot
 from armtransfer.tasks.robot import DiscreteRobot
@@ -30,7 +32,7 @@ def resolve(spec: str | DiscreteRobot, *, xml_path=None, progress: bool = False,
 
         name, _, actions = spec.partition(":")
         arm = arms[name]
-        options = {k: (tuple(v) if isinstance(v, list) else v) for k, v in arm.items() if k != "xml"}
+        options: dict[str, Any] = {k: (tuple(v) if isinstance(v, list) else v) for k, v in arm.items() if k != "xml"}
         return arm_robot(None, actions or "cartesian", xml_path=arm["xml"], arm_name=name, progress=progress,
                          **options)
     from armtransfer.models import ARMS
