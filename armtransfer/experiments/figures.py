@@ -138,11 +138,16 @@ def mapping_paths(
                 label="mapped fragment" if k == 0 else None)
     ax.plot(*src[0], "s", color="green", ms=8, label="start")
     ax.plot(*src[-1], "*", color="black", ms=12, label="goal")
+    _finish_map(fig, ax, lo, hi, title, 8, path)
+
+
+def _finish_map(fig, ax, lo: int, hi: int, title: str, legend_size: int, path: str | os.PathLike) -> None:
+    """Square axes on the cells lo..hi, the title and the legend, then save."""
     ax.set_xlim(lo - 0.5, hi + 0.5)
     ax.set_ylim(lo - 0.5, hi + 0.5)
     ax.set_aspect("equal")
     ax.set_title(title)
-    ax.legend(loc="lower right", fontsize=8)
+    ax.legend(loc="lower right", fontsize=legend_size)
     _save(fig, path)
 
 
@@ -165,12 +170,7 @@ def task_layout(
         ax.plot(*goal, "*", color=c, ms=14, label=f"{name}: goal {goal}")
         ax.annotate(name.split()[-1], start, textcoords="offset points", xytext=(5, 5), color=c)
         ax.annotate(name.split()[-1], goal, textcoords="offset points", xytext=(5, 5), color=c)
-    ax.set_xlim(lo - 0.5, hi + 0.5)
-    ax.set_ylim(lo - 0.5, hi + 0.5)
-    ax.set_aspect("equal")
-    ax.set_title(title)
-    ax.legend(loc="lower right", fontsize=7)
-    _save(fig, path)
+    _finish_map(fig, ax, lo, hi, title, 7, path)
 
 
 def _panel_grid(panels: list, title: str, path: str | os.PathLike, xlabel: str, ylabel: str, draw) -> None:
