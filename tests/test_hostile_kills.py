@@ -53,6 +53,40 @@ def test_a_kill_while_workers_start_leaves_no_process(command, tmp_path):
     assert left == [], "processes outlived the killed driver"
 
 
+GUARDED = """
+import time
+from armtransfer.experiments.reaper import guarded_spawn_context
+child = guarded_spawn_context().Process(target=time.sleep, args=(120,))
+child.start()
+print(child.pid, flush=True)
+time.sleep(120)
+"""
+
+
+def _gone(pid: int) -> bool:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] == "Z"
+    except OSError:
+        return True
+
+
+def test_a_guarded_worker_ends_with_its_driver_whatever_it_runs():
+    """The guard runs before the worker imports anything: a worker whose own code never looks
+    at its parent (here it sleeps for two minutes) still ends when its driver is killed."""
+    driver = subprocess.Popen([sys.executable, "-c", GUARDED], stdout=subprocess.PIPE, text=True,
+                              start_new_session=True)
+    try:
+        child = int(driver.stdout.readline())
+        os.kill(driver.pid, signal.SIGKILL)
+        driver.wait()
+        deadline = time.time() + 10
+        while time.time() < deadline and not _gone(child):
+            time.sleep(0.02)
+        assert _gone(child), "the worker outlived its killed driver"
+    finally:
+        assert settle(driver.pid, 5) == []
+
+
 def _dies_on_first(run, robots):
     """A worker that dies at once the first time it runs (a marker file says it did)."""
     marker = Path(os.environ["HOSTILE_MARKER"])
