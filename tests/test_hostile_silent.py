@@ -42,6 +42,27 @@ def test_an_option_of_another_mode_is_refused(argv, flag, tmp_path, monkeypatch,
     assert f"{flag} does not apply" in err and "its options:" in err
 
 
+@pytest.mark.parametrize("argv,flag,users", [
+    (["rooms", "--beta", "2"], "--beta", "dense"),
+    (["rooms", "--method", "pseudo", "--max-span", "3"], "--max-span", "mapping"),
+    (["rooms", "--method", "none", "--K", "0.1"], "--K", "pseudo"),
+    (["rooms", "--method", "none", "--trajectory", "optimal"], "--trajectory", "pseudo"),
+    (["arms", "--fast", "--out", "o", "--method", "none", "pseudo", "--beta", "2"], "--beta", "dense"),
+])
+def test_a_method_option_no_chosen_method_uses_is_refused(argv, flag, users, tmp_path, monkeypatch, capsys):
+    err = refused(argv, tmp_path, monkeypatch, capsys)
+    assert f"{flag} does not apply to --method" in err and users in err.split("goes with the methods")[1]
+
+
+@pytest.mark.parametrize("argv,flag", [
+    (["bench", "--baseline-repeats", "0", "--baseline-steps", "10"], "--baseline-steps"),
+    (["sweep", "s.toml", "--out", "st", "--executor", "ray", "--address", "127.0.0.1:1", "--workers", "2"],
+     "--workers"),
+])
+def test_an_option_of_another_setting_is_refused(argv, flag, tmp_path, monkeypatch, capsys):
+    assert f"{flag} does not apply" in refused(argv, tmp_path, monkeypatch, capsys)
+
+
 SWEEP = """[sweep]
 name = "s"
 tasks = [1]
