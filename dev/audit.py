@@ -38,7 +38,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
-from contract import FORE, INCLUDING, session, settle  # noqa: E402  (the tests' helpers)
+from contract import FORE, INCLUDING, SWEEP_WITH_ARM, session, settle  # noqa: E402  (the tests' helpers)
 from conftest import SCARA_XML  # noqa: E402  (the tests' bring-your-own arm)
 
 
@@ -181,20 +181,6 @@ trials = 1
 trajectory = "optimal"
 max_episodes = 30
 """
-
-SWEEP_ARM_TABLE = """[sweep]
-name = "s"
-tasks = [1]
-pairs = [["coarse", "fine"]{extra_pair}]
-methods = ["none"]
-trials = 1
-max_episodes = 3
-
-[arms.{name}]
-xml = "scara.xml"
-tip_site = "pen_tip"
-"""
-
 
 def write(name: str, text: str) -> Callable[[Path], None]:
     def setup(d: Path) -> None:
@@ -632,12 +618,12 @@ CASES: list[Case] = [
                       "2"], "--workers does not apply", setup=write("s.toml", SWEEP.format(seeds=[0])))),
     Case("sweep [arms.fine] shadows a grid robot", "refused",
          cli_refused(["sweep", "s.toml", "--out", "store"], "arms.fine has the name of a robot",
-                     setup=lambda d: (scara(d), write("s.toml", SWEEP_ARM_TABLE.format(
-                         name="fine", extra_pair=', ["fine", "coarse"]'))(d)))),
+                     setup=lambda d: (scara(d), write("s.toml", SWEEP_WITH_ARM.format(
+                         name="fine", extra_pair=', ["fine", "coarse"]', xml="scara.xml"))(d)))),
     Case("sweep [arms.myarm] unused", "refused",
          cli_refused(["sweep", "s.toml", "--out", "store"], "arms.myarm is not used",
-                     setup=lambda d: (scara(d), write("s.toml", SWEEP_ARM_TABLE.format(
-                         name="myarm", extra_pair=""))(d)))),
+                     setup=lambda d: (scara(d), write("s.toml", SWEEP_WITH_ARM.format(
+                         name="myarm", extra_pair="", xml="scara.xml"))(d)))),
     Case("rooms: a trajectory that jumps", "refused before learning",
          jump_refused_before_learning(["rooms", "--method", "pseudo", "--trajectory", "jump.json", "--trials", "1",
                                        "--json", "o.json"])),

@@ -1,6 +1,6 @@
 """What the tests of the error contract share: a command refused in one line, the
-processes of a session (to check that a kill leaves none behind), and an arm file that
-includes another (to check what the arm cache's key covers)."""
+processes of a session (to check that a kill leaves none behind), an arm file that includes
+another (to check what the arm cache's key covers), and a sweep with an arm table."""
 
 from __future__ import annotations
 
@@ -69,3 +69,18 @@ FORE = """<mujoco><body name="fore" pos="0.24 0 -0.03">
     </body></mujoco>"""
 """An arm file (``INCLUDING.format(meshdir=...)``) whose forearm is in ``fore.xml``
 (``FORE.format(length=...)``)."""
+
+
+SWEEP_WITH_ARM = """[sweep]
+name = "s"
+tasks = [1]
+pairs = [["coarse", "fine"]{extra_pair}]
+methods = ["none"]
+trials = 1
+max_episodes = 3
+
+[arms.{name}]
+xml = "{xml}"
+tip_site = "pen_tip"
+"""
+"""A sweep with an ``[arms.NAME]`` table (the arm file ``xml``) and maybe a pair more."""

@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from contract import refused
+from contract import SWEEP_WITH_ARM, refused
 from armtransfer.errors import InvalidTrajectoryError
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.tasks.catalog import table_task
@@ -63,27 +63,13 @@ def test_an_option_of_another_setting_is_refused(argv, flag, tmp_path, monkeypat
     assert f"{flag} does not apply" in refused(argv, tmp_path, monkeypatch, capsys)
 
 
-SWEEP = """[sweep]
-name = "s"
-tasks = [1]
-pairs = [["coarse", "fine"]{extra_pair}]
-methods = ["none"]
-trials = 1
-max_episodes = 3
-
-[arms.{name}]
-xml = "{xml}"
-tip_site = "pen_tip"
-"""
-
-
 @pytest.mark.parametrize("name,extra_pair,message", [
     ("fine", ', ["fine", "coarse"]', "has the name of a robot"),
     ("planar2", ', ["planar2:joint", "fine"]', "has the name of a robot"),
     ("myarm", "", "is not used by any pair"),
 ])
 def test_every_sweep_arm_table_is_checked(name, extra_pair, message, tmp_path, monkeypatch, capsys, scara_xml):
-    (tmp_path / "s.toml").write_text(SWEEP.format(name=name, extra_pair=extra_pair, xml=scara_xml))
+    (tmp_path / "s.toml").write_text(SWEEP_WITH_ARM.format(name=name, extra_pair=extra_pair, xml=scara_xml))
     err = refused(["sweep", "s.toml", "--out", "store"], tmp_path, monkeypatch, capsys)
     assert f"arms.{name} {message}" in err
 
