@@ -48,6 +48,8 @@ def test_an_option_of_another_mode_is_refused(argv, flag, tmp_path, monkeypatch,
     (["rooms", "--method", "none", "--K", "0.1"], "--K", "pseudo"),
     (["rooms", "--method", "none", "--trajectory", "optimal"], "--trajectory", "pseudo"),
     (["arms", "--fast", "--out", "o", "--method", "none", "pseudo", "--beta", "2"], "--beta", "dense"),
+    (["matrix", "--robots", "coarse,fine", "--methods", "none", "--trajectory", "optimal", "--out", "m"],
+     "--trajectory", "pseudo"),
 ])
 def test_a_method_option_no_chosen_method_uses_is_refused(argv, flag, users, tmp_path, monkeypatch, capsys):
     err = refused(argv, tmp_path, monkeypatch, capsys)
@@ -58,6 +60,8 @@ def test_a_method_option_no_chosen_method_uses_is_refused(argv, flag, users, tmp
     (["bench", "--baseline-repeats", "0", "--baseline-steps", "10"], "--baseline-steps"),
     (["sweep", "s.toml", "--out", "st", "--executor", "ray", "--address", "127.0.0.1:1", "--workers", "2"],
      "--workers"),
+    (["arms", "--fast", "--out", "o", "--trials", "5"], "--trials 5"),
+    (["arms", "--fast", "--out", "o", "--patience", "50"], "--patience 50"),
 ])
 def test_an_option_of_another_setting_is_refused(argv, flag, tmp_path, monkeypatch, capsys):
     assert f"{flag} does not apply" in refused(argv, tmp_path, monkeypatch, capsys)

@@ -151,12 +151,13 @@ def transfer_kwargs(args: argparse.Namespace) -> dict:
     )
 
 
-def refuse_unused_method_options(args: argparse.Namespace) -> None:
-    """A method's option given (different from its default) while no method of --method
+def refuse_unused_method_options(args: argparse.Namespace, flag: str = "--method") -> None:
+    """A method's option given (different from its default) while no method of ``flag``
     uses it is an error naming the methods that do, instead of being silently ignored."""
     from armtransfer.learning import methods
 
-    chosen = [methods.get(m) for m in args.method]
+    names = getattr(args, flag.lstrip("-"))
+    chosen = [methods.get(m) for m in names]
     users = {
         "--beta": ("beta", [m for m in methods.METHODS.values() if m.name == "dense"]),
         "--max-span": ("max_span", [m for m in methods.METHODS.values() if m.macros]),
@@ -164,10 +165,11 @@ def refuse_unused_method_options(args: argparse.Namespace) -> None:
         "--trajectory": ("trajectory", [m for m in methods.METHODS.values() if m.shaped and m.uses_trajectory]),
     }
     parser_defaults = {a.dest: a.default for a in options_of(args)}
-    for flag, (dest, using) in users.items():
-        if getattr(args, dest) != parser_defaults.get(dest) and not any(m in using for m in chosen):
+    for option, (dest, using) in users.items():
+        if dest in parser_defaults and getattr(args, dest) != parser_defaults[dest] \
+                and not any(m in using for m in chosen):
             raise InvalidParameterError(
-                f"{flag} does not apply to --method {' '.join(args.method)}; it goes with the methods "
+                f"{option} does not apply to {flag} {' '.join(names)}; it goes with the methods "
                 f"{', '.join(m.name for m in using)}")
 
 

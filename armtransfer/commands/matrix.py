@@ -72,6 +72,7 @@ def run(args: argparse.Namespace) -> int:
     check_executor_options(args)
     for m in args.methods:
         methods.get(m)
+    common.refuse_unused_method_options(args, "--methods")
     robots, arms = arm_file_robots(args)
     sweep = matrix.matrix_sweep(robots, args.tasks, args.methods, args.trials, args.seeds, args.trajectory,
                                 arms=arms)
