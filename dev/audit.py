@@ -237,11 +237,14 @@ def symlinked_out(r: Runner, d: Path) -> str:
 def two_runs_into_one_out(r: Runner, d: Path) -> str:
     argv = [*FAST_ARMS[:-1], "3", "--out", "D"]
     first = r.start(d, *argv)
-    while not list(d.glob(".D.*.tmp")) and first.poll() is None:
-        time.sleep(0.02)
-    second = r.cli(d, *argv)
-    code = first.wait(timeout=300)
-    err = first.stderr.read() if first.stderr else ""
+    try:
+        while not list(d.glob(".D.*.tmp")) and first.poll() is None:
+            time.sleep(0.02)
+        second = r.cli(d, *argv)
+        code = first.wait(timeout=300)
+        err = first.stderr.read() if first.stderr else ""
+    finally:
+        settle(first.pid, 10)  # kills whatever of the first run a failure left running
     if code != 0:
         raise Failed(f"the first run: exit {code}: {err.strip()[-120:]}")
     lines = second.err.strip().splitlines()
@@ -480,13 +483,12 @@ def same_sweep_same_bytes(r: Runner, d: Path) -> str:
 
 def kill_and_resume(argv: list[str], moment: str, target: str = "driver", setup: Callable[[Path], None] | None = None):
     """Start ``argv``; at ``moment`` SIGKILL its driver (or, with target 'worker', one of its
-    workers); then no process of it may be left, and the same command run again must finish
-    with nothing left behind (a killed worker: the run itself must finish)."""
+    workers); then no process of it may be left, and the same command run again must find
+    all the work done or finish it, with nothing left behind."""
     def case(r: Runner, d: Path) -> str:
         if setup:
             setup(d)
         proc = r.start(d, *argv)
-        left: list[int] = []
         try:
             reached = wait_for(moment, proc, d)
             if target == "worker":
@@ -499,20 +501,36 @@ def kill_and_resume(argv: list[str], moment: str, target: str = "driver", setup:
             else:
                 os.kill(proc.pid, signal.SIGKILL)
                 proc.wait()
+            t0 = time.monotonic()
         finally:
             left = settle(proc.pid, 90)  # Ray's own processes take tens of seconds to go
         if left:
             raise Failed(f"{len(left)} processes outlived the kill ({reached})")
-        if target == "driver":
-            again = r.cli(d, *argv, timeout=600)
-            completed(again, d)
-            check = argv[argv.index("--out") + 1]
-            if not list((d / check).iterdir()):
-                raise Failed("the next run wrote nothing")
+        gone = time.monotonic() - t0
+        if gone > 15:
+            raise Failed(f"{reached}: its processes took {gone:.0f} s to go")
+        again = r.cli(d, *argv, timeout=600)
+        completed(again, d)
+        whole(argv, again, d)
         if list(d.glob(".*.tmp")):
             raise Failed("a staging folder is left")
-        return f"none left ({reached}); {'resumed, exit 0' if target == 'driver' else 'run finished, exit 0'}"
+        return f"{reached}: none left after {gone:.1f} s; " + ("resumed" if target == "driver" else "all runs done")
     return case
+
+
+def whole(argv: list[str], ran: Ran, d: Path) -> None:
+    """The work of ``argv`` is all there after ``ran``: every run of a sweep or matrix store,
+    the arms run's results."""
+    out = d / argv[argv.index("--out") + 1]
+    if argv[0] == "arms":
+        if not (out / "results.json").is_file():
+            raise Failed("the next run wrote no results.json")
+        return
+    import re
+
+    counts = re.search(r"(\d+)/(\d+) runs in", ran.out) or re.search(r"(\d+) runs, (\d+) already done", ran.out)
+    if counts is None or counts.group(1) != counts.group(2) or not list((out / "runs").glob("*.json")):
+        raise Failed(f"the store is not whole: {ran.out.strip().splitlines()[:1]}")
 
 
 def cmdline(pid: int) -> bytes:
@@ -666,12 +684,16 @@ CASES: list[Case] = [
     Case("Ray address served by a plain TCP listener", "refused fast, no store", ray_address_not_ray, slow=True),
     Case("two stores of one sweep", "byte-identical", same_sweep_same_bytes, slow=True),
     # kills
+    Case("SIGKILL sweep at 0.5 s (the driver importing)", "none left; resumes",
+         kill_and_resume(SWEEP_RUN, "0.5 s", setup=sweep_file), slow=True),
     Case("SIGKILL sweep while workers start", "none left; resumes",
          kill_and_resume(SWEEP_RUN, "workers", setup=sweep_file), slow=True),
     Case("SIGKILL sweep after a run", "none left; resumes",
          kill_and_resume(SWEEP_RUN, "a run", setup=sweep_file), slow=True),
-    Case("SIGKILL a sweep's worker", "the sweep finishes",
+    Case("SIGKILL a sweep's worker while it starts", "the sweep finishes",
          kill_and_resume(SWEEP_RUN, "workers", target="worker", setup=sweep_file), slow=True),
+    Case("SIGKILL a sweep's worker after a run", "the sweep finishes",
+         kill_and_resume(SWEEP_RUN, "a run", target="worker", setup=sweep_file), slow=True),
     Case("SIGKILL matrix while workers start", "none left; resumes", kill_and_resume(MATRIX_RUN, "workers"),
          slow=True),
     Case("SIGKILL matrix at 15 s", "none left; resumes", kill_and_resume(MATRIX_LONG, "15 s"), slow=True),

@@ -87,6 +87,38 @@ def test_a_guarded_worker_ends_with_its_driver_whatever_it_runs():
         assert settle(driver.pid, 5) == []
 
 
+REAPED = """
+import subprocess, sys, time
+from armtransfer.experiments.reaper import Reaper
+reaper = Reaper()
+time.sleep(0.2)
+grandchild = "import subprocess, sys, time; p = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(120)']); print(p.pid, flush=True); time.sleep(120)"
+middle = subprocess.Popen([sys.executable, "-c", grandchild], stdout=subprocess.PIPE, text=True)
+print(middle.pid, middle.stdout.readline().strip(), flush=True)
+time.sleep(120)
+"""
+
+
+def test_the_reaper_stops_what_the_sweep_started_that_it_was_never_told_of():
+    """Ray starts processes after its init (its agents), whose parent (the raylet) may die
+    before them: the watcher lists every process below the sweep while it lives, so such an
+    orphan goes too when the sweep is killed."""
+    driver = subprocess.Popen([sys.executable, "-c", REAPED], stdout=subprocess.PIPE, text=True,
+                              start_new_session=True)
+    try:
+        middle, orphan = map(int, driver.stdout.readline().split())
+        time.sleep(1.5)  # a few of the watcher's looks
+        os.kill(middle, signal.SIGKILL)  # the parent dies first: its child is PID 1's now
+        os.kill(driver.pid, signal.SIGKILL)
+        driver.wait()
+        deadline = time.time() + 10
+        while time.time() < deadline and not _gone(orphan):
+            time.sleep(0.05)
+        assert _gone(orphan), "a process the sweep started outlived it"
+    finally:
+        assert settle(driver.pid, 5) == []
+
+
 def _dies_on_first(run, robots):
     """A worker that dies at once the first time it runs (a marker file says it did)."""
     marker = Path(os.environ["HOSTILE_MARKER"])

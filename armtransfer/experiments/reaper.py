@@ -8,10 +8,11 @@ seconds, a few hundred MB each) takes them with it at once.
 
 A local Ray instance's processes (its GCS server, raylet, agents and workers) are the
 sweep's children, but a sweep killed with SIGKILL cannot stop them, and they lived on for
-minutes. :class:`Reaper` starts a small watcher process before anything else is started and
-tells it the pids to stop; the watcher waits on a pipe from the sweep. When the sweep says
-``done`` (it stopped them itself) the watcher just exits; when the pipe closes without it
-(the sweep died), the watcher kills those processes and every process they started.
+minutes. :class:`Reaper` starts a small watcher process before anything else is started; it
+lists every process the sweep starts from then on (and the pids it is told), and waits on a
+pipe from the sweep. When the sweep says ``done`` (it stopped them itself) the watcher just
+exits; when the pipe closes without it (the sweep died), the watcher kills those processes
+and every process they started.
 """
 
 from __future__ import annotations
@@ -91,17 +92,40 @@ def children_of(pid: int) -> set[int]:
     return descendants({pid}) - {pid}
 
 
+POLL = 0.5
+"""Seconds between two looks of the watcher at the sweep's processes."""
+
+
 def main() -> None:
-    """The watcher: read "PID START" lines until the pipe closes; then, unless the last line
-    was ``done``, kill each listed process that still is the one listed, with everything below."""
+    """The watcher: while the sweep lives, list every process below it (each look, every
+    :data:`POLL` s, adds those started since: Ray starts its agents after ``init`` returns,
+    and a raylet that dies first would leave them to PID 1) and the "PID START" lines it is
+    sent; when the pipe closes, unless the last line was ``done``, kill each listed process
+    that still is the one listed, with everything below it."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # a Ctrl-C to the sweep's group is the sweep's
+    import selectors
+
+    sweep, me = os.getppid(), os.getpid()
+    earlier = descendants({sweep})  # what the sweep ran before the watcher is not its to stop
     listed: dict[int, str] = {}
-    last = ""
-    for line in sys.stdin:
-        last = line.strip()
-        parts = last.split()
-        if len(parts) == 2 and parts[0].isdigit():
-            listed[int(parts[0])] = parts[1]
+    last, pending = "", b""
+    watch = selectors.DefaultSelector()
+    watch.register(sys.stdin.fileno(), selectors.EVENT_READ)
+    while True:
+        if watch.select(timeout=POLL):
+            chunk = os.read(sys.stdin.fileno(), 65536)
+            if not chunk:
+                break
+            *lines, pending = (pending + chunk).split(b"\n")
+            for line in lines:
+                last = line.decode(errors="replace").strip()
+                parts = last.split()
+                if len(parts) == 2 and parts[0].isdigit():
+                    listed[int(parts[0])] = parts[1]
+        for pid in descendants({sweep}) - earlier - {me}:
+            start = start_time(pid)
+            if start is not None:
+                listed.setdefault(pid, start)
     if last == DONE:
         return
     alive = {pid for pid, start in listed.items() if start_time(pid) == start}
