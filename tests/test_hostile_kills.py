@@ -70,6 +70,16 @@ def _gone(pid: int) -> bool:
         return True
 
 
+def _killed_takes(driver: subprocess.Popen, pid: int, seconds: float = 10.0) -> bool:
+    """SIGKILL ``driver``: is ``pid`` gone within ``seconds``?"""
+    os.kill(driver.pid, signal.SIGKILL)
+    driver.wait()
+    deadline = time.time() + seconds
+    while time.time() < deadline and not _gone(pid):
+        time.sleep(0.02)
+    return _gone(pid)
+
+
 def test_a_guarded_worker_ends_with_its_driver_whatever_it_runs():
     """The guard runs before the worker imports anything: a worker whose own code never looks
     at its parent (here it sleeps for two minutes) still ends when its driver is killed."""
@@ -77,12 +87,7 @@ def test_a_guarded_worker_ends_with_its_driver_whatever_it_runs():
                               start_new_session=True)
     try:
         child = int(driver.stdout.readline())
-        os.kill(driver.pid, signal.SIGKILL)
-        driver.wait()
-        deadline = time.time() + 10
-        while time.time() < deadline and not _gone(child):
-            time.sleep(0.02)
-        assert _gone(child), "the worker outlived its killed driver"
+        assert _killed_takes(driver, child), "the worker outlived its killed driver"
     finally:
         assert settle(driver.pid, 5) == []
 
@@ -92,7 +97,8 @@ import subprocess, sys, time
 from armtransfer.experiments.reaper import Reaper
 reaper = Reaper()
 time.sleep(0.2)
-grandchild = "import subprocess, sys, time; p = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(120)']); print(p.pid, flush=True); time.sleep(120)"
+grandchild = ("import subprocess, sys, time; p = subprocess.Popen([sys.executable, '-c', 'import time; "
+              "time.sleep(120)']); print(p.pid, flush=True); time.sleep(120)")
 middle = subprocess.Popen([sys.executable, "-c", grandchild], stdout=subprocess.PIPE, text=True)
 print(middle.pid, middle.stdout.readline().strip(), flush=True)
 time.sleep(120)
@@ -109,12 +115,7 @@ def test_the_reaper_stops_what_the_sweep_started_that_it_was_never_told_of():
         middle, orphan = map(int, driver.stdout.readline().split())
         time.sleep(1.5)  # a few of the watcher's looks
         os.kill(middle, signal.SIGKILL)  # the parent dies first: its child is PID 1's now
-        os.kill(driver.pid, signal.SIGKILL)
-        driver.wait()
-        deadline = time.time() + 10
-        while time.time() < deadline and not _gone(orphan):
-            time.sleep(0.05)
-        assert _gone(orphan), "a process the sweep started outlived it"
+        assert _killed_takes(driver, orphan), "a process the sweep started outlived it"
     finally:
         assert settle(driver.pid, 5) == []
 
