@@ -169,7 +169,7 @@ def _guarded_popen():
 
                 spawn.get_command_line = guarded  # read by the launch below, put back after it
                 try:
-                    super()._launch(process_obj)
+                    super()._launch(process_obj)  # type: ignore[misc]  # typeshed leaves this private method out
                 finally:
                     spawn.get_command_line = plain
 
