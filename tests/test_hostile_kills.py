@@ -113,7 +113,7 @@ def test_the_reaper_stops_what_the_sweep_started_that_it_was_never_told_of():
                               start_new_session=True)
     try:
         middle, orphan = map(int, driver.stdout.readline().split())
-        time.sleep(1.5)  # a few of the watcher's looks
+        time.sleep(2.5)  # two of the watcher's looks at least
         os.kill(middle, signal.SIGKILL)  # the parent dies first: its child is PID 1's now
         assert _killed_takes(driver, orphan), "a process the sweep started outlived it"
     finally:

@@ -92,7 +92,7 @@ def children_of(pid: int) -> set[int]:
     return descendants({pid}) - {pid}
 
 
-POLL = 0.5
+POLL = 1.0
 """Seconds between two looks of the watcher at the sweep's processes."""
 
 
