@@ -1,9 +1,8 @@
 """Processes that end with the sweep that started them, however it ends.
 
-A pool worker is started by :func:`guarded_spawn_context`'s processes: its first
-instructions, before Python imports anything for it, check that its parent is still the
-driver that started it and ask Linux to send it SIGTERM when that parent dies
-(``PR_SET_PDEATHSIG``). A driver killed while its workers are still importing (a few
+A pool worker started from :func:`guarded_spawn_context` runs :data:`GUARD` first: before
+Python imports anything for it, it checks that its parent is still the driver that started
+it and asks Linux to send it SIGTERM when that parent dies (``PR_SET_PDEATHSIG``). A driver killed while its workers are still importing (a few
 seconds, a few hundred MB each) takes them with it at once.
 
 A local Ray instance's processes (its GCS server, raylet, agents and workers) are the
@@ -17,6 +16,7 @@ and every process they started.
 
 from __future__ import annotations
 
+import functools
 import multiprocessing.context
 import os
 import signal
@@ -152,7 +152,10 @@ not exist, the worker's own initializer watches its parent instead): the standar
 _LAUNCH = threading.Lock()
 
 
+@functools.cache
 def _guarded_popen():
+    """The POSIX spawn launcher with :data:`GUARD` before its command (made on first use: the
+    module it extends exists on POSIX only)."""
     from multiprocessing import popen_spawn_posix, spawn
 
     class GuardedPopen(popen_spawn_posix.Popen):
