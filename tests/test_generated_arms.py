@@ -63,37 +63,43 @@ def test_the_contract_names_what_is_wrong(tmp_path):
     assert contract.problems(tmp_path / "bad.xml", ROOMS)[0].startswith("does not compile")
 
 
-def test_same_seed_same_files_other_seed_other_arm(tmp_path):
-    a = generate_arm("planar", 2, 3, tmp_path / "a")
-    b = generate_arm("planar", 2, 3, tmp_path / "b")
-    for name in ("gen_planar2_s3.xml", "gen_planar2_s3.json", "README.md"):
+def test_same_seed_same_files_other_seed_other_arm(tmp_path, generated):
+    # the module's arm again (same seed as the fixture: its compiled robot is the cache's already)
+    a = generate_arm("planar", 3, 11, tmp_path / "a")
+    b = generate_arm("planar", 3, 11, tmp_path / "b")
+    for name in ("gen_planar3_s11.xml", "gen_planar3_s11.json", "README.md"):
         assert (a.xml_path.parent / name).read_bytes() == (b.xml_path.parent / name).read_bytes()
+    assert a.xml_path.read_bytes() == generated["planar"].xml_path.read_bytes()
     # another seed draws another arm (its draws alone: compiling one is ten seconds of IK)
-    rng3, rng4 = np.random.default_rng(3), np.random.default_rng(4)
-    draws3 = [generate.draw_arm("planar", 2, rng3, "x").params for _ in range(a.draws)]
-    assert draws3[-1]["lengths"] == a.draw.params["lengths"]  # the generator's own draws, replayed
-    assert generate.draw_arm("planar", 2, rng4, "x").params["lengths"] != draws3[0]["lengths"]
+    rng11, rng12 = np.random.default_rng(11), np.random.default_rng(12)
+    draws = [generate.draw_arm("planar", 3, rng11, "x").params for _ in range(a.draws)]
+    assert draws[-1]["lengths"] == a.draw.params["lengths"]  # the generator's own draws, replayed
+    assert generate.draw_arm("planar", 3, rng12, "x").params["lengths"] != draws[0]["lengths"]
 
 
-def test_a_rejected_draw_is_redrawn_and_the_reasons_kept(tmp_path, monkeypatch):
+def test_a_rejected_draw_is_redrawn_and_the_reasons_kept(tmp_path, monkeypatch, generated):
     calls = []
     real = generate.draw_arm
 
     def first_too_short(family, dof, rng, name):
-        d = real(family, dof, rng, name)
+        # the first draw cannot reach the far rooms; it leaves the generator's stream untouched, so
+        # the next is the module fixture's arm (seed 11), whose compiled robot the cache has
+        d = real(family, dof, np.random.default_rng(99) if not calls else rng, name)
         calls.append(d)
-        if len(calls) == 1:  # the first draw cannot reach the far rooms
-            lengths = [0.08, 0.06]
+        if len(calls) == 1:
+            lengths = [0.08, 0.06, 0.04]
             xml = mjcf.planar_arm(name, lengths, d.params["limits"], d.params["home"], height=0.12, drop=0.025)
             d = generate.ArmDraw(d.name, d.family, d.dof, xml, {**d.params, "lengths": lengths}, d.mount_pos,
                                  d.mount_yaw, d.tip_down, d.kind, d.joint_step)
         return d
 
     monkeypatch.setattr("armtransfer.tasks.generated.draw_arm", first_too_short)
-    arm = generate_arm("planar", 2, 0, tmp_path)
+    arm = generate_arm("planar", 3, 11, tmp_path)
     assert arm.draws >= 2 and len(arm.rejected) == arm.draws - 1 == len(calls) - 1
     assert arm.rejected[0].startswith("draw 1: the tip cannot get near Table I cell")
     assert read_sidecar(arm.xml_path)["rejected"] == arm.rejected
+    assert arm.draws == generated["planar"].draws + 1
+    assert arm.xml_path.read_bytes() == generated["planar"].xml_path.read_bytes()
 
 
 def test_no_usable_draw_is_a_one_line_error_and_writes_nothing(tmp_path, monkeypatch):
@@ -126,10 +132,11 @@ def test_bad_generate_input_is_one_line_exit_2(tmp_path, capsys, args, message):
     assert not out.exists()
 
 
-def test_arms_generate_writes_the_arm(tmp_path, capsys):
-    assert main(["arms", "generate", "--family", "planar", "--dof", "2", "--seed", "3", "--out", str(tmp_path)]) == 0
-    assert "gen_planar2_s3.xml:cartesian" in capsys.readouterr().out
-    assert np.isfinite(read_sidecar(tmp_path / "gen_planar2_s3" / "gen_planar2_s3.xml")["reach"])
+def test_arms_generate_writes_the_arm(tmp_path, capsys, generated):
+    # the module fixture's arm: its compiled robot is in the run's arm cache already
+    assert main(["arms", "generate", "--family", "planar", "--dof", "3", "--seed", "11", "--out", str(tmp_path)]) == 0
+    assert "gen_planar3_s11.xml:cartesian" in capsys.readouterr().out
+    assert np.isfinite(read_sidecar(tmp_path / "gen_planar3_s11" / "gen_planar3_s11.xml")["reach"])
 
 
 def test_an_arm_file_keeps_its_generated_mount_everywhere(generated):
