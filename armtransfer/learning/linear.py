@@ -43,6 +43,7 @@ import numpy as np
 from armtransfer.errors import InvalidParameterError
 from armtransfer.learning import jitcache as _jitcache
 from armtransfer.learning import tiles as _tiles
+from armtransfer.learning import traces as _traces
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.sarsa import TrialResult, _shaping
 from armtransfer.learning.shaping import MODE_NONE, Shaping
@@ -183,35 +184,8 @@ def _update(w, q, lower, width, offsets, dims, strides, per_tiling, feats, qrow,
     delta = r + gamma * q_next - q_sa
     n_tr = c[I_NTR]
     for k in range(feat.shape[0]):
-        sa = feat[k] * n_actions + a
-        slot = pos[sa]
-        if slot < 0:
-            pos[sa] = n_tr
-            tr_sa[n_tr] = sa
-            tr_e[n_tr] = 1.0
-            n_tr += 1
-        elif c[I_REPLACING]:
-            tr_e[slot] = 1.0
-        else:
-            tr_e[slot] += 1.0
-    step = p[P_ALPHA] * delta
-    decay, cutoff = p[P_DECAY], p[P_CUTOFF]
-    k = 0
-    while k < n_tr:
-        pair = tr_sa[k]
-        e = tr_e[k]
-        w[pair] += step * e
-        e *= decay
-        if e < cutoff or e == 0.0:
-            pos[pair] = -1
-            n_tr -= 1
-            if k < n_tr:
-                tr_sa[k] = tr_sa[n_tr]
-                tr_e[k] = tr_e[n_tr]
-                pos[tr_sa[k]] = k
-            continue
-        tr_e[k] = e
-        k += 1
+        n_tr = _traces.mark(tr_sa, tr_e, pos, n_tr, feat[k] * n_actions + a, c[I_REPLACING] != 0)
+    n_tr = _traces.apply(w, tr_sa, tr_e, pos, n_tr, p[P_ALPHA] * delta, p[P_DECAY], p[P_CUTOFF])
     c[I_NTR] = n_tr
     if not terminal:
         for k in range(feat.shape[0]):
@@ -377,4 +351,4 @@ def _greedy_path(mover: Mover, learner: _Learner, goal: int, cap: int) -> tuple[
 
 
 _jitcache.invalidate_stale(__name__, [_draw, _egreedy, _values, _begin, _greedy, _update],
-                           [_tiles.__file__, __file__.replace("linear.py", "sarsa.py")])
+                           [_tiles.__file__, _traces.__file__, __file__.replace("linear.py", "sarsa.py")])

@@ -46,6 +46,7 @@ The random stream, in the order it is drawn (the dense reference draws the same)
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import NamedTuple
 
 import numba
@@ -56,6 +57,7 @@ from armtransfer.learning.config import LearnerConfig
 
 from armtransfer.learning import guide as _guide
 from armtransfer.learning import jitcache as _jitcache
+from armtransfer.learning import traces as _traces
 from armtransfer.learning.guide import choice as _choice
 from armtransfer.learning.guide import model as _model
 from armtransfer.learning.guide import planner as _planner
@@ -389,33 +391,9 @@ def _make_run_trial(with_guide: bool):
                         )
                     macro_used += used
                     q_next = Q[s2, a2]
-                sa = s * n_actions + a
                 delta = r + gamma * q_next - Q[s, a]
-                p = pos[sa]
-                if p < 0:
-                    pos[sa] = n_tr
-                    tr_sa[n_tr] = sa
-                    tr_e[n_tr] = 1.0
-                    n_tr += 1
-                else:
-                    tr_e[p] += 1.0
-                k = 0
-                while k < n_tr:
-                    pair = tr_sa[k]
-                    e = tr_e[k]
-                    q_flat[pair] += alpha * delta * e
-                    e *= decay
-                    if e < cutoff or e == 0.0:
-                        # drop: move the last trace into this slot
-                        pos[pair] = -1
-                        n_tr -= 1
-                        if k < n_tr:
-                            tr_sa[k] = tr_sa[n_tr]
-                            tr_e[k] = tr_e[n_tr]
-                            pos[tr_sa[k]] = k
-                        continue
-                    tr_e[k] = e
-                    k += 1
+                n_tr = _traces.mark(tr_sa, tr_e, pos, n_tr, s * n_actions + a, False)
+                n_tr = _traces.apply(q_flat, tr_sa, tr_e, pos, n_tr, alpha * delta, decay, cutoff)
                 if terminal:
                     reached = True
                     break
@@ -572,6 +550,9 @@ def _greedy_action(Q: np.ndarray, s: int) -> int:
     return int(np.argmax(Q[s]))
 
 
-# The kernels above call the guide's jitted functions; numba's cache does not notice an edit to
-# the guide's files alone (``jitcache``), so their cache is emptied when that file changes.
-_jitcache.invalidate_stale(__name__, [_egreedy, _macro_step, _choose, _choose_guided, _greedy_path, _shaping, _run_trial, _run_trial_guided], _guide.FILES)
+DEPENDENCIES = [*_guide.FILES, Path(_traces.__file__)]
+"""The files whose jitted functions the kernels above call: the guide's and the traces'."""
+
+# numba's cache does not notice an edit to those files alone (``jitcache``), so the kernels'
+# cache is emptied when one of them changes.
+_jitcache.invalidate_stale(__name__, [_egreedy, _macro_step, _choose, _choose_guided, _greedy_path, _shaping, _run_trial, _run_trial_guided], DEPENDENCIES)
