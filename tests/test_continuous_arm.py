@@ -191,7 +191,7 @@ def test_api_runs_a_continuous_target_and_refuses_bad_values_in_one_line():
 
 
 def test_continuous_arm_names_the_valid_arms():
-    with pytest.raises(UnknownArmError, match="valid arms: planar2, planar3, planar4 or PATH.xml"):
+    with pytest.raises(UnknownArmError, match="valid arms: planar2, planar3, planar4, PATH.xml"):
         continuous_arm("panda_like")
 
 
@@ -205,3 +205,13 @@ def test_benchmark_fast_mode_writes_its_report(tmp_path):
     again = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "bench_continuous.py"), "--fast", "--out",
                             str(out)], capture_output=True, text=True, timeout=120)
     assert again.returncode == 2 and again.stderr.count("\n") == 1 and "absent or empty" in again.stderr
+
+
+@pytest.mark.slow
+def test_a_generated_planar_arm_is_a_continuous_arm_and_a_spatial_one_is_refused():
+    arm = continuous_arm("gen:planar:3:1:joint")
+    start = TABLE_I[1].cells(arm.layout)[0]
+    arm.place(start)
+    assert arm.dof == 3 and arm.label == start
+    with pytest.raises(ArmTransferError, match="needs a planar arm"):
+        continuous_arm("gen:spatial6:6:1")

@@ -20,6 +20,7 @@ from armtransfer.learning import cells, linear
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.tiles import TileCoding
 from armtransfer.learning.trajectory import Trajectory
+from armtransfer.tasks.catalog import Task
 
 
 @dataclass(frozen=True)
@@ -84,8 +85,7 @@ class ContinuousResult:
     """What ``armtransfer.transfer(..., state="continuous")`` returns: the methods' trials on a
     continuous-state target, summarised as the tabular runs are (``experiment.summarize``)."""
 
-    task: object
-    """The ``tasks.catalog.Task``."""
+    task: Task
     source: str
     target: str
     trajectories: list[Trajectory]
@@ -111,6 +111,6 @@ class ContinuousResult:
     def __repr__(self) -> str:
         lines = [f"<ContinuousResult {self.task.name}: {self.source} -> {self.target} (continuous state), "
                  f"{self.trials} trials"]
-        for m, r in self.methods.items():
+        for r in self.methods.values():
             lines.append(f"  {r!r}")
         return "\n".join(lines) + ">"

@@ -2,7 +2,7 @@
 
 A continuous robot (``ik.continuous``) has no table of states, only a label, the cell under
 its tool point. The transfer methods' arrays (``learning.methods``) are built per state of a
-``DiscreteRobot``; built for :func:`cell_robot`, whose states are the layout's cells each
+``DiscreteRobot``; built for ``tasks.robot.cell_robot``, whose states are the layout's cells each
 labelled with itself, they are per-cell arrays that the linear learner indexes by label. The
 methods that apply are those whose transfer is a reward term on labels alone
 (:data:`CELL_METHODS`).
@@ -12,29 +12,19 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-import numpy as np
-
 from armtransfer.errors import InvalidParameterError
 from armtransfer.learning import methods as registry
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.shaping import Shaping
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.layout import Layout
-from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.tasks.robot import cell_robot
 
 CELL_METHODS = tuple(name for name, m in registry.METHODS.items()
                      if not (m.chooses or m.macros or m.is_baseline) and name != "dense")
 """The methods a robot known only by its label can learn with: no transfer and the reward terms
 paid by the cell reached (``dense`` needs distances over the robot's own states; ``guided``
 and its kin model a table of moves; ``mapping`` needs state numbers for its macros)."""
-
-
-def cell_robot(layout: Layout) -> DiscreteRobot:
-    """The layout's cells as states, each labelled with itself, with one action that stays."""
-    n = layout.n_cells
-    return DiscreteRobot(name="cells", next_state=np.arange(n, dtype=np.int32)[:, None],
-                         wind_state=np.arange(n, dtype=np.int32), label=np.arange(n, dtype=np.int32),
-                         action_names=("stay",), layout=layout)
 
 
 def check_method(method: str) -> str:

@@ -25,11 +25,18 @@ ACTIONS = ("joint",)
 
 
 def parse_spec(spec: str) -> tuple[str | None, str | None]:
-    """'planar3', 'planar3:joint' -> ('planar3', None); 'PATH.xml[:joint]' -> (None, 'PATH.xml').
+    """'planar3', 'planar3:joint' -> ('planar3', None); 'PATH.xml[:joint]' -> (None, 'PATH.xml');
+    'gen:planar:DOF:SEED[:joint]' -> (None, the generated arm's file, generated at its first use).
     Anything else is a one-line error listing the valid arms and action models."""
     if not isinstance(spec, str):
         raise UnknownArmError(f"a continuous arm is named by a string, got {spec!r}")
-    if ".xml" in spec:
+    if spec.startswith("gen:"):
+        from armtransfer.tasks.generated import generated_file
+
+        xml, _, _ = generated_file(spec)
+        parts = spec.split(":")
+        path, name, actions = str(xml), None, parts[4] if len(parts) > 4 else ""
+    elif ".xml" in spec:
         path, _, actions = spec.rpartition(":") if not spec.endswith(".xml") else (spec, "", "")
         name = None
     else:
@@ -37,8 +44,8 @@ def parse_spec(spec: str) -> tuple[str | None, str | None]:
         path = None
         planar = [a for a, info in ARMS.items() if info.kind == "planar"]
         if name not in planar:
-            raise UnknownArmError(f"unknown continuous arm {name!r}; valid arms: {', '.join(planar)} or PATH.xml "
-                                  "(a planar arm file)")
+            raise UnknownArmError(f"unknown continuous arm {name!r}; valid arms: {', '.join(planar)}, PATH.xml "
+                                  "(a planar arm file) or gen:planar:DOF:SEED")
     if actions and actions not in ACTIONS:
         raise UnknownArmError(f"a continuous arm has no action model {actions!r}; valid action models: "
                               f"{', '.join(ACTIONS)}")
@@ -65,6 +72,8 @@ def continuous_arm(spec: str | None = None, *, xml_path=None, tip_site: str | No
             raise UnknownArmError("give a continuous arm: a built-in planar arm or an arm file")
         scene = arm_scene(name, cell_size=cell_size, layout=layout)
         return ContinuousArm(scene, joint_step or ARMS[name].joint_step)
+    if tip_site is None and tip_body is None and spec is not None and spec.startswith("gen:"):
+        tip_site = "tip"  # a generated arm's tool point
     generated = read_sidecar(path) if base_pos is None else None
     if generated is not None:
         base_pos, base_yaw = tuple(generated["mount_pos"]), float(generated["mount_yaw"])

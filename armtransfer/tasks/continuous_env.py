@@ -23,6 +23,7 @@ import armtransfer.checks as checks
 from armtransfer.errors import InvalidActionError, InvalidParameterError
 from armtransfer.tasks.catalog import Task
 from armtransfer.tasks.envs import check_options, rooms_task
+from armtransfer.tasks.robot import cell_robot
 
 ARM_OPTIONS = ("xml_path", "tip_site", "tip_body", "tip_offset", "base_pos", "base_yaw", "joint_step", "cell_size")
 """The keywords that build the arm (``tasks.continuous.continuous_arm``)."""
@@ -53,8 +54,6 @@ class ContinuousArmRoomsEnv(gym.Env):
         self.observation_space = spaces.Box(np.concatenate([lo, [-REACH] * 3]), np.concatenate([hi, [REACH] * 3]),
                                             dtype=np.float64)
         self.action_space = spaces.Discrete(arm.n_actions)
-        from armtransfer.learning.cells import cell_robot
-
         self.robot = cell_robot(layout)
         """The cells as a robot (states = cells): what ``TransferReward`` pays transfer by."""
         self.start_state = self.start_cell
