@@ -26,6 +26,7 @@ improvement in first exposure over none.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import platform
@@ -197,6 +198,8 @@ def markdown(result: dict) -> str:
              f"| arm + linear SARSA(lambda) ({rate['tilings']} tilings, {rate['features']:,} features) | "
              f"{_n(med['learner'])} | {rate['ratio_to_bare']['learner']:.2f} |", ""]
     cfg = result["config"]
+    if not result["table_one"]:
+        return "\n".join(lines) + "\n"
     lines += [f"Table I, {result['seeds']} source seeds, caps: {cfg['max_total_steps']:,} steps per trial, "
               f"{cfg['max_episodes']} episodes, {cfg['max_episode_steps']:,} steps per episode after the first, "
               f"patience {cfg['patience']}. First exposure: mean [bootstrap 95%] (a lower bound, marked >=, when a "
@@ -237,13 +240,15 @@ def _run(args) -> int:
     source_config = LearnerConfig()
     print("step rate ...", file=sys.stderr, flush=True)
     rate = step_rate(args.rounds, args.rate_steps, approx)
-    print("Table I ...", file=sys.stderr, flush=True)
-    with tempfile.TemporaryDirectory() as tmp:
-        table = table_one(args.seeds, config, source_config, approx, Path(tmp), args.fast, tasks)
+    table: list[dict] = []
+    if not args.rate_only:
+        print("Table I ...", file=sys.stderr, flush=True)
+        with tempfile.TemporaryDirectory() as tmp:
+            table = table_one(args.seeds, config, source_config, approx, Path(tmp), args.fast, tasks)
     result = {"command": " ".join(["python", "benchmarks/bench_continuous.py", *sys.argv[1:]]),
               "machine": f"{platform.machine()}, {platform.processor() or 'cpu'}, Python {platform.python_version()}",
               "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "seeds": args.seeds,
-              "config": config.to_dict(), "approximation": vars(approx) if hasattr(approx, "__dict__") else {},
+              "config": config.to_dict(), "approximation": dataclasses.asdict(approx),
               "rate": rate, "table_one": table}
     out.mkdir(parents=True, exist_ok=True)
     (out / "continuous.json").write_text(json.dumps(result, indent=1, default=float) + "\n")
@@ -258,6 +263,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--out", required=True, help="an absent or empty directory for continuous.md and continuous.json")
     p.add_argument("--fast", action="store_true",
                    help="a smoke run: 2 seeds, task 1, one pair, tiny caps, the source's shortest path handed over")
+    p.add_argument("--rate-only", action="store_true", help="measure the step rate only (a)")
     p.add_argument("--seeds", type=int, default=10)
     p.add_argument("--rounds", type=int, default=5)
     p.add_argument("--rate-steps", type=int, default=100_000)

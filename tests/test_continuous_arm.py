@@ -215,3 +215,31 @@ def test_a_generated_planar_arm_is_a_continuous_arm_and_a_spatial_one_is_refused
     assert arm.dof == 3 and arm.label == start
     with pytest.raises(ArmTransferError, match="needs a planar arm"):
         continuous_arm("gen:spatial6:6:1")
+
+
+def test_from_its_start_the_arm_reaches_the_goal_in_the_joint_robots_fewest_moves():
+    """The start is on the home lattice, so the moves reach what the joint model's reach: a
+    breadth-first search over the continuous arm's own moves (MuJoCo at each) finds the goal
+    of Table I task 1 as many moves away as the tabular planar2:joint robot's shortest path."""
+    arm = continuous_arm("planar2")
+    start, goal = TABLE_I[1].cells(arm.layout)
+    arm.place(start)
+    depth = {arm.key(): 0}
+    frontier = [(arm.key(), arm.q.copy())]
+    found = None
+    while frontier and found is None:
+        nxt = []
+        for key, q in frontier:
+            for a in range(arm.n_actions):
+                arm.q[:] = q
+                arm._n = list(key)
+                label = arm.move(a)
+                if label < 0 or arm.key() in depth:
+                    continue
+                depth[arm.key()] = depth[key] + 1
+                if label == goal:
+                    found = depth[arm.key()]
+                nxt.append((arm.key(), arm.q.copy()))
+        frontier = nxt
+    tab = robot("planar2:joint")
+    assert found == len(tab.shortest_path(tab.start_state(start), goal)) - 1

@@ -23,6 +23,7 @@ the move (``_sweep``), without another MuJoCo call.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import mujoco
@@ -211,8 +212,14 @@ class ContinuousArm:
         return q0 + np.array(self._nlo) * self.step, q0 + np.array(self._nhi) * self.step
 
     def place(self, cell: int) -> np.ndarray:
-        """A configuration with the tool point over ``cell`` (mink IK from home, then from
-        random starts of a fixed seed), set as the arm's configuration; returns it."""
+        """A configuration with the tool point over ``cell``, set as the arm's configuration;
+        returns it. It lies on the arm's home lattice (home + n * step, the points the ``joint``
+        model's moves reach from home), so that the moves from it reach what the joint model's
+        moves reach: mink IK (from home, then from random starts of a fixed seed) gives a
+        configuration over the cell, and of the lattice points around it (each joint rounded
+        to the lattice, then one step either way) the one whose tool point is nearest the
+        cell's centre, over the cell and touching nothing, is taken; the IK configuration
+        itself when none is."""
         ik = TipIK(self.scene, False)
         x, y = self.layout.xy(int(cell))
         target = np.array([x * self.scene.cell, y * self.scene.cell])
@@ -220,11 +227,25 @@ class ContinuousArm:
         if not ik.ok(res):
             res = ik.solve_any(target, self.scene.home, np.random.default_rng(0))
         if ik.ok(res):
-            try:
-                if self.set_configuration(res.q) == cell:
-                    return self.q.copy()
-            except (ArmModelError, InvalidCellError):
-                pass
+            home = self.scene.home.astype(float)
+            base = np.rint((res.q - home) / self.step)
+            best, best_d = None, np.inf
+            for off in itertools.product((0, -1, 1), repeat=self.dof):
+                q = home + (base + np.array(off)) * self.step
+                try:
+                    if self.set_configuration(q) != cell:
+                        continue
+                except (ArmModelError, InvalidCellError):
+                    continue
+                d = float(np.linalg.norm(self.tool_point()[:2] - target))
+                if d < best_d:
+                    best, best_d = q, d
+            for q in ([best] if best is not None else []) + [res.q]:
+                try:
+                    if self.set_configuration(q) == cell:
+                        return self.q.copy()
+                except (ArmModelError, InvalidCellError):
+                    pass
         raise UnreachableTableError(f"the arm cannot place its tool point over cell {(x, y)} without touching "
                                     "anything")
 
