@@ -1,6 +1,6 @@
 """Robot 2 in its continuous configuration space: step rate, and Table I learned from the pseudo reward.
 
-    python benchmarks/bench_continuous.py --out DIR            # the measured run (about 25 minutes)
+    python benchmarks/bench_continuous.py --out DIR            # the measured run (about 15-25 minutes)
     python benchmarks/bench_continuous.py --fast --out DIR     # a smoke run (seconds; the source's
                                                                # shortest path instead of its learned one)
 
@@ -65,13 +65,21 @@ def byo_arm(directory: Path, fast: bool):
     return continuous_arm(None, xml_path=xml, joint_step=0.35, **opts), f"{BYO} arm file (joint step 0.35)"
 
 
-def pairs(directory: Path, fast: bool) -> list[tuple[str, str, object]]:
-    """(source spec, target name, target arm)."""
-    out = [("planar2:joint", "planar3:joint (continuous)", continuous_arm("planar3")),
-           ("ur5e_like:cartesian", "planar2:joint (continuous)", continuous_arm("planar2"))]
-    arm, name = byo_arm(directory, fast)
-    out.append(("planar2:joint", name + " (continuous)", arm))
-    return out[:1] if fast else out
+PAIRS = ("planar2:joint->planar3", "ur5e_like:cartesian->planar2", f"planar2:joint->{BYO}")
+"""The pairs measured, by the names ``--pairs`` takes."""
+
+
+def pairs(directory: Path, fast: bool, chosen: list[str]) -> list[tuple[str, str, object]]:
+    """(source spec, target name, target arm) of each chosen pair."""
+    out = []
+    for name in chosen:
+        source, target = name.split("->")
+        if target == BYO:
+            arm, label = byo_arm(directory, fast)
+            out.append((source, label + " (continuous)", arm))
+        else:
+            out.append((source, f"{target}:joint (continuous)", continuous_arm(target)))
+    return out
 
 
 # ----------------------------------------------------------------------------- (a) step rate
@@ -144,9 +152,9 @@ def method_stats(trials: list, cap: int, horizon: int) -> dict:
 
 
 def table_one(seeds: int, config: LearnerConfig, source_config: LearnerConfig, approx: runs.Approximation,
-              directory: Path, fast: bool, tasks: list[int]) -> list[dict]:
+              directory: Path, fast: bool, tasks: list[int], chosen: list[str]) -> list[dict]:
     out = []
-    for source_spec, target_name, arm in pairs(directory, fast):
+    for source_spec, target_name, arm in pairs(directory, fast, chosen):
         source = tabular_robot(source_spec)
         for task in tasks:
             start, goal = TABLE_I[task].cells(arm.layout)
@@ -223,6 +231,23 @@ def markdown(result: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def machine() -> str:
+    """The CPU's model and count, memory and Python, as this machine reports them."""
+    import os
+
+    model = platform.processor() or "cpu"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+        pages = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+        memory = f", {pages / 2**30:.0f} GiB"
+    except (OSError, ValueError):
+        memory = ""
+    return f"{platform.machine()} {model}, {os.cpu_count()} cores{memory}, Python {platform.python_version()}"
+
+
 def _run(args) -> int:
     out = Path(args.out)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
@@ -230,13 +255,18 @@ def _run(args) -> int:
     if args.seeds < 1 or args.rounds < 1 or args.rate_steps < 100:
         raise InvalidParameterError("--seeds and --rounds must be positive and --rate-steps at least 100")
     approx = runs.Approximation(tilings=args.tilings, width=args.width)
+    bad = [t for t in args.tasks if t not in TABLE_I] + [p for p in args.pairs if p not in PAIRS]
+    if bad:
+        raise InvalidParameterError(f"unknown task or pair {bad[0]!r}; valid tasks: {', '.join(map(str, TABLE_I))}; "
+                                    f"valid pairs: {', '.join(PAIRS)}")
+    chosen = list(dict.fromkeys(args.pairs))
+    tasks = list(dict.fromkeys(args.tasks))
     if args.fast:
         config = LearnerConfig(max_episodes=5, max_total_steps=20_000, max_episode_steps=5_000, patience=2)
-        tasks = [1]
+        tasks, chosen = tasks[:1], chosen[:1]
     else:
         config = LearnerConfig(max_episodes=args.episodes, max_total_steps=args.cap,
                                max_episode_steps=args.episode_cap, patience=args.patience)
-        tasks = list(TABLE_I)
     source_config = LearnerConfig()
     print("step rate ...", file=sys.stderr, flush=True)
     rate = step_rate(args.rounds, args.rate_steps, approx)
@@ -244,9 +274,9 @@ def _run(args) -> int:
     if not args.rate_only:
         print("Table I ...", file=sys.stderr, flush=True)
         with tempfile.TemporaryDirectory() as tmp:
-            table = table_one(args.seeds, config, source_config, approx, Path(tmp), args.fast, tasks)
+            table = table_one(args.seeds, config, source_config, approx, Path(tmp), args.fast, tasks, chosen)
     result = {"command": " ".join(["python", "benchmarks/bench_continuous.py", *sys.argv[1:]]),
-              "machine": f"{platform.machine()}, {platform.processor() or 'cpu'}, Python {platform.python_version()}",
+              "machine": machine(),
               "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "seeds": args.seeds,
               "config": config.to_dict(), "approximation": dataclasses.asdict(approx),
               "rate": rate, "table_one": table}
@@ -262,17 +292,19 @@ def main(argv: list[str] | None = None) -> int:
     p = script.parser(__doc__)
     p.add_argument("--out", required=True, help="an absent or empty directory for continuous.md and continuous.json")
     p.add_argument("--fast", action="store_true",
-                   help="a smoke run: 2 seeds, task 1, one pair, tiny caps, the source's shortest path handed over")
+                   help="a smoke run: 2 seeds, the first task and pair, tiny caps, the source's shortest path handed over")
     p.add_argument("--rate-only", action="store_true", help="measure the step rate only (a)")
     p.add_argument("--seeds", type=int, default=10)
+    p.add_argument("--tasks", type=int, nargs="+", default=list(TABLE_I), help="Table I tasks (default: all)")
+    p.add_argument("--pairs", nargs="+", default=list(PAIRS), help=f"pairs (default: all): {', '.join(PAIRS)}")
     p.add_argument("--rounds", type=int, default=5)
     p.add_argument("--rate-steps", type=int, default=100_000)
     p.add_argument("--tilings", type=int, default=runs.Approximation().tilings)
     p.add_argument("--width", type=float, default=runs.Approximation().width, help="tile width in joint steps")
     p.add_argument("--cap", type=int, default=150_000, help="steps per trial at most")
-    p.add_argument("--episodes", type=int, default=30)
-    p.add_argument("--episode-cap", type=int, default=30_000)
-    p.add_argument("--patience", type=int, default=5)
+    p.add_argument("--episodes", type=int, default=300)
+    p.add_argument("--episode-cap", type=int, default=50_000, help="steps per episode after the first at most")
+    p.add_argument("--patience", type=int, default=LearnerConfig().patience)
     args = p.parse_args(argv)
     if args.fast:
         args.seeds, args.rounds, args.rate_steps = min(args.seeds, 2), min(args.rounds, 2), min(args.rate_steps, 3000)
