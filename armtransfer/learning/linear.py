@@ -45,7 +45,7 @@ from armtransfer.learning import jitcache as _jitcache
 from armtransfer.learning import tiles as _tiles
 from armtransfer.learning import traces as _traces
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.learning.sarsa import TrialResult, _shaping
+from armtransfer.learning.sarsa import TrialResult, _best_and_ties, _nth_best, _shaping
 from armtransfer.learning.shaping import MODE_NONE, Shaping
 from armtransfer.learning.tiles import TileCoding
 
@@ -91,26 +91,8 @@ def _egreedy(qrow, n_actions, eps, u, c):
     draws in the same order, the same choice (the one-hot test checks it)."""
     if _draw(u, c) < eps:
         return int(_draw(u, c) * n_actions)
-    best = qrow[0, 0]
-    ties = 1
-    for a in range(1, n_actions):
-        v = qrow[0, a]
-        if v > best:
-            best = v
-            ties = 1
-        elif v == best:
-            ties += 1
-    if ties == 1:
-        for a in range(n_actions):
-            if qrow[0, a] == best:
-                return a
-    k = int(_draw(u, c) * ties)
-    for a in range(n_actions):
-        if qrow[0, a] == best:
-            if k == 0:
-                return a
-            k -= 1
-    return n_actions - 1  # unreachable
+    best, ties = _best_and_ties(qrow, 0, n_actions)
+    return _nth_best(qrow, 0, n_actions, best, 0 if ties == 1 else int(_draw(u, c) * ties))
 
 
 @numba.njit(cache=True, nogil=True, inline="always")

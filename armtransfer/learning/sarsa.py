@@ -152,9 +152,8 @@ class Outputs(NamedTuple):
 
 
 @numba.njit(cache=True, inline="always")
-def _egreedy(Q, s, n_actions, eps, rng):
-    if rng.random() < eps:
-        return int(rng.random() * n_actions)
+def _best_and_ties(Q, s, n_actions):
+    """(the largest Q[s, .], how many actions have it)."""
     best = Q[s, 0]
     ties = 1
     for a in range(1, n_actions):
@@ -164,17 +163,26 @@ def _egreedy(Q, s, n_actions, eps, rng):
             ties = 1
         elif q == best:
             ties += 1
-    if ties == 1:
-        for a in range(n_actions):
-            if Q[s, a] == best:
-                return a
-    k = int(rng.random() * ties)
+    return best, ties
+
+
+@numba.njit(cache=True, inline="always")
+def _nth_best(Q, s, n_actions, best, k):
+    """The k-th (from 0, in index order) action whose Q[s, .] is ``best``."""
     for a in range(n_actions):
         if Q[s, a] == best:
             if k == 0:
                 return a
             k -= 1
     return n_actions - 1  # unreachable
+
+
+@numba.njit(cache=True, inline="always")
+def _egreedy(Q, s, n_actions, eps, rng):
+    if rng.random() < eps:
+        return int(rng.random() * n_actions)
+    best, ties = _best_and_ties(Q, s, n_actions)
+    return _nth_best(Q, s, n_actions, best, 0 if ties == 1 else int(rng.random() * ties))
 
 
 @numba.njit(cache=True, inline="always")
@@ -555,4 +563,4 @@ DEPENDENCIES = [*_guide.FILES, Path(_traces.__file__)]
 
 # numba's cache does not notice an edit to those files alone (``jitcache``), so the kernels'
 # cache is emptied when one of them changes.
-_jitcache.invalidate_stale(__name__, [_egreedy, _macro_step, _choose, _choose_guided, _greedy_path, _shaping, _run_trial, _run_trial_guided], DEPENDENCIES)
+_jitcache.invalidate_stale(__name__, [_best_and_ties, _nth_best, _egreedy, _macro_step, _choose, _choose_guided, _greedy_path, _shaping, _run_trial, _run_trial_guided], DEPENDENCIES)
