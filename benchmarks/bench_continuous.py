@@ -231,6 +231,21 @@ def markdown(result: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def survival_figure(result: dict, path: Path) -> None:
+    """Kaplan-Meier curves of first exposure, one panel per pair and task, none against pseudo."""
+    from armtransfer.experiments import figures
+
+    cap = result["config"]["max_total_steps"]
+    panels = []
+    for row in result["table_one"]:
+        curves = {}
+        for m, st in row["methods"].items():
+            km = survival.kaplan_meier(st["first_exposure"], cap)
+            curves[m] = (km["times"], km["survival"])
+        panels.append((f"{row['source']} -> {row['target'].replace(' (continuous)', '')}, task {row['task']}", curves))
+    figures.survival_grid(panels, cap, f"First exposure on continuous targets ({result['seeds']} source seeds)", path)
+
+
 def machine() -> str:
     """The CPU's model and count, memory and Python, as this machine reports them."""
     import os
@@ -284,6 +299,8 @@ def _run(args) -> int:
     (out / "continuous.json").write_text(json.dumps(result, indent=1, default=float) + "\n")
     text = markdown(result)
     (out / "continuous.md").write_text(text)
+    if table:
+        survival_figure(result, out / "survival.png")
     print(text)
     return 0
 
