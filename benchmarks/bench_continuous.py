@@ -35,6 +35,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -69,7 +70,7 @@ PAIRS = ("planar2:joint->planar3", "ur5e_like:cartesian->planar2", f"planar2:joi
 """The pairs measured, by the names ``--pairs`` takes."""
 
 
-def pairs(directory: Path, fast: bool, chosen: list[str]) -> list[tuple[str, str, object]]:
+def pairs(directory: Path, fast: bool, chosen: list[str]) -> list[tuple[str, str, Any]]:
     """(source spec, target name, target arm) of each chosen pair."""
     out = []
     for name in chosen:

@@ -48,7 +48,7 @@ def _expected_end(arm, q, a):
 def test_every_move_is_checked_by_mujoco_at_its_end(arm):
     arm.reset()
     rng = np.random.default_rng(0)
-    seen = {"moved": 0, "limit": 0, "wall or edge": 0}
+    seen = {"moved": 0, "limit": 0, "wall or edge": 0, "contact": 0}
     for _ in range(3000):
         q = arm.q.copy()
         a = int(rng.integers(arm.n_actions))
@@ -61,11 +61,34 @@ def test_every_move_is_checked_by_mujoco_at_its_end(arm):
         elif touches or cell < 0 or not arm.layout.free[cell]:
             assert label == BLOCKED and np.array_equal(arm.q, q)
             seen["wall or edge"] += not touches
+            seen["contact"] += touches  # the stylus against a wall
         elif label != BLOCKED:  # the arc between may still pass over a wall
             assert label == cell == arm.label
             assert np.count_nonzero(arm.q != q) == 1
             seen["moved"] += 1
-    assert seen["moved"] > 1000 and seen["wall or edge"] > 0
+    assert seen["moved"] > 1000 and seen["wall or edge"] > 0 and seen["contact"] > 0
+
+
+def test_a_bring_your_own_arm_file_is_blocked_by_its_own_links(tmp_path):
+    """Menagerie's kind of planar 5-joint file, whose links may strike each other: every move
+    into a configuration where MuJoCo finds the arm touching itself (or anything) is blocked."""
+    import menagerie_like as ml
+
+    a = continuous_arm(None, xml_path=ml.planar5_straight(tmp_path), joint_step=0.35, **ml.SUGGESTED["planar5"])
+    assert a.checker.can_self_collide
+    a.place(TABLE_I[1].cells(a.layout)[0])
+    rng = np.random.default_rng(0)
+    touched = 0
+    for _ in range(2500):
+        q = a.q.copy()
+        act = int(rng.integers(a.n_actions))
+        inside, touches, _ = _expected_end(a, q, act)
+        a.q[:] = q
+        label = a.move(act)
+        if inside and touches:
+            touched += 1
+            assert label == BLOCKED and np.array_equal(a.q, q)
+    assert touched > 0
 
 
 def test_limits_block_a_move():
