@@ -26,6 +26,7 @@ from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import DEFAULT_MAX_SPAN, ActionMapping
 from armtransfer.learning.mapping import load_for as load_mapping
+from armtransfer.experiments.continuous import ContinuousResult
 from armtransfer.experiments.results import MappingInfo, TransferResult
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.catalog import Task, as_xy, custom_task, table_task
@@ -70,7 +71,7 @@ def transfer(
     progress: Callable[[], None] | None = None,
     state: str = "discrete",
     **learner_options,
-):
+) -> TransferResult | ContinuousResult:
     """Transfer a trajectory from ``source`` to ``target`` and learn with each method.
 
     ``task`` is a Table I task (1-4) or give ``start`` and ``goal`` cells; with neither, a
@@ -204,7 +205,7 @@ def _cell_methods() -> tuple[str, ...]:
 
 
 def _transfer_continuous(source, target, the_task: Task, method_names: list[str], specs, trials: int, seed: int,
-                         K, config: LearnerConfig, arm_xml, options: dict, progress):
+                         K, config: LearnerConfig, arm_xml, options: dict, progress) -> ContinuousResult:
     """``transfer`` with a continuous-state target (see its docstring)."""
     from armtransfer.experiments import continuous as runs
     from armtransfer.learning.cells import check_method
