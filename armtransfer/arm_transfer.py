@@ -28,6 +28,7 @@ from typing import Any
 from armtransfer import api
 from armtransfer.commands import common
 from armtransfer.commands.rooms import print_results, results_table
+from armtransfer.errors import InvalidParameterError
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.layout import ROOMS
@@ -75,15 +76,32 @@ def arm_options(args: argparse.Namespace) -> dict:
     return options
 
 
+FAST_CAPS = {"trials": 2, "patience": 5}
+"""What --fast caps (a smaller value given is kept)."""
+
+
 def _fast_overrides(args: argparse.Namespace) -> dict:
     """--fast: 2 trials, convergence after 5 unchanged episodes, no controls."""
     if not args.fast:
         return {}
-    return dict(trials=min(args.trials, 2), patience=min(args.patience, 5), controls=False)
+    return dict({k: min(getattr(args, k), cap) for k, cap in FAST_CAPS.items()}, controls=False)
+
+
+def _check_fast(args: argparse.Namespace) -> None:
+    """A value given above what --fast caps would be silently cut: an error instead."""
+    if not args.fast:
+        return
+    defaults = {a.dest: a.default for a in common.options_of(args)}
+    for dest, cap in FAST_CAPS.items():
+        value = getattr(args, dest)
+        if value != defaults.get(dest) and value > cap:
+            raise InvalidParameterError(f"--{dest} {value} does not apply with --fast (it runs at most {cap}); "
+                                        f"drop --fast to run {value}")
 
 
 def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
+    _check_fast(args)
     out = Path(args.out) if args.out else Path("runs") / _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
     check_distinct_outputs({"--json": args.json, "--render": args.render, "--mapping": args.mapping},
                            {"--out": out})

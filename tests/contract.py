@@ -1,5 +1,6 @@
-"""What the tests of the error contract share: a command refused in one line, and the
-processes of a session (to check that a kill leaves none behind)."""
+"""What the tests of the error contract share: a command refused in one line, the
+processes of a session (to check that a kill leaves none behind), an arm file that includes
+another (to check what the arm cache's key covers), and a sweep with an arm table."""
 
 from __future__ import annotations
 
@@ -53,3 +54,33 @@ def settle(sid: int, seconds: float = 60.0) -> list[int]:
         except ProcessLookupError:
             pass
     return left
+
+
+INCLUDING = """<mujoco model="inc_scara"><compiler angle="radian" meshdir="{meshdir}"/><worldbody>
+  <body name="upper" pos="0.05 0.02 0.15">
+    <joint name="shoulder" type="hinge" axis="0 0 1" range="-3 3"/>
+    <geom name="upper_geom" type="capsule" size="0.01" fromto="0 0 0 0.24 0 0"/>
+    <include file="fore.xml"/>
+  </body></worldbody></mujoco>"""
+FORE = """<mujoco><body name="fore" pos="0.24 0 -0.03">
+      <joint name="elbow" type="hinge" axis="0 0 1" range="-2.9 2.9"/>
+      <geom name="fore_geom" type="capsule" size="0.01" fromto="0 0 0 {length} 0 0"/>
+      <site name="pen_tip" pos="{length} 0 -0.116"/>
+    </body></mujoco>"""
+"""An arm file (``INCLUDING.format(meshdir=...)``) whose forearm is in ``fore.xml``
+(``FORE.format(length=...)``)."""
+
+
+SWEEP_WITH_ARM = """[sweep]
+name = "s"
+tasks = [1]
+pairs = [["coarse", "fine"]{extra_pair}]
+methods = ["none"]
+trials = 1
+max_episodes = 3
+
+[arms.{name}]
+xml = "{xml}"
+tip_site = "pen_tip"
+"""
+"""A sweep with an ``[arms.NAME]`` table (the arm file ``xml``) and maybe a pair more."""

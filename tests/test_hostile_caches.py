@@ -14,20 +14,10 @@ from armtransfer.errors import ArmModelError
 from armtransfer.ik import cache as _cache
 from armtransfer.tasks import arms
 from armtransfer.tasks.arms import arm_robot
+from contract import FORE, INCLUDING
 
 POSE = dict(tip_site="pen_tip", base_pos=(-0.15, -0.02, -0.002), base_yaw=0.0)
 
-INCLUDING = """<mujoco model="inc_scara"><compiler angle="radian" meshdir="{meshdir}"/><worldbody>
-  <body name="upper" pos="0.05 0.02 0.15">
-    <joint name="shoulder" type="hinge" axis="0 0 1" range="-3 3"/>
-    <geom name="upper_geom" type="capsule" size="0.01" fromto="0 0 0 0.24 0 0"/>
-    <include file="fore.xml"/>
-  </body></worldbody></mujoco>"""
-FORE = """<mujoco><body name="fore" pos="0.24 0 -0.03">
-      <joint name="elbow" type="hinge" axis="0 0 1" range="-2.9 2.9"/>
-      <geom name="fore_geom" type="capsule" size="0.01" fromto="0 0 0 {length} 0 0"/>
-      <site name="pen_tip" pos="{length} 0 -0.116"/>
-    </body></mujoco>"""
 
 
 @pytest.fixture

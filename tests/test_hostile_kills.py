@@ -53,6 +53,73 @@ def test_a_kill_while_workers_start_leaves_no_process(command, tmp_path):
     assert left == [], "processes outlived the killed driver"
 
 
+GUARDED = """
+import time
+from armtransfer.experiments.reaper import guarded_spawn_context
+child = guarded_spawn_context().Process(target=time.sleep, args=(120,))
+child.start()
+print(child.pid, flush=True)
+time.sleep(120)
+"""
+
+
+def _gone(pid: int) -> bool:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] == "Z"
+    except OSError:
+        return True
+
+
+def _killed_takes(driver: subprocess.Popen, pid: int, seconds: float = 10.0) -> bool:
+    """SIGKILL ``driver``: is ``pid`` gone within ``seconds``?"""
+    os.kill(driver.pid, signal.SIGKILL)
+    driver.wait()
+    deadline = time.time() + seconds
+    while time.time() < deadline and not _gone(pid):
+        time.sleep(0.02)
+    return _gone(pid)
+
+
+def test_a_guarded_worker_ends_with_its_driver_whatever_it_runs():
+    """The guard runs before the worker imports anything: a worker whose own code never looks
+    at its parent (here it sleeps for two minutes) still ends when its driver is killed."""
+    driver = subprocess.Popen([sys.executable, "-c", GUARDED], stdout=subprocess.PIPE, text=True,
+                              start_new_session=True)
+    try:
+        child = int(driver.stdout.readline())
+        assert _killed_takes(driver, child), "the worker outlived its killed driver"
+    finally:
+        assert settle(driver.pid, 5) == []
+
+
+REAPED = """
+import subprocess, sys, time
+from armtransfer.experiments.reaper import Reaper
+reaper = Reaper()
+time.sleep(0.2)
+grandchild = ("import subprocess, sys, time; p = subprocess.Popen([sys.executable, '-c', 'import time; "
+              "time.sleep(120)']); print(p.pid, flush=True); time.sleep(120)")
+middle = subprocess.Popen([sys.executable, "-c", grandchild], stdout=subprocess.PIPE, text=True)
+print(middle.pid, middle.stdout.readline().strip(), flush=True)
+time.sleep(120)
+"""
+
+
+def test_the_reaper_stops_what_the_sweep_started_that_it_was_never_told_of():
+    """Ray starts processes after its init (its agents), whose parent (the raylet) may die
+    before them: the watcher lists every process below the sweep while it lives, so such an
+    orphan goes too when the sweep is killed."""
+    driver = subprocess.Popen([sys.executable, "-c", REAPED], stdout=subprocess.PIPE, text=True,
+                              start_new_session=True)
+    try:
+        middle, orphan = map(int, driver.stdout.readline().split())
+        time.sleep(2.5)  # two of the watcher's looks at least
+        os.kill(middle, signal.SIGKILL)  # the parent dies first: its child is PID 1's now
+        assert _killed_takes(driver, orphan), "a process the sweep started outlived it"
+    finally:
+        assert settle(driver.pid, 5) == []
+
+
 def _dies_on_first(run, robots):
     """A worker that dies at once the first time it runs (a marker file says it did)."""
     marker = Path(os.environ["HOSTILE_MARKER"])

@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from contract import refused
+from contract import SWEEP_WITH_ARM, refused
 from armtransfer.errors import InvalidTrajectoryError
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.tasks.catalog import table_task
@@ -42,18 +42,29 @@ def test_an_option_of_another_mode_is_refused(argv, flag, tmp_path, monkeypatch,
     assert f"{flag} does not apply" in err and "its options:" in err
 
 
-SWEEP = """[sweep]
-name = "s"
-tasks = [1]
-pairs = [["coarse", "fine"]{extra_pair}]
-methods = ["none"]
-trials = 1
-max_episodes = 3
+@pytest.mark.parametrize("argv,flag,users", [
+    (["rooms", "--beta", "2"], "--beta", "dense"),
+    (["rooms", "--method", "pseudo", "--max-span", "3"], "--max-span", "mapping"),
+    (["rooms", "--method", "none", "--K", "0.1"], "--K", "pseudo"),
+    (["rooms", "--method", "none", "--trajectory", "optimal"], "--trajectory", "pseudo"),
+    (["arms", "--fast", "--out", "o", "--method", "none", "pseudo", "--beta", "2"], "--beta", "dense"),
+    (["matrix", "--robots", "coarse,fine", "--methods", "none", "--trajectory", "optimal", "--out", "m"],
+     "--trajectory", "pseudo"),
+])
+def test_a_method_option_no_chosen_method_uses_is_refused(argv, flag, users, tmp_path, monkeypatch, capsys):
+    err = refused(argv, tmp_path, monkeypatch, capsys)
+    assert f"{flag} does not apply to --method" in err and users in err.split("goes with the methods")[1]
 
-[arms.{name}]
-xml = "{xml}"
-tip_site = "pen_tip"
-"""
+
+@pytest.mark.parametrize("argv,flag", [
+    (["bench", "--baseline-repeats", "0", "--baseline-steps", "10"], "--baseline-steps"),
+    (["sweep", "s.toml", "--out", "st", "--executor", "ray", "--address", "127.0.0.1:1", "--workers", "2"],
+     "--workers"),
+    (["arms", "--fast", "--out", "o", "--trials", "5"], "--trials 5"),
+    (["arms", "--fast", "--out", "o", "--patience", "50"], "--patience 50"),
+])
+def test_an_option_of_another_setting_is_refused(argv, flag, tmp_path, monkeypatch, capsys):
+    assert f"{flag} does not apply" in refused(argv, tmp_path, monkeypatch, capsys)
 
 
 @pytest.mark.parametrize("name,extra_pair,message", [
@@ -62,7 +73,7 @@ tip_site = "pen_tip"
     ("myarm", "", "is not used by any pair"),
 ])
 def test_every_sweep_arm_table_is_checked(name, extra_pair, message, tmp_path, monkeypatch, capsys, scara_xml):
-    (tmp_path / "s.toml").write_text(SWEEP.format(name=name, extra_pair=extra_pair, xml=scara_xml))
+    (tmp_path / "s.toml").write_text(SWEEP_WITH_ARM.format(name=name, extra_pair=extra_pair, xml=scara_xml))
     err = refused(["sweep", "s.toml", "--out", "store"], tmp_path, monkeypatch, capsys)
     assert f"arms.{name} {message}" in err
 

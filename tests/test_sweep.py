@@ -103,7 +103,8 @@ def crash_always(run, robots):
     os.kill(os.getpid(), signal.SIGKILL)
 
 
-@pytest.mark.parametrize("fn,expect_failed", [(crash_once, 0), (crash_always, 2)])
+@pytest.mark.parametrize("fn,expect_failed", [(crash_once, 0),
+                                              pytest.param(crash_always, 2, marks=pytest.mark.slow)])
 def test_killed_workers_are_retried_or_reported_never_lost(tmp_path, monkeypatch, fn, expect_failed):
     monkeypatch.setenv("CRASH_DIR", str(tmp_path))
     sw_path = tmp_path / "s.toml"
@@ -158,6 +159,7 @@ def test_an_output_directory_holding_another_sweep_is_refused(sweep_file, tmp_pa
     assert "holds no sweep" in capsys.readouterr().err
 
 
+@pytest.mark.slow  # Ray's start-up alone is 10-20 s of CPU
 def test_ray_executor_matches_the_local_executor(sweep_file, tmp_path):
     ray = pytest.importorskip("ray")
     local, remote = tmp_path / "local", tmp_path / "ray"

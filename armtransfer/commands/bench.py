@@ -10,7 +10,7 @@ import time
 
 import numpy as np
 
-from armtransfer.commands.common import non_negative_int, positive_int
+from armtransfer.commands.common import non_negative_int, options_of, positive_int, refuse_other_options
 from armtransfer.tasks.catalog import table_task
 from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.learning import sarsa
@@ -64,6 +64,9 @@ def measure_reference(steps: int, seed: int) -> tuple[int, float]:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.baseline_repeats == 0:
+        refuse_other_options(args, {a.dest for a in options_of(args)} - {"baseline_steps"},
+                             "bench with --baseline-repeats 0 (no baseline)")
     if args.json:
         check_writable(args.json)
     measure(10_000, args.seed)  # compile (or load the cached kernel) outside the timing

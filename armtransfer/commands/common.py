@@ -142,12 +142,35 @@ def transfer_kwargs(args: argparse.Namespace) -> dict:
         start, goal = parse_xy(start, "--start"), parse_xy(goal, "--goal")
     if args.mapping is not None and "mapping" not in args.method:
         raise InvalidParameterError("--mapping goes with --method mapping")
+    refuse_unused_method_options(args)
     return dict(
         task=args.task, start=start, goal=goal, methods=args.method, trials=args.trials, seed=args.seed,
         wind=args.wind, K=args.K, beta=args.beta, trajectory=args.trajectory, controls=not args.no_controls,
         mapping=args.mapping, save_mapping=args.mapping is not None, max_span=args.max_span,
         **config_options(args),
     )
+
+
+def refuse_unused_method_options(args: argparse.Namespace, flag: str = "--method") -> None:
+    """A method's option given (different from its default) while no method of ``flag``
+    uses it is an error naming the methods that do, instead of being silently ignored."""
+    from armtransfer.learning import methods
+
+    names = getattr(args, flag.lstrip("-"))
+    chosen = [methods.get(m) for m in names]
+    users = {
+        "--beta": ("beta", [m for m in methods.METHODS.values() if m.name == "dense"]),
+        "--max-span": ("max_span", [m for m in methods.METHODS.values() if m.macros]),
+        "--K": ("K", [m for m in methods.METHODS.values() if m.shaped]),
+        "--trajectory": ("trajectory", [m for m in methods.METHODS.values() if m.shaped and m.uses_trajectory]),
+    }
+    parser_defaults = {a.dest: a.default for a in options_of(args)}
+    for option, (dest, using) in users.items():
+        if dest in parser_defaults and getattr(args, dest) != parser_defaults[dest] \
+                and not any(m in using for m in chosen):
+            raise InvalidParameterError(
+                f"{option} does not apply to {flag} {' '.join(names)}; it goes with the methods "
+                f"{', '.join(m.name for m in using)}")
 
 
 def _flag(action: argparse.Action) -> str:

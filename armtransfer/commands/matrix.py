@@ -11,7 +11,7 @@ import argparse
 from pathlib import Path
 
 from armtransfer.commands import common
-from armtransfer.commands.sweep import add_executor_arguments, run_sweep
+from armtransfer.commands.sweep import add_executor_arguments, check_executor_options, run_sweep
 from armtransfer.errors import InvalidParameterError
 from armtransfer.io import write_bytes_atomic, write_json_atomic, write_text_atomic
 from armtransfer.experiments import matrix
@@ -69,8 +69,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from armtransfer.learning import methods
 
+    check_executor_options(args)
     for m in args.methods:
         methods.get(m)
+    common.refuse_unused_method_options(args, "--methods")
     robots, arms = arm_file_robots(args)
     sweep = matrix.matrix_sweep(robots, args.tasks, args.methods, args.trials, args.seeds, args.trajectory,
                                 arms=arms)

@@ -27,6 +27,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_executor_options(args)
     return run_sweep(sweeps.load(args.sweep_file, args.max_runs), args)
 
 
@@ -40,13 +41,21 @@ def add_executor_arguments(p: argparse.ArgumentParser) -> None:
                    help="retries of a run whose worker died (default 2)")
 
 
+def check_executor_options(args: argparse.Namespace) -> None:
+    """The executor options that do not apply to the chosen executor are an error."""
+    if args.address is not None and args.executor != "ray":
+        raise ExecutorError("--address goes with --executor ray (the local executor has no address)")
+    if args.address and args.workers is not None:
+        raise ExecutorError("--workers does not apply to a Ray cluster (--address): its CPUs are the cluster's; "
+                            "--workers sizes the local pool or a local Ray instance")
+
+
 def run_sweep(sweep: sweeps.Sweep, args: argparse.Namespace) -> int:
     """Run every unfinished run of ``sweep`` into the store at ``args.out`` with the executor
     the arguments name; returns the exit code (1 when a run failed). The whole sweep is
     checked (every robot built, every task's cells checked for both robots) before anything
     is written."""
-    if args.address is not None and args.executor != "ray":
-        raise ExecutorError("--address goes with --executor ray (the local executor has no address)")
+    check_executor_options(args)
     if args.executor == "ray":
         _import_ray()  # say how to install Ray before anything is written
         if args.address:

@@ -7,7 +7,6 @@ a run is recorded exactly once. A run whose worker crashes (or is killed) is ret
 
 from __future__ import annotations
 
-import multiprocessing
 import os
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -17,6 +16,7 @@ from concurrent.futures.process import BrokenProcessPool
 from armtransfer.experiments.execute import execute
 from armtransfer.errors import ArmTransferError
 from armtransfer.cpus import ENV as CPUS_ENV
+from armtransfer.experiments.reaper import guarded_spawn_context
 from armtransfer.tasks.robot import DiscreteRobot
 
 Done = Callable[[dict, dict, float], None]  # (run, result, seconds)
@@ -28,8 +28,9 @@ class ExecutorError(ArmTransferError):
 
 
 def _worker_init(driver: int | None = None) -> None:
-    """A pool worker's first code: it ends when the driver ``driver`` (its parent's pid,
-    given by the driver itself) is gone, and runs its trials on one thread."""
+    """A pool worker's first code after its imports (its command line's guard ran before
+    them, see ``reaper.guarded_spawn_context``): it ends when the driver ``driver`` (its
+    parent's pid, given by the driver itself) is gone, and runs its trials on one thread."""
     _die_with_parent(driver)
     # one thread per worker process: the workers are the parallelism
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS", CPUS_ENV):
@@ -88,7 +89,7 @@ def run_local(
     where a crash is its own, and counted against it (up to ``retries`` retries).
     ``fn(run, robots) -> (result, seconds)`` is what a worker runs (tests inject faults here).
     """
-    ctx = multiprocessing.get_context("spawn")
+    ctx = guarded_spawn_context()
     queue = list(runs)
     suspects: list[dict] = []
     attempts = {r["key"]: 0 for r in runs}

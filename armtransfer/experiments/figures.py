@@ -3,13 +3,11 @@
 from __future__ import annotations
 
 import os
-import matplotlib
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import numpy as np
 
-from armtransfer.io import write_bytes_atomic  # noqa: E402
+from armtransfer.experiments.lazy import pyplot
+from armtransfer.io import write_bytes_atomic
 
 
 def _save(fig, path: str | os.PathLike) -> None:
@@ -17,7 +15,7 @@ def _save(fig, path: str | os.PathLike) -> None:
 
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
-    plt.close(fig)
+    pyplot().close(fig)
     write_bytes_atomic(path, buf.getvalue())
 
 
@@ -33,7 +31,7 @@ def bar_chart(
     """Grouped bars: ``series`` maps a label to (means per group, 95% CIs per group).
     ``lower_bound[label][g]``: that mean counts unreached trials at the step cap and is a
     lower bound; its bar is hatched and the title says so."""
-    fig, ax = plt.subplots(figsize=(7 if len(series) < 4 else 9, 4))
+    fig, ax = pyplot().subplots(figsize=(7 if len(series) < 4 else 9, 4))
     n = len(series)
     width = 0.8 / max(n, 1)
     x = np.arange(len(groups))
@@ -71,7 +69,7 @@ def learning_curves(
     counts its greedy path length (``greedy[label][i]``), an unconverged one its last
     episode. Without ``greedy`` a converged trial also counts its last episode. So late
     episodes are not an average of the slow trials only (no survivorship bias)."""
-    fig, ax = plt.subplots(figsize=(7, 4))
+    fig, ax = pyplot().subplots(figsize=(7, 4))
     for label, trials in curves.items():
         mean, low, high = curve_band(trials, (greedy or {}).get(label), max_episodes)
         eps = np.arange(1, len(mean) + 1)
@@ -124,7 +122,7 @@ def mapping_paths(
     """Fig. 7 analog: the rooms map, the source robot's trajectory (dashed), the target's
     greedy path (solid) and the target's mapped fragments (thick). ``segments`` are
     [j0, j1) step ranges of the target path."""
-    fig, ax = plt.subplots(figsize=(6.5, 6.5))
+    fig, ax = pyplot().subplots(figsize=(6.5, 6.5))
     hi = lo + wall_mask.shape[0] - 1
     ax.imshow(wall_mask, origin="lower", cmap="Greys", extent=(lo - 0.5, hi + 0.5, lo - 0.5, hi + 0.5),
               vmin=0, vmax=1.4)
@@ -138,11 +136,16 @@ def mapping_paths(
                 label="mapped fragment" if k == 0 else None)
     ax.plot(*src[0], "s", color="green", ms=8, label="start")
     ax.plot(*src[-1], "*", color="black", ms=12, label="goal")
+    _finish_map(fig, ax, lo, hi, title, 8, path)
+
+
+def _finish_map(fig, ax, lo: int, hi: int, title: str, legend_size: int, path: str | os.PathLike) -> None:
+    """Square axes on the cells lo..hi, the title and the legend, then save."""
     ax.set_xlim(lo - 0.5, hi + 0.5)
     ax.set_ylim(lo - 0.5, hi + 0.5)
     ax.set_aspect("equal")
     ax.set_title(title)
-    ax.legend(loc="lower right", fontsize=8)
+    ax.legend(loc="lower right", fontsize=legend_size)
     _save(fig, path)
 
 
@@ -154,23 +157,18 @@ def task_layout(
     path: str | os.PathLike,
 ) -> None:
     """Fig. 3 analog: the rooms map with each task's start (square) and goal (star)."""
-    fig, ax = plt.subplots(figsize=(6.5, 6.5))
+    fig, ax = pyplot().subplots(figsize=(6.5, 6.5))
     hi = lo + wall_mask.shape[0] - 1
     ax.imshow(wall_mask, origin="lower", cmap="Greys", extent=(lo - 0.5, hi + 0.5, lo - 0.5, hi + 0.5),
               vmin=0, vmax=1.4)
-    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    colors = pyplot().rcParams["axes.prop_cycle"].by_key()["color"]
     for k, (name, start, goal) in enumerate(tasks):
         c = colors[k % len(colors)]
         ax.plot(*start, "s", color=c, ms=9, label=f"{name}: start {start}")
         ax.plot(*goal, "*", color=c, ms=14, label=f"{name}: goal {goal}")
         ax.annotate(name.split()[-1], start, textcoords="offset points", xytext=(5, 5), color=c)
         ax.annotate(name.split()[-1], goal, textcoords="offset points", xytext=(5, 5), color=c)
-    ax.set_xlim(lo - 0.5, hi + 0.5)
-    ax.set_ylim(lo - 0.5, hi + 0.5)
-    ax.set_aspect("equal")
-    ax.set_title(title)
-    ax.legend(loc="lower right", fontsize=7)
-    _save(fig, path)
+    _finish_map(fig, ax, lo, hi, title, 7, path)
 
 
 def _panel_grid(panels: list, title: str, path: str | os.PathLike, xlabel: str, ylabel: str, draw) -> None:
@@ -179,7 +177,7 @@ def _panel_grid(panels: list, title: str, path: str | os.PathLike, xlabel: str, 
     n = len(panels)
     cols = min(n, 4)
     rows = (n + cols - 1) // cols
-    fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 3.2 * rows), squeeze=False)
+    fig, axes = pyplot().subplots(rows, cols, figsize=(4 * cols, 3.2 * rows), squeeze=False)
     for ax in axes.flat[n:]:
         ax.set_visible(False)
     for ax, (label, curves) in zip(axes.flat, panels):

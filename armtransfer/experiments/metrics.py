@@ -14,7 +14,8 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
-from scipy import stats
+
+from armtransfer.experiments.lazy import scipy_stats
 
 PAIRED_DESIGN = "paired: methods share random streams trial by trial (common random numbers)"
 INDEPENDENT_DESIGN = "independent samples"
@@ -24,7 +25,7 @@ def t95(df: int) -> float:
     """The two-sided 95% Student t quantile for ``df`` degrees of freedom (nan for df < 1)."""
     if df < 1:
         return math.nan
-    return float(stats.t.ppf(0.975, df))
+    return float(scipy_stats().t.ppf(0.975, df))
 
 
 def mean_ci(values: Sequence[float | None]) -> tuple[float | None, list[float] | None]:
@@ -60,11 +61,11 @@ def median_ci(xs: np.ndarray, level: float = 0.95) -> tuple[list[float] | None, 
     x = np.sort(xs)
     best = 1
     for l in range(1, n // 2 + 1):
-        if 1.0 - 2.0 * stats.binom.cdf(l - 1, n, 0.5) >= level:
+        if 1.0 - 2.0 * scipy_stats().binom.cdf(l - 1, n, 0.5) >= level:
             best = l
         else:
             break
-    coverage = float(1.0 - 2.0 * stats.binom.cdf(best - 1, n, 0.5))
+    coverage = float(1.0 - 2.0 * scipy_stats().binom.cdf(best - 1, n, 0.5))
     return [float(x[best - 1]), float(x[n - best])], coverage
 
 

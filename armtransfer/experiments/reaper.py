@@ -1,19 +1,28 @@
 """Processes that end with the sweep that started them, however it ends.
 
+A pool worker started from :func:`guarded_spawn_context` runs :data:`GUARD` first: before
+Python imports anything for it, it checks that its parent is still the driver that started
+it and asks Linux to send it SIGTERM when that parent dies (``PR_SET_PDEATHSIG``). A driver killed while its workers are still importing (a few
+seconds, a few hundred MB each) takes them with it at once.
+
 A local Ray instance's processes (its GCS server, raylet, agents and workers) are the
 sweep's children, but a sweep killed with SIGKILL cannot stop them, and they lived on for
-minutes. :class:`Reaper` starts a small watcher process before anything else is started and
-tells it the pids to stop; the watcher waits on a pipe from the sweep. When the sweep says
-``done`` (it stopped them itself) the watcher just exits; when the pipe closes without it
-(the sweep died), the watcher kills those processes and every process they started.
+minutes. :class:`Reaper` starts a small watcher process before anything else is started; it
+lists every process the sweep starts from then on (and the pids it is told), and waits on a
+pipe from the sweep. When the sweep says ``done`` (it stopped them itself) the watcher just
+exits; when the pipe closes without it (the sweep died), the watcher kills those processes
+and every process they started.
 """
 
 from __future__ import annotations
 
+import functools
+import multiprocessing.context
 import os
 import signal
 import subprocess
 import sys
+import threading
 from typing import IO
 from pathlib import Path
 
@@ -83,17 +92,40 @@ def children_of(pid: int) -> set[int]:
     return descendants({pid}) - {pid}
 
 
+POLL = 1.0
+"""Seconds between two looks of the watcher at the sweep's processes."""
+
+
 def main() -> None:
-    """The watcher: read "PID START" lines until the pipe closes; then, unless the last line
-    was ``done``, kill each listed process that still is the one listed, with everything below."""
+    """The watcher: while the sweep lives, list every process below it (each look, every
+    :data:`POLL` s, adds those started since: Ray starts its agents after ``init`` returns,
+    and a raylet that dies first would leave them to PID 1) and the "PID START" lines it is
+    sent; when the pipe closes, unless the last line was ``done``, kill each listed process
+    that still is the one listed, with everything below it."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # a Ctrl-C to the sweep's group is the sweep's
+    import selectors
+
+    sweep, me = os.getppid(), os.getpid()
+    earlier = descendants({sweep})  # what the sweep ran before the watcher is not its to stop
     listed: dict[int, str] = {}
-    last = ""
-    for line in sys.stdin:
-        last = line.strip()
-        parts = last.split()
-        if len(parts) == 2 and parts[0].isdigit():
-            listed[int(parts[0])] = parts[1]
+    last, pending = "", b""
+    watch = selectors.DefaultSelector()
+    watch.register(sys.stdin.fileno(), selectors.EVENT_READ)
+    while True:
+        if watch.select(timeout=POLL):
+            chunk = os.read(sys.stdin.fileno(), 65536)
+            if not chunk:
+                break
+            *lines, pending = (pending + chunk).split(b"\n")
+            for line in lines:
+                last = line.decode(errors="replace").strip()
+                parts = last.split()
+                if len(parts) == 2 and parts[0].isdigit():
+                    listed[int(parts[0])] = parts[1]
+        for pid in descendants({sweep}) - earlier - {me}:
+            start = start_time(pid)
+            if start is not None:
+                listed.setdefault(pid, start)
     if last == DONE:
         return
     alive = {pid for pid, start in listed.items() if start_time(pid) == start}
@@ -102,3 +134,64 @@ def main() -> None:
             os.kill(pid, signal.SIGKILL)
         except (ProcessLookupError, PermissionError):
             pass
+
+
+GUARD = """import os
+if os.getppid() != {driver}: os._exit(1)
+try:
+    import ctypes
+    ctypes.CDLL(None).prctl(1, {signal}, 0, 0, 0)
+except Exception:
+    pass
+if os.getppid() != {driver}: os._exit(1)
+"""
+"""The first lines a guarded worker runs (``prctl(1, ...)`` is PR_SET_PDEATHSIG; where it does
+not exist, the worker's own initializer watches its parent instead): the standard library's
+``os`` and ``ctypes`` only, so that nothing is imported before the driver is known alive."""
+
+_LAUNCH = threading.Lock()
+
+
+@functools.cache
+def _guarded_popen():
+    """The POSIX spawn launcher with :data:`GUARD` before its command (made on first use: the
+    module it extends exists on POSIX only)."""
+    from multiprocessing import popen_spawn_posix, spawn
+
+    class GuardedPopen(popen_spawn_posix.Popen):
+        def _launch(self, process_obj) -> None:
+            guard = GUARD.format(driver=os.getpid(), signal=int(signal.SIGTERM))
+            with _LAUNCH:
+                plain = spawn.get_command_line
+
+                def guarded(**kwds) -> list[str]:
+                    cmd = plain(**kwds)
+                    at = cmd.index("-c") + 1
+                    cmd[at] = guard + cmd[at]
+                    return cmd
+
+                spawn.get_command_line = guarded  # read by the launch below, put back after it
+                try:
+                    super()._launch(process_obj)  # type: ignore[misc]  # typeshed leaves this private method out
+                finally:
+                    spawn.get_command_line = plain
+
+    return GuardedPopen
+
+
+class GuardedSpawnProcess(multiprocessing.context.SpawnProcess):
+    """A spawned process whose command line starts with :data:`GUARD`."""
+
+    @staticmethod
+    def _Popen(process_obj):
+        return _guarded_popen()(process_obj)
+
+
+class GuardedSpawnContext(multiprocessing.context.SpawnContext):
+    Process = GuardedSpawnProcess
+
+
+def guarded_spawn_context() -> multiprocessing.context.SpawnContext:
+    """The "spawn" start method with processes that end with their parent from their first
+    instruction (a pool's ``mp_context``)."""
+    return GuardedSpawnContext()

@@ -16,19 +16,24 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy import stats
+
+from armtransfer.experiments.lazy import scipy_stats
+
+if TYPE_CHECKING:
+    from scipy.stats import CensoredData
 
 LEVEL = 0.95
 BOOTSTRAP_RESAMPLES = 2000
 BOOTSTRAP_SEED = 0
 
 
-def censored_data(values: Sequence[float | None], cap: float) -> stats.CensoredData:
+def censored_data(values: Sequence[float | None], cap: float) -> "CensoredData":
     """``values`` as right-censored data: None (never reached) is censored at ``cap``."""
     seen = [float(v) for v in values if v is not None]
-    return stats.CensoredData(uncensored=seen, right=[float(cap)] * sum(v is None for v in values))
+    return scipy_stats().CensoredData(uncensored=seen, right=[float(cap)] * sum(v is None for v in values))
 
 
 def kaplan_meier(values: Sequence[float | None], cap: float) -> dict:
@@ -44,7 +49,7 @@ def kaplan_meier(values: Sequence[float | None], cap: float) -> dict:
            "median": None, "median_beyond_cap": True, "median_ci95": [None, None]}
     if events == 0:
         return out
-    sf = stats.ecdf(censored_data(values, cap)).sf
+    sf = scipy_stats().ecdf(censored_data(values, cap)).sf
     with warnings.catch_warnings():  # undefined where the curve is 0: nan, set below
         warnings.simplefilter("ignore", RuntimeWarning)
         band = sf.confidence_interval(LEVEL, method="log-log")
@@ -82,7 +87,7 @@ def bootstrap_ci(values: Sequence[float] | np.ndarray, statistic: Callable = np.
         return None
     if np.ptp(x) == 0:
         return [float(x[0]), float(x[0])]
-    res = stats.bootstrap((x,), lambda a, axis: statistic(a, axis=axis), n_resamples=resamples,
+    res = scipy_stats().bootstrap((x,), lambda a, axis: statistic(a, axis=axis), n_resamples=resamples,
                           confidence_level=LEVEL, method="percentile", vectorized=True,
                           random_state=np.random.default_rng(seed))
     lo, hi = float(res.confidence_interval.low), float(res.confidence_interval.high)

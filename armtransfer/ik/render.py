@@ -39,7 +39,7 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Sequence
+from typing import TYPE_CHECKING, Self, Sequence
 
 import mujoco  # after armtransfer.ik named the backend
 import numpy as np
@@ -261,7 +261,23 @@ def render_with_markers(renderer: mujoco.Renderer, model: mujoco.MjModel, data: 
     return renderer.render()
 
 
-class PanelRenderer:
+class OwnsRenderer:
+    """An object holding one ``mujoco.Renderer`` as ``self.renderer``: ``close()`` frees it, and
+    ``with`` closes it on the way out."""
+
+    renderer: mujoco.Renderer
+
+    def close(self) -> None:
+        self.renderer.close()
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+class PanelRenderer(OwnsRenderer):
     """Renders one replay's configurations with its markers (close it, or use ``with``)."""
 
     def __init__(self, panel: RolloutPanel, width: int = 320, height: int = 240, *,
@@ -281,15 +297,6 @@ class PanelRenderer:
         """[height, width, 3] uint8 image of the arm at ``qpos``."""
         return render_with_markers(self.renderer, self.model, self.data, self.camera, qpos, self._markers,
                                    self.shadows)
-
-    def close(self) -> None:
-        self.renderer.close()
-
-    def __enter__(self) -> "PanelRenderer":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
 
 
 def _markers(panel: RolloutPanel) -> list[Marker]:

@@ -14,6 +14,7 @@ import numpy as np
 from armtransfer.ik.render import (
     GOAL_RGBA,
     START_RGBA,
+    OwnsRenderer,
     offscreen_model,
     offscreen_renderer,
     render_with_markers,
@@ -24,7 +25,7 @@ from armtransfer.ik.scene import ArmScene
 GRID_RGBA = (0.3, 0.25, 0.2, 0.5)
 
 
-class ArmSnapshot:
+class ArmSnapshot(OwnsRenderer):
     """Renders ``scene``'s arm at any configuration, marking the goal and the tip's cell."""
 
     def __init__(self, scene: ArmScene, width: int = 320, height: int = 240, samples: int = 4,
@@ -50,15 +51,6 @@ class ArmSnapshot:
         markers.append((int(mujoco.mjtGeom.mjGEOM_CYLINDER), np.array([1.2 * cell, thin, 0.0]),
                         np.array([gx * cell, gy * cell, 2 * thin]), np.array(GOAL_RGBA)))
         return render_with_markers(self.renderer, self.model, self.data, self.camera, qpos, markers)
-
-    def close(self) -> None:
-        self.renderer.close()
-
-    def __enter__(self) -> "ArmSnapshot":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
 
 
 def _grid_lines(scene: ArmScene) -> list[tuple]:

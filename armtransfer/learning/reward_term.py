@@ -23,6 +23,7 @@ from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.sarsa import _shaping
 from armtransfer.learning.shaping import MODE_NONE
 from armtransfer.learning.trajectory import Trajectory
+from armtransfer.tasks.grid_robots import GRID_ROBOTS
 from armtransfer.tasks.robot import DiscreteRobot
 
 TrajectoryLike = Trajectory | str | os.PathLike
@@ -69,6 +70,10 @@ class TransferTerm:
         n_cells = layout.n_cells
         if any(not 0 <= c < n_cells for c in (*traj.cells, traj.goal)):
             raise InvalidTrajectoryError(f"the trajectory names cells outside this robot's layout (0..{n_cells - 1})")
+        if self.robot.arm is not None and traj.source in GRID_ROBOTS:
+            raise InvalidTrajectoryError(
+                f"the trajectory is of the grid robot {traj.source!r} but this environment's robot "
+                f"{self.robot.name} is an arm; give a trajectory of an arm (robot 1 of an arm-to-arm transfer)")
         if task is not None:
             trajectories.check_task(traj, task[0], task[1], layout)
         return traj

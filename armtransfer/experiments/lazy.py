@@ -1,0 +1,23 @@
+"""Heavy third-party modules, imported on first use.
+
+A command that stops on bad input, or only prints its help, should not pay for what it never
+runs: scipy.stats takes most of a second to import, matplotlib a third of one."""
+
+from __future__ import annotations
+
+
+def scipy_stats():
+    """``scipy.stats``."""
+    from scipy import stats
+
+    return stats
+
+
+def pyplot():
+    """``matplotlib.pyplot`` on the Agg backend (files only, no window)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
