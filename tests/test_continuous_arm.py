@@ -45,16 +45,26 @@ def _expected_end(arm, q, a):
     return True, touches, cell
 
 
-def test_every_move_is_checked_by_mujoco_at_its_end(arm):
+def _random_moves(arm, n, seed):
+    """``n`` random moves from the arm's start: (q before, the action, ``_expected_end``'s
+    answer, what ``move`` returned). The caller may ask MuJoCo about other configurations in
+    between: the arm's configuration is put back before the next move."""
     arm.reset()
-    rng = np.random.default_rng(0)
-    seen = {"moved": 0, "limit": 0, "wall or edge": 0, "contact": 0}
-    for _ in range(3000):
+    rng = np.random.default_rng(seed)
+    for _ in range(n):
         q = arm.q.copy()
         a = int(rng.integers(arm.n_actions))
-        inside, touches, cell = _expected_end(arm, q, a)
+        expected = _expected_end(arm, q, a)
         arm.q[:] = q  # the check above moved MuJoCo's data
         label = arm.move(a)
+        after = arm.q.copy()
+        yield q, a, expected, label
+        arm.q[:] = after
+
+
+def test_every_move_is_checked_by_mujoco_at_its_end(arm):
+    seen = {"moved": 0, "limit": 0, "wall or edge": 0, "contact": 0}
+    for q, a, (inside, touches, cell), label in _random_moves(arm, 3000, 0):
         if not inside:
             assert label == BLOCKED and np.array_equal(arm.q, q)
             seen["limit"] += 1
@@ -77,29 +87,27 @@ def test_a_bring_your_own_arm_file_is_blocked_by_its_own_links(tmp_path):
     a = continuous_arm(None, xml_path=ml.planar5_straight(tmp_path), joint_step=0.35, **ml.SUGGESTED["planar5"])
     assert a.checker.can_self_collide
     a.place(TABLE_I[1].cells(a.layout)[0])
-    rng = np.random.default_rng(0)
     touched = 0
-    for _ in range(2500):
-        q = a.q.copy()
-        act = int(rng.integers(a.n_actions))
-        inside, touches, _ = _expected_end(a, q, act)
-        a.q[:] = q
-        label = a.move(act)
+    for q, _, (inside, touches, _), label in _random_moves(a, 2500, 0):
         if inside and touches:
             touched += 1
             assert label == BLOCKED and np.array_equal(a.q, q)
     assert touched > 0
 
 
-def test_limits_block_a_move():
+def test_limits_block_a_move_before_mujoco_is_asked():
     a = continuous_arm("planar2")
     a.place(TABLE_I[1].cells(a.layout)[0])
     lo, hi = a.bounds
-    n = 0
-    while a.move(0) != BLOCKED and n < 200:
-        n += 1
-    assert a.q[0] <= hi[0] + 1e-9
-    assert a.q[0] + a.step > hi[0] or a.move(0) == BLOCKED
+    assert hi[0] <= a.scene.upper[0] + 1e-9 and hi[0] + a.step > a.scene.upper[0]
+    a._n[0] = a._nhi[0]  # joint 1 at its last lattice point below its upper limit
+    a.q[0] = hi[0]
+    q = a.q.copy()
+    assert a.move(0) == BLOCKED and np.array_equal(a.q, q)
+    a._n[0] = a._nlo[0]
+    a.q[0] = lo[0]
+    q = a.q.copy()
+    assert a.move(1) == BLOCKED and np.array_equal(a.q, q)
 
 
 def test_a_move_and_its_reverse_return_to_the_same_bits(arm):
@@ -114,21 +122,14 @@ def test_a_move_and_its_reverse_return_to_the_same_bits(arm):
 def test_a_move_is_blocked_exactly_when_a_point_of_its_arc_is_over_a_wall_or_off_the_table(arm):
     """The points between the ends count too (checked here with MuJoCo at each interpolated
     configuration): joint 1's move sweeps the tip about 5 cells."""
-    arm.reset()
-    rng = np.random.default_rng(5)
     crossed = 0
-    for _ in range(1500):
-        q = arm.q.copy()
-        a = int(rng.integers(arm.n_actions))
-        inside, touches, cell = _expected_end(arm, q, a)
+    for q, a, (inside, touches, cell), label in _random_moves(arm, 1500, 5):
         j, sign, m = a // 2, 1 - 2 * (a % 2), int(arm._m[a])
         points = []
         for k in range(1, m + 1):
             qt = q.copy()
             qt[j] += sign * arm.step * k / (m + 1)
             points.append(int(cells_of_xy(arm.checker.tip(qt), arm.scene.cell, arm.layout)))
-        arm.q[:] = q
-        label = arm.move(a)
         if not inside or touches:
             continue
         off = [c for c in [cell, *points] if c < 0 or not arm.layout.free[c]]
@@ -138,7 +139,6 @@ def test_a_move_is_blocked_exactly_when_a_point_of_its_arc_is_over_a_wall_or_off
         elif label == BLOCKED:  # then MuJoCo found a contact at a point along the arc
             probes = [q + np.eye(arm.dof)[j] * sign * arm.step * t for t in arm._probe[a]]
             assert any(arm.checker.touches(p) for p in probes)
-            arm.q[:] = q
     assert crossed > 0
 
 
