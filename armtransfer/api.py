@@ -26,6 +26,7 @@ from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import DEFAULT_MAX_SPAN, ActionMapping
 from armtransfer.learning.mapping import load_for as load_mapping
+from armtransfer.experiments.continuous import ContinuousResult
 from armtransfer.experiments.results import MappingInfo, TransferResult
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.catalog import Task, as_xy, custom_task, table_task
@@ -38,6 +39,12 @@ TRAJECTORY_KINDS = ("optimal", "learned", "shuffled", "random")
 (the default); ``optimal``: its shortest path; ``shuffled``/``random``: control trajectories."""
 
 TrajectorySpec = str | Trajectory
+
+STATES = ("discrete", "continuous")
+"""How the target robot's state is known: ``discrete``, its table of states (the tabular
+learner); ``continuous``, its joint configuration with MuJoCo at every move and the linear
+learner over tile coding (``ik.continuous``, ``learning.linear``; planar arms, the ``joint``
+action model)."""
 
 
 def transfer(
@@ -62,8 +69,9 @@ def transfer(
     arm_xml: str | Path | None = None,
     arm_options: dict | None = None,
     progress: Callable[[], None] | None = None,
+    state: str = "discrete",
     **learner_options,
-) -> TransferResult:
+) -> TransferResult | ContinuousResult:
     """Transfer a trajectory from ``source`` to ``target`` and learn with each method.
 
     ``task`` is a Table I task (1-4) or give ``start`` and ``goal`` cells; with neither, a
@@ -76,7 +84,15 @@ def transfer(
     with ``save_mapping`` the file is updated from this run's converged trials.
     ``learner_options`` are :class:`LearnerConfig` fields (``alpha``, ``epsilon``, ...).
     ``progress`` is called after every trial.
+
+    ``state="continuous"``: the target is a planar arm (``"planar3:joint"``, an arm file
+    ``"PATH.xml"``, or ``"custom"`` with ``arm_xml=``) whose state is its joint configuration,
+    learned by linear SARSA(lambda) over tile coding (:data:`STATES`); the methods are those
+    paid on labels alone (``learning.cells.CELL_METHODS``), no controls or mapping are run, and
+    the result is an ``experiments.continuous.ContinuousResult``.
     """
+    if not isinstance(state, str) or state not in STATES:
+        raise InvalidParameterError(f"unknown state {state!r}; valid states: {', '.join(STATES)}")
     config = LearnerConfig.from_options(learner_options)
     method_names = [registry.get(m).name for m in _as_sequence(methods, "methods")]
     if not method_names:
@@ -110,6 +126,14 @@ def transfer(
 
     the_task = _task(task, start, goal, specs)
     start_cell, goal_cell = the_task.cells()
+    if state == "continuous":
+        if wind:
+            raise InvalidParameterError("a continuous target has no wind; valid wind: 0")
+        if mapping is not None or uses_mapping:
+            raise InvalidParameterError("the action sequence mapping needs a discrete target; valid methods for a "
+                                        "continuous one: " + ", ".join(_cell_methods()))
+        return _transfer_continuous(source, target, the_task, method_names, specs, trials, seed, K, config,
+                                    arm_xml, options, progress)
     src = resolve(source, xml_path=arm_xml, **options)
     tgt = resolve(target, xml_path=arm_xml, **options)
     for robot in (src, tgt):
@@ -172,6 +196,48 @@ def transfer(
         trials=trials, wind=wind, config=config, methods=by_method, controls=by_control,
         mapping=info, learned_mapping=learned,
     )
+
+
+def _cell_methods() -> tuple[str, ...]:
+    from armtransfer.learning.cells import CELL_METHODS
+
+    return CELL_METHODS
+
+
+def _transfer_continuous(source, target, the_task: Task, method_names: list[str], specs, trials: int, seed: int,
+                         K, config: LearnerConfig, arm_xml, options: dict, progress) -> ContinuousResult:
+    """``transfer`` with a continuous-state target (see its docstring)."""
+    from armtransfer.experiments import continuous as runs
+    from armtransfer.learning.cells import check_method
+    from armtransfer.tasks.continuous import continuous_arm
+
+    for m in method_names:
+        check_method(m)
+    if isinstance(target, DiscreteRobot) or not isinstance(target, str):
+        raise InvalidParameterError("a continuous target is named by a string: a planar arm such as "
+                                    f"'planar3:joint', PATH.xml or 'custom' with arm_xml, got {target!r}")
+    arm_keys = ("tip_site", "tip_body", "tip_offset", "base_pos", "base_yaw", "joint_step", "cell_size")
+    unknown = sorted(k for k in options if k not in arm_keys)
+    if unknown:
+        raise InvalidParameterError(f"arm option {unknown[0]!r} does not apply to a continuous target; valid "
+                                    f"options: {', '.join(arm_keys)}")
+    if target.partition(":")[0] == "custom":
+        if arm_xml is None:
+            raise InvalidParameterError("target 'custom' needs arm_xml")
+        arm = continuous_arm(None, xml_path=arm_xml, **options)
+    else:
+        arm = continuous_arm(target, **{k: v for k, v in options.items() if k in ("joint_step", "cell_size")})
+    start_cell, goal_cell = the_task.cells(arm.layout)
+    arm.place(start_cell)  # the task's start must be reachable before the source learns anything
+    src = resolve(source, xml_path=arm_xml, **options)
+    for cell, what in ((start_cell, "start"), (goal_cell, "goal")):
+        src.start_state(cell, what=what)
+    shaped = any(registry.get(m).shaped for m in method_names)
+    trajs = resolve_trajectories(specs, src, the_task, config, seed) if shaped else []
+    results = runs.run_all(arm, start_cell, goal_cell, method_names, trajs, trials, seed, config, K, tick=progress)
+    return runs.ContinuousResult(task=the_task, source=src.name, target=f"{target} (continuous)", trajectories=trajs,
+                                 seed=seed, trials=trials, config=config, approximation=runs.Approximation(),
+                                 methods={r.method: r for r in results})
 
 
 def resolve_trajectories(specs: Sequence[TrajectorySpec], source: DiscreteRobot, task: Task,

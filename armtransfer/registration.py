@@ -17,6 +17,7 @@ from typing import Any
 ENVIRONMENTS = {
     "armtransfer/Rooms-v0": "armtransfer.tasks.envs:make_rooms_env",
     "armtransfer/ArmRooms-v0": "armtransfer.tasks.envs:make_arm_rooms_env",
+    "armtransfer/ContinuousArmRooms-v0": "armtransfer.tasks.continuous_env:make_continuous_arm_rooms_env",
 }
 MAX_EPISODE_STEPS = 100_000
 

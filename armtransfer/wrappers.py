@@ -56,6 +56,9 @@ class TransferReward(gym.Wrapper, gym.utils.RecordConstructorArgs):
         self.robot = base.robot
         self.goal_cell = int(base.goal_cell)
         self._state: int | None = None
+        # the robot's state as the shaping indexes it: the observation, or what the env says it is
+        # (the continuous arm's: the cell under its tool point, from info)
+        self._state_of = getattr(base, "state_of", lambda obs, info: int(obs))
 
     @property
     def method(self) -> str:
@@ -80,14 +83,15 @@ class TransferReward(gym.Wrapper, gym.utils.RecordConstructorArgs):
     def reset(self, **kwargs):
         obs, info = self.env.reset(**kwargs)
         self.transfer.reset()
-        self._state = int(obs)
+        self._state = self._state_of(obs, info)
         return obs, info
 
     def step(self, action):
         if self._state is None:
             raise InvalidParameterError("call reset() before step()")
         obs, reward, terminated, truncated, info = self.env.step(action)
-        term = self.transfer.term(self._state, int(obs), bool(terminated))
-        self._state = int(obs)
+        state = self._state_of(obs, info)
+        term = self.transfer.term(self._state, state, bool(terminated))
+        self._state = state
         info = dict(info, shaping=term)
         return obs, reward + term, terminated, truncated, info

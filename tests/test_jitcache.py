@@ -59,5 +59,6 @@ def test_an_edit_to_a_callee_in_another_file_reaches_the_cached_caller(tmp_path)
 def test_the_learner_kernel_guards_its_cache_against_guide_edits():
     stamp = os.path.join(sarsa._run_trial._cache.cache_path, jitcache.STAMP.format(module="sarsa"))
     with open(stamp) as f:  # written at import, for the guide files the kernels call into
-        assert f.read() == jitcache.digest(sarsa._guide.FILES)
-    assert not jitcache.invalidate_stale("sarsa", [sarsa._run_trial], sarsa._guide.FILES)  # unchanged
+        assert f.read() == jitcache.digest(sarsa.DEPENDENCIES)
+    assert set(sarsa._guide.FILES) < set(sarsa.DEPENDENCIES)
+    assert not jitcache.invalidate_stale("sarsa", [sarsa._run_trial], sarsa.DEPENDENCIES)  # unchanged

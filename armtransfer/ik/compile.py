@@ -289,6 +289,13 @@ def _lattice_dims(lo: np.ndarray, hi: np.ndarray, home: np.ndarray, step: float)
     return n_lo, tuple(int(v) for v in n_hi - n_lo + 1)
 
 
+def ladder_step(lo: np.ndarray, hi: np.ndarray, home: np.ndarray) -> float:
+    """The finest of ``STEP_LADDER`` whose lattice about ``home`` within [lo, hi] has at most
+    ``MAX_LATTICE`` points (the coarsest when none has)."""
+    sizes = {s: int(np.prod(_lattice_dims(lo, hi, home, s)[1], dtype=float)) for s in STEP_LADDER}
+    return next((s for s in STEP_LADDER if sizes[s] <= MAX_LATTICE), STEP_LADDER[-1])
+
+
 def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -> dict:
     """The ``joint`` model's arrays; ``step`` None: the finest of ``STEP_LADDER`` whose lattice
     has at most ``MAX_LATTICE`` points (the step used is returned as ``joint_step``)."""
@@ -303,8 +310,7 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
     lo = np.where(np.isfinite(scene.lower), scene.lower, home - np.pi)
     hi = np.where(np.isfinite(scene.upper), scene.upper, home + np.pi)
     if step is None:
-        sizes = {s: int(np.prod(_lattice_dims(lo, hi, home, s)[1], dtype=float)) for s in STEP_LADDER}
-        step = next((s for s in STEP_LADDER if sizes[s] <= MAX_LATTICE), STEP_LADDER[-1])
+        step = ladder_step(lo, hi, home)
     n_lo, dims = _lattice_dims(lo, hi, home, step)
     total = int(np.prod(dims, dtype=float))
     if total > MAX_LATTICE:

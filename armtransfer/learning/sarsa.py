@@ -46,6 +46,7 @@ The random stream, in the order it is drawn (the dense reference draws the same)
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import NamedTuple
 
 import numba
@@ -56,6 +57,7 @@ from armtransfer.learning.config import LearnerConfig
 
 from armtransfer.learning import guide as _guide
 from armtransfer.learning import jitcache as _jitcache
+from armtransfer.learning import traces as _traces
 from armtransfer.learning.guide import choice as _choice
 from armtransfer.learning.guide import model as _model
 from armtransfer.learning.guide import planner as _planner
@@ -150,9 +152,8 @@ class Outputs(NamedTuple):
 
 
 @numba.njit(cache=True, inline="always")
-def _egreedy(Q, s, n_actions, eps, rng):
-    if rng.random() < eps:
-        return int(rng.random() * n_actions)
+def _best_and_ties(Q, s, n_actions):
+    """(the largest Q[s, .], how many actions have it)."""
     best = Q[s, 0]
     ties = 1
     for a in range(1, n_actions):
@@ -162,17 +163,26 @@ def _egreedy(Q, s, n_actions, eps, rng):
             ties = 1
         elif q == best:
             ties += 1
-    if ties == 1:
-        for a in range(n_actions):
-            if Q[s, a] == best:
-                return a
-    k = int(rng.random() * ties)
+    return best, ties
+
+
+@numba.njit(cache=True, inline="always")
+def _nth_best(Q, s, n_actions, best, k):
+    """The k-th (from 0, in index order) action whose Q[s, .] is ``best``."""
     for a in range(n_actions):
         if Q[s, a] == best:
             if k == 0:
                 return a
             k -= 1
     return n_actions - 1  # unreachable
+
+
+@numba.njit(cache=True, inline="always")
+def _egreedy(Q, s, n_actions, eps, rng):
+    if rng.random() < eps:
+        return int(rng.random() * n_actions)
+    best, ties = _best_and_ties(Q, s, n_actions)
+    return _nth_best(Q, s, n_actions, best, 0 if ties == 1 else int(rng.random() * ties))
 
 
 @numba.njit(cache=True, inline="always")
@@ -389,33 +399,9 @@ def _make_run_trial(with_guide: bool):
                         )
                     macro_used += used
                     q_next = Q[s2, a2]
-                sa = s * n_actions + a
                 delta = r + gamma * q_next - Q[s, a]
-                p = pos[sa]
-                if p < 0:
-                    pos[sa] = n_tr
-                    tr_sa[n_tr] = sa
-                    tr_e[n_tr] = 1.0
-                    n_tr += 1
-                else:
-                    tr_e[p] += 1.0
-                k = 0
-                while k < n_tr:
-                    pair = tr_sa[k]
-                    e = tr_e[k]
-                    q_flat[pair] += alpha * delta * e
-                    e *= decay
-                    if e < cutoff or e == 0.0:
-                        # drop: move the last trace into this slot
-                        pos[pair] = -1
-                        n_tr -= 1
-                        if k < n_tr:
-                            tr_sa[k] = tr_sa[n_tr]
-                            tr_e[k] = tr_e[n_tr]
-                            pos[tr_sa[k]] = k
-                        continue
-                    tr_e[k] = e
-                    k += 1
+                n_tr = _traces.mark(tr_sa, tr_e, pos, n_tr, s * n_actions + a, False)
+                n_tr = _traces.apply(q_flat, tr_sa, tr_e, pos, n_tr, alpha * delta, decay, cutoff)
                 if terminal:
                     reached = True
                     break
@@ -572,6 +558,9 @@ def _greedy_action(Q: np.ndarray, s: int) -> int:
     return int(np.argmax(Q[s]))
 
 
-# The kernels above call the guide's jitted functions; numba's cache does not notice an edit to
-# the guide's files alone (``jitcache``), so their cache is emptied when that file changes.
-_jitcache.invalidate_stale(__name__, [_egreedy, _macro_step, _choose, _choose_guided, _greedy_path, _shaping, _run_trial, _run_trial_guided], _guide.FILES)
+DEPENDENCIES = [*_guide.FILES, Path(_traces.__file__)]
+"""The files whose jitted functions the kernels above call: the guide's and the traces'."""
+
+# numba's cache does not notice an edit to those files alone (``jitcache``), so the kernels'
+# cache is emptied when one of them changes.
+_jitcache.invalidate_stale(__name__, [_best_and_ties, _nth_best, _egreedy, _macro_step, _choose, _choose_guided, _greedy_path, _shaping, _run_trial, _run_trial_guided], DEPENDENCIES)

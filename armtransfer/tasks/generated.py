@@ -166,6 +166,13 @@ def readme(draw: ArmDraw, seed: int, index: int, rejected: list[str], reach: flo
 def resolve_generated(spec: str, progress: bool = False):
     """The robot of ``gen:FAMILY:DOF:SEED[:ACTIONS]``: the arm generated with those settings,
     kept in the cache directory (``$ARMTRANSFER_CACHE/generated``) after the first use."""
+    xml, generated, actions = generated_file(spec, progress)
+    return robot_of(xml, generated, actions, progress=progress)
+
+
+def generated_file(spec: str, progress: bool = False) -> tuple[Path, dict, str]:
+    """(the arm file, its sidecar, the action model named) of ``gen:FAMILY:DOF:SEED[:ACTIONS]``,
+    generated into the cache directory at its first use."""
     from armtransfer.ik.cache import cache_dir
 
     parts = spec.split(":")
@@ -190,4 +197,4 @@ def resolve_generated(spec: str, progress: bool = False):
         generate_arm(family, dof, seed, root, progress=progress)
         generated = read_sidecar(xml)
         assert generated is not None  # generate_arm has just written it
-    return robot_of(xml, generated, actions, progress=progress)
+    return xml, generated, actions

@@ -143,3 +143,12 @@ class DiscreteRobot:
             s = int(parent[s])
         path.reverse()
         return path
+
+
+def cell_robot(layout: Layout) -> DiscreteRobot:
+    """The layout's cells as a robot: each cell a state labelled with itself, one action that
+    stays. What a robot known only by its label is paid by (``learning.cells``)."""
+    n = layout.n_cells
+    return DiscreteRobot(name="cells", next_state=np.arange(n, dtype=np.int32)[:, None],
+                         wind_state=np.arange(n, dtype=np.int32), label=np.arange(n, dtype=np.int32),
+                         action_names=("stay",), layout=layout)

@@ -1,0 +1,116 @@
+"""Trials on a continuous-state arm: the linear learner (``learning.linear``) over tile coding.
+
+The arm is any ``Mover`` placed at the task's start (``ik.continuous.ContinuousArm.place``);
+the methods are those paid on labels alone (``learning.cells.CELL_METHODS``). Trial k of every
+method draws from ``experiment.trial_rng(seed, k)``, as the tabular trials do, so the methods
+meet the same random streams trial by trial and the results are the tabular ones' kind
+(``sarsa.TrialResult`` in a ``MethodResult``): ``experiment.summarize``, the metrics and the
+survival statistics apply unchanged. Trials run one after the other (one MuJoCo data per arm).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import armtransfer.checks as checks
+from armtransfer.errors import InvalidParameterError
+from armtransfer.experiments.experiment import MethodResult, trial_rng
+from armtransfer.learning import cells, linear
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.tiles import TileCoding
+from armtransfer.learning.trajectory import Trajectory
+from armtransfer.tasks.catalog import Task
+
+
+@dataclass(frozen=True)
+class Approximation:
+    """How the linear learner sees the arm's configuration: tile coding and traces."""
+
+    tilings: int = 8
+    width: float = 2.0
+    """A tile's width in joint steps (the arm's ``step``)."""
+    traces: str = "accumulating"
+    greedy_cap: int = linear.LinearConfig().greedy_cap
+
+    def __post_init__(self) -> None:
+        checks.whole(self.tilings, "tilings", 1, 64)
+        checks.real(self.width, "the tile width (joint steps)", 0.0, 1000.0, lo_open=True)
+        linear.LinearConfig(self.traces, self.greedy_cap)  # its checks
+
+    def coding(self, arm) -> TileCoding:
+        """Tiles over the configurations the arm can reach from its start (``arm.bounds``)."""
+        lo, hi = arm.bounds
+        return TileCoding.over(lo, hi, self.width * arm.step, self.tilings)
+
+    def linear(self) -> linear.LinearConfig:
+        return linear.LinearConfig(self.traces, self.greedy_cap)
+
+
+def run_method(method: str, arm, goal_cell: int, trajs: Sequence[Trajectory] | None, trials: int, seed: int,
+               config: LearnerConfig, K: float | str = "auto", approx: Approximation = Approximation(),
+               on_trial: Callable[[], None] | None = None) -> MethodResult:
+    """``trials`` trials of ``method`` on ``arm`` (placed at the start) towards ``goal_cell``."""
+    cells.check_method(method)
+    if trials < 1:
+        raise InvalidParameterError(f"trials must be a positive integer, got {trials}")
+    shaping = cells.cell_shaping(method, arm.layout, trajs, K, config)
+    coding, lin = approx.coding(arm), approx.linear()
+    out = MethodResult(method)
+    for trial in range(trials):
+        out.trials.append(linear.learn(arm, goal_cell, coding, config, trial_rng(seed, trial), shaping, lin))
+        if on_trial is not None:
+            on_trial()
+    out.extra["state"] = "continuous"
+    out.extra["approximation"] = {"tilings": approx.tilings, "tile_width_steps": approx.width,
+                                  "traces": approx.traces, "features": coding.size}
+    if shaping is not None:
+        out.extra["K"] = shaping.K
+    return out
+
+
+def run_all(arm, start_cell: int, goal_cell: int, method_names: Sequence[str], trajs: Sequence[Trajectory],
+            trials: int, seed: int, config: LearnerConfig, K: float | str | dict = "auto",
+            approx: Approximation = Approximation(), tick: Callable[[], None] | None = None) -> list[MethodResult]:
+    """Every method on one task, the arm placed over ``start_cell`` first (IK)."""
+    for m in method_names:
+        cells.check_method(m)
+    arm.place(start_cell)
+    return [run_method(m, arm, goal_cell, trajs, trials, seed, config,
+                       K.get(m, "auto") if isinstance(K, dict) else K, approx, tick) for m in method_names]
+
+
+@dataclass
+class ContinuousResult:
+    """What ``armtransfer.transfer(..., state="continuous")`` returns: the methods' trials on a
+    continuous-state target, summarised as the tabular runs are (``experiment.summarize``)."""
+
+    task: Task
+    source: str
+    target: str
+    trajectories: list[Trajectory]
+    seed: int
+    trials: int
+    config: LearnerConfig
+    approximation: Approximation
+    methods: dict[str, MethodResult]
+
+    def to_json(self) -> dict:
+        from armtransfer.experiments.experiment import summarize
+
+        summary = summarize(list(self.methods.values()), baseline="none" if "none" in self.methods else "")
+        t = self.task
+        return {"state": "continuous", "task": {"name": t.name, "start": list(t.start), "goal": list(t.goal)},
+                "source": self.source, "target": self.target,
+                "trajectories": [tr.to_json() for tr in self.trajectories], "seed": self.seed, "trials": self.trials,
+                "config": self.config.to_dict(),
+                "approximation": {"tilings": self.approximation.tilings, "tile_width_steps": self.approximation.width,
+                                  "traces": self.approximation.traces},
+                "results": {m: summary[r.label] for m, r in self.methods.items()}}
+
+    def __repr__(self) -> str:
+        lines = [f"<ContinuousResult {self.task.name}: {self.source} -> {self.target} (continuous state), "
+                 f"{self.trials} trials"]
+        for r in self.methods.values():
+            lines.append(f"  {r!r}")
+        return "\n".join(lines) + ">"

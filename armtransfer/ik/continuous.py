@@ -1,0 +1,311 @@
+"""A planar arm whose state is its joint configuration q: no table of states, MuJoCo at every move.
+
+The ``joint`` action model without its lattice: action ``2j`` turns joint j by +delta, ``2j+1``
+by -delta (``q1+``, ``q1-``, ...). Every move runs MuJoCo's kinematics and collision detection
+on the arm in its table scene (``ik.scene``) at the configuration reached; nothing is
+enumerated or stored. A move is blocked, and the arm stays where it was, when
+
+- it leaves the joint limits (an unlimited joint: pi either side of where the arm started);
+- MuJoCo reports a contact that ``ik.scene.ContactChecker`` counts (the table, a wall, the
+  arm itself) at the configuration reached;
+- the tool point, at the configuration reached or at any of the points the move's arc passes
+  (spaced at most half a cell apart, as ``ik.compile``'s joint model spaces them), is over a
+  wall cell or off the table; near a wall, MuJoCo is also asked at up to 3 of those points.
+
+The label is the cell under the tool point (``ik.labels.cells_of_xy``'s rule: the tip's
+(x, y) divided by the cell size and rounded half to even). The configuration is kept as
+q0 + n * delta with integer n, so a move and its reverse return to the same bits.
+
+A planar arm's joint axes are vertical, so the points along a move's arc are the tip rotated
+about the moved joint's anchor: they are computed from MuJoCo's tip and anchor at the end of
+the move (``_sweep``), without another MuJoCo call.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import mujoco
+import numba
+import numpy as np
+
+from armtransfer.errors import ArmModelError, InvalidCellError, UnreachableTableError
+from armtransfer.ik.compile import _near_wall_mask
+from armtransfer.ik.labels import OFF_TABLE, cells_of_xy
+from armtransfer.ik.scene import ArmScene, ContactChecker
+from armtransfer.ik.solve import TipIK
+
+BLOCKED = -2
+"""What :meth:`ContinuousArm.move` returns for a blocked move (``OFF_TABLE`` is -1)."""
+
+
+@numba.njit(cache=True)
+def _cell(x, y, cell_size, lo, width):
+    """The cell id under (x, y) (metres), -1 off the grid: ``ik.labels.cells_of_xy``'s rule."""
+    cx = int(np.rint(x / cell_size)) - lo
+    cy = int(np.rint(y / cell_size)) - lo
+    if cx < 0 or cy < 0 or cx >= width or cy >= width:
+        return -1
+    return cy * width + cx
+
+
+@numba.njit(cache=True)
+def _sweep(tx, ty, ax, ay, cos_back, sin_back, m, cell_size, lo, width, free, near):
+    """(the end's cell or -1 when the move is blocked by a wall or the table's edge, whether any
+    point of the move is near a wall). (tx, ty): the tip at the end of the move; (ax, ay): the
+    moved joint's anchor; the k-th point of the arc is the tip turned back about the anchor by
+    the angle whose cosine and sine are cos_back[k], sin_back[k]."""
+    end = _cell(tx, ty, cell_size, lo, width)
+    if end < 0 or not free[end]:
+        return -1, False
+    close = near[end]
+    dx = tx - ax
+    dy = ty - ay
+    for k in range(m):
+        c = cos_back[k]
+        s = sin_back[k]
+        cell = _cell(ax + c * dx - s * dy, ay + s * dx + c * dy, cell_size, lo, width)
+        if cell < 0 or not free[cell]:
+            return -1, False
+        if near[cell]:
+            close = True
+    return end, close
+
+
+def clearance_cells(layout) -> np.ndarray:
+    """int64 over cell ids: the Chebyshev distance, in cells, from each cell to the nearest wall
+    cell or cell off the table (a wall cell: 0). A point in a cell at distance k is at least
+    (k - 1) cells from any point of a wall cell or off the table."""
+    free = layout.wall_mask == False  # noqa: E712  (the layout's [y, x] mask)
+    w = layout.width
+    dist = np.where(free, w + 1, 0).astype(np.int64)
+    padded = np.zeros((w + 2, w + 2), np.int64)  # off the table: distance 0
+    for _ in range(w):  # relax until no distance shrinks (at most the grid's width passes)
+        padded[1:-1, 1:-1] = dist
+        nearest = dist.copy()
+        for dy in (-1, 0, 1):
+            for dx in (-1, 0, 1):
+                nearest = np.minimum(nearest, padded[1 + dy:1 + dy + w, 1 + dx:1 + dx + w] + 1)
+        if np.array_equal(nearest, dist):
+            break
+        dist = nearest
+    return dist.reshape(-1)
+
+
+class ContinuousArm:
+    """A planar arm in its table scene, moved by joint increments of ``step`` radians.
+
+    ``q`` is the configuration (a view of MuJoCo's ``qpos``: read it, never write it),
+    ``label`` the cell under the tool point, :meth:`tool_point` the point (x, y, z) in metres.
+    Place the arm with :meth:`place` (over a cell, by IK) or :meth:`set_configuration`."""
+
+    def __init__(self, scene: ArmScene, step: float) -> None:
+        if not scene.planar:
+            raise ArmModelError("the continuous arm moves its joints, which needs a planar arm (all joint axes "
+                                "vertical); this arm is spatial")
+        model = scene.model
+        if model.njnt != model.nq or np.any(model.jnt_type != mujoco.mjtJoint.mjJNT_HINGE):
+            raise ArmModelError("the continuous arm needs an arm with hinge joints only")
+        if not (math.isfinite(step) and 0.0 < step <= math.pi):
+            raise ArmModelError(f"the joint step must be in (0, pi] radians, got {step!r}")
+        self.scene = scene
+        self.step = float(step)
+        self.checker = ContactChecker(scene)
+        self.model, self.data = model, self.checker.data
+        self.dof = int(model.nq)
+        self.n_actions = 2 * self.dof
+        layout = scene.layout
+        self.layout = layout
+        self._free = np.ascontiguousarray(layout.free)
+        self._near = np.ascontiguousarray(_near_wall_mask(layout))
+        self._cell_size, self._lo, self._width = float(scene.cell), int(layout.lo), int(layout.width)
+        self._clear = clearance_cells(layout).tolist()
+        self._tip_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, scene.tip)
+        self._jnt = np.argsort(model.jnt_qposadr)  # joint ids in qpos order
+        self._qpos = self.data.qpos  # views into MuJoCo's buffers: no copy per move
+        self._site_xpos = self.data.site_xpos
+        self._xanchor = self.data.xanchor
+        self._always_probe = self.checker.can_self_collide
+        # the arc's points of each action, as rotations back from the end (``_sweep``)
+        data = mujoco.MjData(model)
+        mujoco.mj_kinematics(model, data)
+        axis_sign = np.sign(data.xaxis[self._jnt, 2])
+        points = np.vstack([data.xanchor[self._jnt, :2], data.site_xpos[self._tip_id, :2]])
+        links = np.linalg.norm(np.diff(points, axis=0), axis=1)
+        reach = [float(links[j:].sum()) for j in range(self.dof)]  # how far the tip can be from joint j
+        self._m = np.zeros(self.n_actions, np.int64)
+        # a move whose end is this many cells (Chebyshev) from every wall and the table's edge
+        # has all its arc's points over free cells that are not near a wall (see clearance_cells)
+        self._clear_needed = [int(math.ceil(self.step * reach[a // 2] / scene.cell)) + 3 for a in range(self.n_actions)]
+        width = max(1, max(int(math.ceil(2.0 * self.step * r / scene.cell)) for r in reach))
+        self._cos = np.zeros((self.n_actions, width))
+        self._sin = np.zeros((self.n_actions, width))
+        self._probe = []
+        for a in range(self.n_actions):
+            j, sign = a // 2, 1.0 - 2.0 * (a % 2)
+            m = max(1, int(math.ceil(2.0 * self.step * reach[j] / scene.cell)))
+            ts = np.arange(1, m + 1) / (m + 1)
+            back = -(1.0 - ts) * sign * self.step * axis_sign[j]  # from the end back to the point at t
+            self._m[a] = m
+            self._cos[a, :m], self._sin[a, :m] = np.cos(back), np.sin(back)
+            self._probe.append(tuple(float(t) for t in ts[np.unique(np.linspace(0, m - 1, min(m, 3)).round().astype(int))]))
+        lo = np.where(np.isfinite(scene.lower), scene.lower, -np.inf)
+        hi = np.where(np.isfinite(scene.upper), scene.upper, np.inf)
+        self._limits = (lo, hi)
+        self._q0: list[float] = [0.0] * self.dof  # lists: indexing them is cheaper than numpy's
+        self._n: list[int] = [0] * self.dof
+        self._nlo: list[int] = [0] * self.dof
+        self._nhi: list[int] = [0] * self.dof
+        self.label = OFF_TABLE
+        self._start: tuple[np.ndarray, int] | None = None
+        self.moves = 0
+        """MuJoCo kinematics + collision calls made by :meth:`move` (blocked ones too)."""
+
+    # ------------------------------------------------------------------ placing the arm
+
+    def set_configuration(self, q: np.ndarray) -> int:
+        """Put the arm at ``q`` (it becomes q0 of the moves that follow) and return its label.
+        A configuration that touches something, or whose tool point is not over a free cell,
+        is refused."""
+        q = np.array(q, dtype=np.float64).reshape(-1)
+        if q.shape != (self.dof,) or not np.all(np.isfinite(q)):
+            raise ArmModelError(f"a configuration of this arm is {self.dof} finite joint angles, got {q.tolist()}")
+        lo, hi = self._limits
+        if np.any(q < lo - 1e-9) or np.any(q > hi + 1e-9):
+            raise ArmModelError("the configuration is outside the joint limits")
+        if self.checker.touches(q):
+            raise ArmModelError("the arm touches the table, a wall or itself at this configuration")
+        tip = self.data.site_xpos[self._tip_id].copy()
+        cell = int(cells_of_xy(tip, self.scene.cell, self.layout))
+        if cell < 0 or not self.layout.free[cell]:
+            raise InvalidCellError("the arm's tool point is not over a free cell at this configuration")
+        lo = np.where(np.isfinite(lo), lo, q - np.pi)
+        hi = np.where(np.isfinite(hi), hi, q + np.pi)
+        self._q0 = q.tolist()
+        self._n = [0] * self.dof
+        self._nlo = np.ceil((lo - q) / self.step - 1e-9).astype(np.int64).tolist()
+        self._nhi = np.floor((hi - q) / self.step + 1e-9).astype(np.int64).tolist()
+        self._qpos[:] = q
+        self._start = (q.copy(), cell)
+        self.label = cell
+        return cell
+
+    def reset(self) -> int:
+        """Back to the configuration last set (:meth:`set_configuration`, :meth:`place`); its label."""
+        if self._start is None:
+            raise ArmModelError("place the arm (place or set_configuration) before resetting it")
+        q, cell = self._start
+        self._qpos[:] = q
+        self._n = [0] * self.dof
+        self.label = cell
+        return cell
+
+    @property
+    def q(self) -> np.ndarray:
+        return self._qpos
+
+    @property
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lowest, highest) configuration the moves from the current q0 can reach."""
+        q0 = np.array(self._q0)
+        return q0 + np.array(self._nlo) * self.step, q0 + np.array(self._nhi) * self.step
+
+    def place(self, cell: int) -> np.ndarray:
+        """A configuration with the tool point over ``cell``, set as the arm's configuration;
+        returns it. It lies on the arm's home lattice (home + n * step, the points the ``joint``
+        model's moves reach from home), so that the moves from it reach what the joint model's
+        moves reach: mink IK (from home, then from random starts of a fixed seed) gives a
+        configuration over the cell, and of the lattice points around it (each joint rounded
+        to the lattice, then one step either way) the one whose tool point is nearest the
+        cell's centre, over the cell and touching nothing, is taken; the IK configuration
+        itself when none is."""
+        ik = TipIK(self.scene, False)
+        x, y = self.layout.xy(int(cell))
+        target = np.array([x * self.scene.cell, y * self.scene.cell])
+        res = ik.solve(target, self.scene.home)
+        if not ik.ok(res):
+            res = ik.solve_any(target, self.scene.home, np.random.default_rng(0))
+        if ik.ok(res):
+            home = self.scene.home.astype(float)
+            base = np.rint((res.q - home) / self.step)
+            best, best_d = None, np.inf
+            for off in itertools.product((0, -1, 1), repeat=self.dof):
+                q = home + (base + np.array(off)) * self.step
+                try:
+                    if self.set_configuration(q) != cell:
+                        continue
+                except (ArmModelError, InvalidCellError):
+                    continue
+                d = float(np.linalg.norm(self.tool_point()[:2] - target))
+                if d < best_d:
+                    best, best_d = q, d
+            for q in ([best] if best is not None else []) + [res.q]:
+                try:
+                    if self.set_configuration(q) == cell:
+                        return self.q.copy()
+                except (ArmModelError, InvalidCellError):
+                    pass
+        raise UnreachableTableError(f"the arm cannot place its tool point over cell {(x, y)} without touching "
+                                    "anything")
+
+    def key(self) -> tuple[int, ...]:
+        """The configuration as integer steps from q0: equal keys are equal configurations."""
+        return tuple(self._n)
+
+    # ------------------------------------------------------------------ moving
+
+    def move(self, a: int) -> int:
+        """Take action ``a`` (0 .. 2 * dof - 1): the cell under the tool point after the move,
+        or ``BLOCKED`` when the move is blocked (the arm has not moved)."""
+        j = a >> 1
+        n = self._n[j] + 1 - 2 * (a & 1)
+        self.moves += 1
+        if n < self._nlo[j] or n > self._nhi[j]:
+            return BLOCKED
+        qpos = self._qpos
+        old = qpos[j]
+        qpos[j] = self._q0[j] + n * self.step
+        m, d = self.model, self.data
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_collision(m, d)
+        if d.ncon and self.checker.touches(qpos.copy()):
+            qpos[j] = old
+            return BLOCKED
+        x, y, _ = self._site_xpos[self._tip_id].tolist()
+        cx, cy = round(x / self._cell_size) - self._lo, round(y / self._cell_size) - self._lo
+        width = self._width
+        cell = cy * width + cx if 0 <= cx < width and 0 <= cy < width else -1
+        if cell < 0 or self._clear[cell] < self._clear_needed[a]:  # near a wall or the edge: check the arc
+            anchor = self._xanchor[self._jnt[j]]
+            cell, close = _sweep(x, y, anchor[0], anchor[1], self._cos[a], self._sin[a], self._m[a],
+                                 self._cell_size, self._lo, width, self._free, self._near)
+            if cell < 0 or ((close or self._always_probe) and self._probe_touches(a, old)):
+                qpos[j] = old
+                return BLOCKED
+        elif self._always_probe and self._probe_touches(a, old):
+            qpos[j] = old
+            return BLOCKED
+        self._n[j] = n
+        self.label = cell
+        return cell
+
+    def _probe_touches(self, a: int, old: float) -> bool:
+        """MuJoCo contact at up to 3 points along the move from ``old`` (joint a // 2)."""
+        j = a >> 1
+        end = float(self._qpos[j])
+        q = self._qpos.copy()
+        hit = False
+        for t in self._probe[a]:
+            q[j] = old + t * (end - old)
+            if self.checker.touches(q):
+                hit = True
+                break
+        q[j] = end
+        self._qpos[:] = q  # the data's configuration is the end's again (kinematics are refreshed by the next move)
+        return hit
+
+    def tool_point(self) -> np.ndarray:
+        """The tool point at the current configuration (MuJoCo's kinematics, run now)."""
+        mujoco.mj_kinematics(self.model, self.data)
+        return self._site_xpos[self._tip_id].copy()

@@ -1,0 +1,97 @@
+"""Continuous-state arms by name: ``continuous_arm("planar3")`` or an arm file.
+
+The arm is built in the same MuJoCo scene as its discrete robots (``tasks.arms.arm_scene``:
+the same mount, tool point, cell size and layout) and moved by the ``joint`` action model's
+increments (the arm's lattice step: ``ARMS[arm].joint_step`` for a built-in arm, the
+generator's for a generated arm file, else ``joint_step=`` or the finest step of
+``ik.compile.STEP_LADDER`` whose lattice ``compile_joint`` would allow), with no lattice
+laid out: ``ik.continuous.ContinuousArm``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+import armtransfer.checks as checks
+from armtransfer.errors import ArmModelError, UnknownArmError
+from armtransfer.ik.workspace import DEFAULT_CELL
+from armtransfer.models import ARMS
+from armtransfer.tasks.layout import ROOMS, Layout
+
+ACTIONS = ("joint",)
+"""The action models a continuous arm has."""
+
+
+def parse_spec(spec: str) -> tuple[str | None, str | None]:
+    """'planar3', 'planar3:joint' -> ('planar3', None); 'PATH.xml[:joint]' -> (None, 'PATH.xml');
+    'gen:planar:DOF:SEED[:joint]' -> (None, the generated arm's file, generated at its first use).
+    Anything else is a one-line error listing the valid arms and action models."""
+    if not isinstance(spec, str):
+        raise UnknownArmError(f"a continuous arm is named by a string, got {spec!r}")
+    if spec.startswith("gen:"):
+        from armtransfer.tasks.generated import generated_file
+
+        xml, _, _ = generated_file(spec)
+        parts = spec.split(":")
+        path, name, actions = str(xml), None, parts[4] if len(parts) > 4 else ""
+    elif ".xml" in spec:
+        path, _, actions = spec.rpartition(":") if not spec.endswith(".xml") else (spec, "", "")
+        name = None
+    else:
+        name, _, actions = spec.partition(":")
+        path = None
+        planar = [a for a, info in ARMS.items() if info.kind == "planar"]
+        if name not in planar:
+            raise UnknownArmError(f"unknown continuous arm {name!r}; valid arms: {', '.join(planar)}, PATH.xml "
+                                  "(a planar arm file) or gen:planar:DOF:SEED")
+    if actions and actions not in ACTIONS:
+        raise UnknownArmError(f"a continuous arm has no action model {actions!r}; valid action models: "
+                              f"{', '.join(ACTIONS)}")
+    return name, path
+
+
+def continuous_arm(spec: str | None = None, *, xml_path=None, tip_site: str | None = None,
+                   tip_body: str | None = None, tip_offset=None, base_pos=None, base_yaw: float | None = None,
+                   joint_step: float | None = None, cell_size: float = DEFAULT_CELL, layout: Layout = ROOMS):
+    """The continuous arm of a built-in planar arm (``spec``, e.g. ``"planar3:joint"``) or of a
+    planar arm file (``spec`` ``"PATH.xml"`` or ``xml_path=``) with its tool point and mount
+    (a generated arm's from its sidecar; without ``base_pos`` the automatic mount)."""
+    from armtransfer.ik.continuous import ContinuousArm
+    from armtransfer.tasks.arms import arm_scene, automatic_mount, make_tool, read_sidecar
+
+    name, path = parse_spec(spec) if spec is not None else (None, None)
+    if xml_path is not None:
+        path = str(checks.path(xml_path, "the arm file (xml_path)", error=ArmModelError))
+    if joint_step is not None:
+        joint_step = checks.real(joint_step, "the joint step (radians)", 0.0, np.pi, lo_open=True,
+                                 error=ArmModelError)
+    if path is None:
+        if name is None:
+            raise UnknownArmError("give a continuous arm: a built-in planar arm or an arm file")
+        scene = arm_scene(name, cell_size=cell_size, layout=layout)
+        return ContinuousArm(scene, joint_step or ARMS[name].joint_step)
+    if tip_site is None and tip_body is None and spec is not None and spec.startswith("gen:"):
+        tip_site = "tip"  # a generated arm's tool point
+    generated = read_sidecar(path) if base_pos is None else None
+    if generated is not None:
+        base_pos, base_yaw = tuple(generated["mount_pos"]), float(generated["mount_yaw"])
+        joint_step = joint_step or generated["joint_step"]
+    if base_pos is None:
+        tool = make_tool(tip_site, tip_body, tip_offset)
+        pose = automatic_mount(Path(path), tool, cell_size=cell_size, layout=layout, yaw=base_yaw)
+        base_pos, base_yaw = pose.pos, pose.yaw
+    scene = arm_scene(None, cell_size=cell_size, xml_path=path, tip_site=tip_site, tip_body=tip_body,
+                      tip_offset=tip_offset, base_pos=base_pos, base_yaw=base_yaw, layout=layout)
+    return ContinuousArm(scene, joint_step or ladder_step(scene))
+
+
+def ladder_step(scene) -> float:
+    """The step ``ik.compile.compile_joint`` picks for the arm when none is given, about its home
+    (unlimited joints: pi either side of it)."""
+    from armtransfer.ik.compile import ladder_step as pick
+
+    home = scene.home.astype(float)
+    return pick(np.where(np.isfinite(scene.lower), scene.lower, home - np.pi),
+                np.where(np.isfinite(scene.upper), scene.upper, home + np.pi), home)

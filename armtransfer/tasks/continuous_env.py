@@ -1,0 +1,105 @@
+"""The continuous-state arm as a Gymnasium environment: ``armtransfer/ContinuousArmRooms-v0``.
+
+    env = gymnasium.make("armtransfer/ContinuousArmRooms-v0", arm="planar3", task=1)
+
+The observation is a ``Box``: the joint configuration q followed by the tool point (x, y, z)
+in metres; the action is ``Discrete(2 * dof)``: joint j turned by +delta (``2j``) or -delta
+(``2j+1``), as the ``joint`` action model. Every step runs MuJoCo (``ik.continuous``): a move
+that is blocked leaves the arm where it was (``info["blocked"]``). Each step costs
+``step_reward``; reaching the goal cell pays ``goal_reward`` and ends the episode.
+``info["label"]`` is the cell under the tool point, which is what a transferred trajectory's
+reward is paid on (``armtransfer.wrappers.TransferReward`` works on this environment).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+import armtransfer.checks as checks
+from armtransfer.errors import InvalidActionError, InvalidParameterError
+from armtransfer.tasks.catalog import Task
+from armtransfer.tasks.envs import check_options, rooms_task
+from armtransfer.tasks.robot import cell_robot
+
+ARM_OPTIONS = ("xml_path", "tip_site", "tip_body", "tip_offset", "base_pos", "base_yaw", "joint_step", "cell_size")
+"""The keywords that build the arm (``tasks.continuous.continuous_arm``)."""
+REACH = 2.0
+"""The observation's bound on the tool point's coordinates (metres): the scene is smaller."""
+
+
+class ContinuousArmRoomsEnv(gym.Env):
+    """A start/goal task for a continuous-state arm (``ik.continuous.ContinuousArm``)."""
+
+    metadata = {"render_modes": ["ansi"], "render_fps": 4}
+
+    def __init__(self, arm, task: Task, step_reward: float = -1.0, goal_reward: float = 0.0,
+                 render_mode: str | None = None) -> None:
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise InvalidParameterError(
+                f"unknown render_mode {render_mode!r}; valid: {', '.join(self.metadata['render_modes'])}")
+        self.render_mode = render_mode
+        self.arm = arm
+        self.task = task
+        self.step_reward = float(checks.real(step_reward, "step_reward"))
+        self.goal_reward = float(checks.real(goal_reward, "goal_reward"))
+        layout = arm.layout
+        self.start_cell, self.goal_cell = task.cells(layout)
+        arm.place(self.start_cell)  # the start configuration: IK over the start cell
+        self.start_q = arm.q.copy()
+        lo, hi = arm.bounds
+        self.observation_space = spaces.Box(np.concatenate([lo, [-REACH] * 3]), np.concatenate([hi, [REACH] * 3]),
+                                            dtype=np.float64)
+        self.action_space = spaces.Discrete(arm.n_actions)
+        self.robot = cell_robot(layout)
+        """The cells as a robot (states = cells): what ``TransferReward`` pays transfer by."""
+        self.start_state = self.start_cell
+
+    def _obs(self) -> np.ndarray:
+        return np.concatenate([self.arm.q, self.arm.tool_point()])
+
+    def state_of(self, obs: np.ndarray, info: dict) -> int:
+        """The state ``TransferReward`` pays by: the cell under the tool point."""
+        return int(info["label"])
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        super().reset(seed=seed)
+        label = self.arm.reset()
+        return self._obs(), {"label": label}
+
+    def step(self, action):
+        if isinstance(action, (bool, np.bool_)) or not self.action_space.contains(action):
+            raise InvalidActionError(
+                f"action must be an integer in 0..{self.arm.n_actions - 1} (the action space {self.action_space}), "
+                f"got {action!r}")
+        moved = self.arm.move(int(action))
+        label = self.arm.label
+        terminated = label == self.goal_cell
+        reward = self.step_reward + (self.goal_reward if terminated else 0.0)
+        return self._obs(), reward, terminated, False, {"label": label, "blocked": moved < 0}
+
+    def render(self):
+        if self.render_mode == "ansi":
+            layout = self.arm.layout
+            return layout.ascii({layout.xy(self.arm.label): "R", layout.xy(self.goal_cell): "G"}) + "\n"
+        return None
+
+
+def make_continuous_arm_rooms_env(arm: str | None = "planar3", task: int | None = 1,
+                                  start: tuple[int, int] | None = None, goal: tuple[int, int] | None = None,
+                                  **kwargs: Any) -> ContinuousArmRoomsEnv:
+    """Entry point of ``armtransfer/ContinuousArmRooms-v0``: a built-in planar arm (``arm``, e.g.
+    ``"planar3"`` or ``"planar3:joint"``) or a planar arm file (``xml_path=``) on a Table I or
+    custom task."""
+    from armtransfer.tasks.continuous import continuous_arm
+
+    check_options(kwargs, ARM_OPTIONS)
+    the_task = rooms_task(task, start, goal)
+    arm_kwargs = {k: kwargs.pop(k) for k in ARM_OPTIONS if k in kwargs}
+    if kwargs.pop("wind", 0.0) != 0.0:
+        raise InvalidParameterError("the continuous arm has no wind; valid wind: 0")
+    spec = None if arm_kwargs.get("xml_path") is not None else arm
+    return ContinuousArmRoomsEnv(continuous_arm(spec, **arm_kwargs), the_task, **kwargs)
