@@ -171,6 +171,7 @@ def wheel(tmp_path_factory) -> Path:
     return whl
 
 
+@pytest.mark.slow  # builds a wheel from a copy of the tree: 10 s of pip
 def test_wheel_installs_only_the_armtransfer_namespace(wheel):
     names = zipfile.ZipFile(wheel).namelist()
     top = {n.split("/")[0] for n in names}
