@@ -24,8 +24,14 @@ def _load():
 audit = _load()
 
 
-@pytest.mark.parametrize("case", [pytest.param(c, id=c.name, marks=[pytest.mark.slow] if c.slow else [])
-                                  for c in audit.CASES])
+def _marks(case) -> list:
+    marks = [pytest.mark.slow] if case.slow else []
+    if case.known:  # found, not fixed: reported as expected to fail, not run (it may hang)
+        marks.append(pytest.mark.xfail(run=False, reason=case.known, strict=True))
+    return marks
+
+
+@pytest.mark.parametrize("case", [pytest.param(c, id=c.name, marks=_marks(c)) for c in audit.CASES])
 def test_the_audit_case_holds(case, tmp_path):
     runner = audit.Runner(in_process=not case.slow, cache=Path(os.environ["ARMTRANSFER_CACHE"]))
     held, got = audit.run_case(case, runner, tmp_path, limit=600)
