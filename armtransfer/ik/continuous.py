@@ -269,7 +269,7 @@ class ContinuousArm:
         m, d = self.model, self.data
         mujoco.mj_kinematics(m, d)
         mujoco.mj_collision(m, d)
-        if d.ncon and self.checker.touches(qpos.copy()):
+        if d.ncon and self.checker.touches_now():  # the kinematics and contacts just computed
             qpos[j] = old
             return BLOCKED
         x, y, _ = self._site_xpos[self._tip_id].tolist()

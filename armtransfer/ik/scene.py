@@ -597,7 +597,16 @@ class ContactChecker:
         return g1[mine], g2[mine]
 
     def touches(self, q: np.ndarray) -> bool:
-        g1, g2 = self._contacts(q)
+        return self._counts(*self._contacts(q))
+
+    def touches_now(self) -> bool:
+        """``touches`` at the configuration whose kinematics and collision detection were last
+        run on :attr:`data` (by the caller), without running them again."""
+        n = self.data.ncon
+        return self._counts(self.data.contact.geom1[:n], self.data.contact.geom2[:n])
+
+    def _counts(self, g1: np.ndarray, g2: np.ndarray) -> bool:
+        """Whether any of these contacts is one ``touches`` counts."""
         if len(g1) == 0:
             return False
         env = (self._env[g1] & self._moving[g2]) | (self._env[g2] & self._moving[g1])
