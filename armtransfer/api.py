@@ -234,7 +234,9 @@ def _transfer_continuous(source, target, the_task: Task, method_names: list[str]
         src.start_state(cell, what=what)
     shaped = any(registry.get(m).shaped for m in method_names)
     trajs = resolve_trajectories(specs, src, the_task, config, seed) if shaped else []
-    results = runs.run_all(arm, start_cell, goal_cell, method_names, trajs, trials, seed, config, K, tick=progress)
+    # the arm is placed over the start already (above): run_all would solve the same IK again
+    results = [runs.run_method(m, arm, goal_cell, trajs, trials, seed, config, K, on_trial=progress)
+               for m in method_names]
     return runs.ContinuousResult(task=the_task, source=src.name, target=f"{target} (continuous)", trajectories=trajs,
                                  seed=seed, trials=trials, config=config, approximation=runs.Approximation(),
                                  methods={r.method: r for r in results})
