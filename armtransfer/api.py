@@ -97,6 +97,11 @@ def transfer(
     method_names = [registry.get(m).name for m in _as_sequence(methods, "methods")]
     if not method_names:
         raise InvalidParameterError(f"give at least one method; valid methods: {', '.join(registry.METHODS)}")
+    if state == "continuous":  # the methods asked for, before their baselines join them
+        from armtransfer.learning.cells import check_method
+
+        for m in method_names:
+            check_method(m)
     baselines = checks.flag(baselines, "baselines")
     if baselines:
         method_names = registry.with_baselines(method_names)

@@ -204,7 +204,7 @@ def test_api_runs_a_continuous_target_and_refuses_bad_values_in_one_line():
     bad = [(dict(state="cont"), "valid states: discrete, continuous"),
            (dict(state="continuous", target="ur5e_like:cartesian"), "valid arms: planar2, planar3, planar4"),
            (dict(state="continuous", target="planar3:cartesian"), "valid action models: joint"),
-           (dict(state="continuous", methods=["guided"]), "valid methods: none, pseudo"),
+           (dict(state="continuous", methods=["guided"]), "method 'guided' does not apply.*valid methods: none, pseudo"),
            (dict(state="continuous", wind=0.1), "valid wind: 0")]
     for kwargs, message in bad:
         kw = {**dict(source="planar2:joint", target="planar3:joint", task=1, trials=1), **kwargs}
