@@ -138,26 +138,68 @@ def test_a_worker_dying_while_work_is_handed_out_costs_a_retry(tmp_path, monkeyp
     assert sorted(done) == sorted(r["key"] for r in runs) and failed == []
 
 
-def test_a_broken_pool_at_submit_is_a_retry_not_a_traceback(tmp_path, monkeypatch):
-    from concurrent.futures.process import BrokenProcessPool
+FAULTS = """
+import time
 
-    calls = {"n": 0}
-    real = executors.ProcessPoolExecutor.submit
+def answer(run, robots):
+    time.sleep(0.8)  # the workers outlive the latest kill below
+    return {"robots_bytes": len(robots["big"])}, 0.8
+"""
 
-    def flaky(self, *a, **k):
-        calls["n"] += 1
-        if calls["n"] == 2:
-            raise BrokenProcessPool("a worker died while work was handed out")
-        return real(self, *a, **k)
+DRIVER = """
+import sys
+sys.path.insert(0, sys.argv[1])
+from armtransfer.experiments.executors import run_local
+import faults
 
-    monkeypatch.setattr(executors.ProcessPoolExecutor, "submit", flaky)
-    monkeypatch.setenv("HOSTILE_MARKER", str(tmp_path / "never"))
-    (tmp_path / "never").write_text("")  # _dies_on_first never dies
-    runs = [{"key": f"r{i}", "source": "coarse", "target": "fine"} for i in range(4)]
-    done = []
-    executors.run_local(runs, {}, 2, lambda run, result, secs: done.append(run["key"]),
-                        lambda *a: pytest.fail(f"failed: {a}"), fn=_dies_on_first)
-    assert sorted(done) == sorted(r["key"] for r in runs)
+if __name__ == "__main__":
+    runs = [{"key": f"r{i}", "source": "big", "target": "big"} for i in range(8)]
+    done, failed = [], []
+    run_local(runs, {"big": bytes(16_000_000)}, 2, lambda run, result, secs: done.append(result),
+              lambda run, error, attempts: failed.append(error), retries=2, fn=faults.answer)
+    print(len(done), len(failed), done[0]["robots_bytes"], flush=True)
+"""
+
+
+def _kill_a_starting_worker(tmp_path: Path, delay: float) -> str:
+    """Start a driver whose robots (16 MB) outgrow any pipe's buffer, SIGKILL its first worker
+    ``delay`` s after it appears (starting, importing, or taking the robots), and return what
+    the driver printed: it must finish, and leave nothing behind."""
+    (tmp_path / "faults.py").write_text(FAULTS)
+    (tmp_path / "driver.py").write_text(DRIVER)
+    driver = subprocess.Popen([sys.executable, str(tmp_path / "driver.py"), str(tmp_path)], cwd=tmp_path,
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        deadline = time.time() + 60
+        workers: list[int] = []
+        while time.time() < deadline and not workers and driver.poll() is None:
+            workers = [p for p in session(driver.pid) if b"spawn_main" in Path(f"/proc/{p}/cmdline").read_bytes()]
+            time.sleep(0.005)
+        assert workers, "no worker started"
+        time.sleep(delay)
+        os.kill(workers[0], signal.SIGKILL)
+        out, err = driver.communicate(timeout=120)
+    finally:
+        left = settle(driver.pid, 10)
+    assert left == [], "processes outlived the driver"
+    assert driver.returncode == 0 and "Traceback" not in err, err
+    return out
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.4])
+def test_a_worker_killed_while_it_starts_costs_a_retry(tmp_path, delay):
+    """Killed as it starts (0 s: the interpreter is coming up) or as it imports or takes the
+    robots: the driver sees the death, gives the run to a fresh worker, and finishes. The
+    standard library's pool could miss it and wait for good."""
+    assert _kill_a_starting_worker(tmp_path, delay).split() == ["8", "0", "16000000"]
+
+
+@pytest.mark.slow
+def test_a_worker_killed_at_any_moment_of_its_start_costs_a_retry(tmp_path):
+    for i, delay in enumerate([0.0, 0.01, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 3.0]):
+        folder = tmp_path / str(i)
+        folder.mkdir()
+        assert _kill_a_starting_worker(folder, delay).split() == ["8", "0", "16000000"], delay
 
 
 def test_a_killed_arms_run_leaves_staging_that_the_next_run_removes(tmp_path):

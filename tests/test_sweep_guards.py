@@ -104,6 +104,33 @@ def test_ctrl_c_during_start_up_is_one_line(tmp_path, delay):
     assert err.strip() == "armtransfer rooms: interrupted"
 
 
+def test_ctrl_c_to_a_working_sweep_is_one_line_and_ends_its_workers(tmp_path):
+    """A terminal's Ctrl-C reaches the whole group, the busy workers included: the driver
+    alone answers (one line, exit 130), no worker is left, and the next run finishes."""
+    from contract import settle
+
+    path = tmp_path / "s.toml"
+    path.write_text(GOOD.replace("seeds = [0]", "seeds = [0, 1, 2, 3, 4, 5, 6, 7]").replace(
+        "trials = 1", "trials = 2\nmax_episodes = 400"))
+    argv = [sys.executable, "-m", "armtransfer.cli", "sweep", "s.toml", "--out", "store", "--workers", "2"]
+    proc = subprocess.Popen(argv, cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    try:
+        deadline = time.time() + 120
+        while time.time() < deadline and proc.poll() is None and not list(tmp_path.glob("store/runs/*.json")):
+            time.sleep(0.02)
+        assert proc.poll() is None, "the sweep ended before a worker was busy"
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        left = settle(proc.pid, 10)
+    assert left == [], "a worker outlived the interrupted sweep"
+    assert proc.returncode == 130 and err.strip() == "armtransfer sweep: interrupted", err
+    again = subprocess.run(argv, cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert again.returncode == 0 and "8/8 runs in store; 0 failed" in again.stdout, again.stdout + again.stderr
+
+
 def test_an_unreachable_ray_address_fails_fast_in_one_line(tmp_path, capsys):
     pytest.importorskip("ray")
     path = tmp_path / "s.toml"

@@ -8,15 +8,14 @@ a run is recorded exactly once. A run whose worker crashes (or is killed) is ret
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-from concurrent.futures.process import BrokenProcessPool
+from collections import deque
+from collections.abc import Callable
+from typing import cast
 
 from armtransfer.experiments.execute import execute
 from armtransfer.errors import ArmTransferError
 from armtransfer.cpus import ENV as CPUS_ENV
-from armtransfer.experiments.reaper import guarded_spawn_context
+from armtransfer.experiments.pool import DONE, Pool
 from armtransfer.tasks.robot import DiscreteRobot
 
 Done = Callable[[dict, dict, float], None]  # (run, result, seconds)
@@ -27,149 +26,43 @@ class ExecutorError(ArmTransferError):
     """An executor cannot start (e.g. Ray is not installed or unreachable)."""
 
 
-def _worker_init(driver: int | None = None) -> None:
-    """A pool worker's first code after its imports (its command line's guard ran before
-    them, see ``reaper.guarded_spawn_context``): it ends when the driver ``driver`` (its
-    parent's pid, given by the driver itself) is gone, and runs its trials on one thread."""
-    _die_with_parent(driver)
-    # one thread per worker process: the workers are the parallelism
-    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS", CPUS_ENV):
-        os.environ.setdefault(var, "1")
-
-
 def _execute_in_ray(run: dict, robots):
     """``execute`` in a Ray worker, its trials on one thread: Ray's tasks are the parallelism."""
     os.environ.setdefault(CPUS_ENV, "1")
     return execute(run, robots)
 
 
-def _die_with_parent(driver: int | None = None) -> None:
-    """A worker ends when the sweep that started it is killed (even by SIGKILL), instead of
-    living on as an orphan: Linux's PR_SET_PDEATHSIG sends it SIGTERM when its parent dies.
-    Elsewhere a thread watches the parent's pid and ends the worker.
-
-    ``driver`` is the pid the driver had when it started the worker: a driver killed while
-    the worker was still starting (importing) is noticed here, since the worker's parent is
-    then already someone else (a worker that only read its own parent's pid here took that
-    adoptive parent for its driver, and lived on)."""
-    parent = os.getppid() if driver is None else driver
-    if os.getppid() != parent:
-        os._exit(1)
-    try:
-        import ctypes
-        import signal
-
-        libc = ctypes.CDLL(None, use_errno=True)
-        PR_SET_PDEATHSIG = 1
-        if libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGTERM), 0, 0, 0) == 0:
-            if os.getppid() != parent:  # the parent died before the call
-                os._exit(1)
-            return
-    except (OSError, AttributeError):
-        pass
-    import threading
-    import time
-
-    def watch() -> None:
-        while os.getppid() == parent:
-            time.sleep(1.0)
-        os._exit(1)
-
-    threading.Thread(target=watch, daemon=True).start()
-
-
 def run_local(
     runs: list[dict], robots: dict[str, DiscreteRobot], workers: int, on_done: Done, on_failed: Failed,
     retries: int = 2, fn: Callable = execute,
 ) -> None:
-    """A process pool over this machine's cores.
+    """A process pool over this machine's cores (:class:`~armtransfer.experiments.pool.Pool`).
 
-    At most ``workers`` runs are in flight, so when a worker dies the runs that may have
-    killed it are known: each of them is then retried alone in a fresh one-worker pool,
-    where a crash is its own, and counted against it (up to ``retries`` retries).
-    ``fn(run, robots) -> (result, seconds)`` is what a worker runs (tests inject faults here).
+    Each worker holds one run at a time, so when a worker dies (at any moment, its start-up
+    included) the run it held is known: that run is given to a fresh worker, up to
+    ``retries`` more times, then recorded as failed. ``fn(run, robots) -> (result, seconds)``
+    is what a worker runs (tests inject faults here).
     """
-    ctx = guarded_spawn_context()
-    queue = list(runs)
-    suspects: list[dict] = []
+    queue = deque(runs)
     attempts = {r["key"]: 0 for r in runs}
-
-    def finish(fut, run) -> bool:
-        """Report a finished future; False when its pool broke."""
-        try:
-            result, secs = fut.result()
-        except BrokenProcessPool:
-            return False
-        except ArmTransferError as err:
-            on_failed(run, str(err), attempts[run["key"]] + 1)
-        except Exception as err:  # noqa: BLE001 - recorded, not lost
-            on_failed(run, f"{type(err).__name__}: {err}", attempts[run["key"]] + 1)
-        else:
-            on_done(run, result, secs)
-        return True
-
-    while queue or suspects:
-        if suspects:
-            run = suspects.pop(0)
-            with _pool(1, ctx) as pool:
-                fut = _submit(pool, fn, run, _robots_for([run], robots))
-                if fut is not None:
-                    wait([fut])
-                if fut is None or not finish(fut, run):
-                    attempts[run["key"]] += 1
-                    if attempts[run["key"]] > retries:
-                        on_failed(run, "worker process died", attempts[run["key"]])
-                    else:
-                        suspects.append(run)
-            continue
-        with _pool(workers, ctx) as pool:
-            shared = _robots_for(queue, robots)
-            in_flight: dict = {}
-            while queue or in_flight:
-                broken = False
-                while queue and len(in_flight) < workers:
-                    run = queue.pop(0)
-                    fut = _submit(pool, fn, run, shared)
-                    if fut is None:  # a worker died while this was handed over
-                        suspects.append(run)
-                        broken = True
-                        break
-                    in_flight[fut] = run
-                if broken:
-                    suspects.extend(in_flight.values())
-                    break
-                finished, _ = wait(list(in_flight), return_when=FIRST_COMPLETED)
-                for fut in finished:
-                    run = in_flight.pop(fut)
-                    if not finish(fut, run):
-                        broken = True
-                        suspects.append(run)
-                if broken:  # every run still in flight may be the culprit
-                    suspects.extend(in_flight.values())
-                    break
-
-
-@contextmanager
-def _pool(workers: int, ctx) -> Iterator[ProcessPoolExecutor]:
-    """A process pool whose workers know the driver's pid from their first code; leaving it
-    waits for its workers, a broken pool included."""
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init,
-                               initargs=(os.getpid(),))
-    try:
-        yield pool
-    finally:
-        try:
-            pool.shutdown(wait=True, cancel_futures=True)
-        except BrokenProcessPool:
-            pass
-
-
-def _submit(pool: ProcessPoolExecutor, fn: Callable, run: dict, robots: dict):
-    """``pool.submit(fn, run, robots)``, or None when the pool broke (a worker died) meanwhile."""
-    try:
-        return pool.submit(fn, run, robots)
-    except (BrokenProcessPool, RuntimeError):  # RuntimeError: the pool shut down after breaking
-        return None
+    with Pool(max(1, min(workers, len(queue))), _robots_for(runs, robots), fn) as pool:
+        while queue or pool.busy():
+            while queue and (worker := pool.idle()) is not None:
+                pool.give(worker, queue.popleft())
+            _, run, answer = pool.next_event()
+            if run is None:  # an idle worker died: a new one starts when there is work
+                continue
+            if answer is None:
+                attempts[run["key"]] += 1
+                if attempts[run["key"]] > retries:
+                    on_failed(run, "worker process died", attempts[run["key"]])
+                else:
+                    queue.appendleft(run)
+            elif answer[0] == DONE:
+                result, secs = cast(tuple, answer[1])  # fn's answer is (result, seconds)
+                on_done(run, result, secs)
+            else:
+                on_failed(run, str(answer[1]), attempts[run["key"]] + 1)
 
 
 def _robots_for(runs: list[dict], robots: dict[str, DiscreteRobot]) -> dict[str, DiscreteRobot]:
