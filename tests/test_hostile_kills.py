@@ -5,6 +5,7 @@ folder that the next run into the same --out removes. Every test here kills only
 it started, and kills whatever it finds left over even when its check fails."""
 
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -136,6 +137,25 @@ def test_a_worker_dying_while_work_is_handed_out_costs_a_retry(tmp_path, monkeyp
     executors.run_local(runs, {}, 3, lambda run, result, secs: done.append(run["key"]),
                         lambda run, error, attempts: failed.append(run["key"]), retries=2, fn=_dies_on_first)
     assert sorted(done) == sorted(r["key"] for r in runs) and failed == []
+
+
+def _raises_or_unsendable(run, robots):
+    if run["key"] == "raises":
+        raise ValueError("no such thing")
+    if run["key"] == "unsendable":
+        return {"f": lambda: 0}, 0.0  # a lambda cannot be pickled back to the driver
+    return {"ok": True}, 0.0
+
+
+def test_a_run_that_raises_or_cannot_answer_is_a_failure_and_its_worker_goes_on():
+    runs = [{"key": k, "source": "coarse", "target": "fine"} for k in ("raises", "unsendable", "fine1", "fine2")]
+    done, failed = [], {}
+    executors.run_local(runs, {}, 1, lambda run, result, secs: done.append(run["key"]),
+                        lambda run, error, attempts: failed.update({run["key"]: (error, attempts)}),
+                        retries=2, fn=_raises_or_unsendable)
+    assert sorted(done) == ["fine1", "fine2"]
+    assert failed["raises"] == ("ValueError: no such thing", 1)
+    assert failed["unsendable"][0].startswith("its result cannot be sent back") and failed["unsendable"][1] == 1
 
 
 FAULTS = """
@@ -275,3 +295,39 @@ def test_a_killed_ray_sweep_takes_its_local_ray_with_it(tmp_path):
     finally:
         left = settle(proc.pid, 90)  # Ray's own shutdown takes tens of seconds on a loaded machine
     assert left == [], "Ray's processes outlived the killed sweep"
+
+
+MOMENTS = [0.05, 0.3, 0.8, 1.5, 2.5, 4.0]
+"""Seconds after the start at which the "any moment" test kills: the interpreter starting,
+the imports, the workers starting, and the work under way."""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("command", ["sweep", "matrix", "arms"])
+def test_a_kill_at_any_moment_leaves_nothing_and_the_next_run_finishes(command, tmp_path):
+    (tmp_path / "s.toml").write_text(SWEEP.format(seeds=list(range(8))))
+    argv = {"sweep": ["sweep", "s.toml", "--out", "store", "--workers", "2"],
+            "matrix": ["matrix", "--robots", "coarse,fine", "--tasks", "1-4", "--methods", "none", "pseudo",
+                       "--trials", "2", "--out", "store", "--workers", "2"],
+            "arms": ["arms", "--source", "coarse", "--target", "fine", "--trajectory", "optimal", "--no-video",
+                     "--no-controls", "--trials", "30", "--out", "store"]}[command]
+    for moment in MOMENTS:
+        proc = start(argv, tmp_path)
+        try:
+            time.sleep(moment)
+            os.killpg(proc.pid, signal.SIGKILL) if proc.poll() is None else None
+            proc.wait()
+        finally:
+            left = settle(proc.pid, 10)
+        assert left == [], f"processes outlived a kill at {moment} s"
+    again = subprocess.run([sys.executable, "-m", "armtransfer.cli", *argv], cwd=tmp_path, capture_output=True,
+                           text=True, timeout=600)
+    assert again.returncode == 0, again.stderr
+    assert not list(tmp_path.glob(".*.tmp")), "a staging folder outlived the next run"
+    if command == "arms":
+        assert (tmp_path / "store" / "results.json").is_file()
+    else:
+        # "N/N runs in store", or, when the killed runs had finished it all, "N runs, N already done"
+        counts = re.search(r"(\d+)/(\d+) runs in", again.stdout) or re.search(r"(\d+) runs, (\d+) already done",
+                                                                             again.stdout)
+        assert counts and counts.group(1) == counts.group(2), again.stdout
