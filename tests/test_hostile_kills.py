@@ -9,10 +9,12 @@ import re
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
 import pytest
+from hypothesis import example, given, settings, strategies as st
 
 from armtransfer.experiments import executors
 from armtransfer.io import clean_stale_staging, staged_directory
@@ -215,11 +217,14 @@ def test_a_worker_killed_while_it_starts_costs_a_retry(tmp_path, delay):
 
 
 @pytest.mark.slow
-def test_a_worker_killed_at_any_moment_of_its_start_costs_a_retry(tmp_path):
-    for i, delay in enumerate([0.0, 0.01, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 3.0]):
-        folder = tmp_path / str(i)
-        folder.mkdir()
-        assert _kill_a_starting_worker(folder, delay).split() == ["8", "0", "16000000"], delay
+@settings(max_examples=12, deadline=None, derandomize=True)
+@example(delay=0.0)
+@example(delay=0.01)
+@example(delay=3.0)
+@given(delay=st.floats(min_value=0.0, max_value=3.0))
+def test_a_worker_killed_at_any_moment_of_its_start_costs_a_retry(delay):
+    with tempfile.TemporaryDirectory() as folder:
+        assert _kill_a_starting_worker(Path(folder), delay).split() == ["8", "0", "16000000"], delay
 
 
 def test_a_killed_arms_run_leaves_staging_that_the_next_run_removes(tmp_path):
