@@ -44,7 +44,7 @@ from armtransfer.ik.seeds import RING, SEED_RESTARTS, _cells_by_distance, reach_
 from armtransfer.ik.solve import MAX_TIP_HEIGHT, TIP_HEIGHT, TipIK
 
 
-def _near_wall_mask(layout) -> np.ndarray:
+def near_wall_mask(layout) -> np.ndarray:
     """Boolean over cell ids: a wall cell or one of its 8 neighbours."""
     w = layout.wall_mask
     pad = np.pad(w, 1)
@@ -289,6 +289,13 @@ def _lattice_dims(lo: np.ndarray, hi: np.ndarray, home: np.ndarray, step: float)
     return n_lo, tuple(int(v) for v in n_hi - n_lo + 1)
 
 
+def joint_box(scene: ArmScene, centre: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(lowest, highest) configuration: the joint limits, or pi either side of ``centre`` for
+    a joint without limits."""
+    return (np.where(np.isfinite(scene.lower), scene.lower, centre - np.pi),
+            np.where(np.isfinite(scene.upper), scene.upper, centre + np.pi))
+
+
 def ladder_step(lo: np.ndarray, hi: np.ndarray, home: np.ndarray) -> float:
     """The finest of ``STEP_LADDER`` whose lattice about ``home`` within [lo, hi] has at most
     ``MAX_LATTICE`` points (the coarsest when none has)."""
@@ -303,12 +310,11 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
     fk = PlanarFK(scene)
     contact = ContactChecker(scene)
     free = layout.free
-    near = _near_wall_mask(layout)
+    near = near_wall_mask(layout)
     _check_tip_height(scene, fk.tip_z)
     home = _lattice_origin(scene, fk)
     dof = len(home)
-    lo = np.where(np.isfinite(scene.lower), scene.lower, home - np.pi)
-    hi = np.where(np.isfinite(scene.upper), scene.upper, home + np.pi)
+    lo, hi = joint_box(scene, home)
     if step is None:
         step = ladder_step(lo, hi, home)
     n_lo, dims = _lattice_dims(lo, hi, home, step)

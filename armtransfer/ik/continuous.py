@@ -31,7 +31,7 @@ import numba
 import numpy as np
 
 from armtransfer.errors import ArmModelError, InvalidCellError, UnreachableTableError
-from armtransfer.ik.compile import _near_wall_mask
+from armtransfer.ik.compile import joint_box, near_wall_mask
 from armtransfer.ik.labels import OFF_TABLE, cells_of_xy
 from armtransfer.ik.scene import ArmScene, ContactChecker
 from armtransfer.ik.solve import TipIK
@@ -118,7 +118,7 @@ class ContinuousArm:
         layout = scene.layout
         self.layout = layout
         self._free = np.ascontiguousarray(layout.free)
-        self._near = np.ascontiguousarray(_near_wall_mask(layout))
+        self._near = np.ascontiguousarray(near_wall_mask(layout))
         self._cell_size, self._lo, self._width = float(scene.cell), int(layout.lo), int(layout.width)
         self._clear = clearance_cells(layout).tolist()
         self._tip_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, scene.tip)
@@ -180,8 +180,7 @@ class ContinuousArm:
         cell = int(cells_of_xy(tip, self.scene.cell, self.layout))
         if cell < 0 or not self.layout.free[cell]:
             raise InvalidCellError("the arm's tool point is not over a free cell at this configuration")
-        lo = np.where(np.isfinite(lo), lo, q - np.pi)
-        hi = np.where(np.isfinite(hi), hi, q + np.pi)
+        lo, hi = joint_box(self.scene, q)
         self._q0 = q.tolist()
         self._n = [0] * self.dof
         self._nlo = np.ceil((lo - q) / self.step - 1e-9).astype(np.int64).tolist()

@@ -90,8 +90,7 @@ def continuous_arm(spec: str | None = None, *, xml_path=None, tip_site: str | No
 def ladder_step(scene) -> float:
     """The step ``ik.compile.compile_joint`` picks for the arm when none is given, about its home
     (unlimited joints: pi either side of it)."""
-    from armtransfer.ik.compile import ladder_step as pick
+    from armtransfer.ik.compile import joint_box, ladder_step as pick
 
     home = scene.home.astype(float)
-    return pick(np.where(np.isfinite(scene.lower), scene.lower, home - np.pi),
-                np.where(np.isfinite(scene.upper), scene.upper, home + np.pi), home)
+    return pick(*joint_box(scene, home), home)
