@@ -213,19 +213,15 @@ def _transfer_continuous(source, target, the_task: Task, method_names: list[str]
                          K, config: LearnerConfig, arm_xml, options: dict, progress) -> ContinuousResult:
     """``transfer`` with a continuous-state target (see its docstring)."""
     from armtransfer.experiments import continuous as runs
-    from armtransfer.learning.cells import check_method
-    from armtransfer.tasks.continuous import continuous_arm
+    from armtransfer.tasks.continuous import ARM_KEYWORDS, continuous_arm
 
-    for m in method_names:
-        check_method(m)
     if isinstance(target, DiscreteRobot) or not isinstance(target, str):
         raise InvalidParameterError("a continuous target is named by a string: a planar arm such as "
                                     f"'planar3:joint', PATH.xml or 'custom' with arm_xml, got {target!r}")
-    arm_keys = ("tip_site", "tip_body", "tip_offset", "base_pos", "base_yaw", "joint_step", "cell_size")
-    unknown = sorted(k for k in options if k not in arm_keys)
+    unknown = sorted(k for k in options if k not in ARM_KEYWORDS)
     if unknown:
         raise InvalidParameterError(f"arm option {unknown[0]!r} does not apply to a continuous target; valid "
-                                    f"options: {', '.join(arm_keys)}")
+                                    f"options: {', '.join(ARM_KEYWORDS)}")
     if target.partition(":")[0] == "custom":
         if arm_xml is None:
             raise InvalidParameterError("target 'custom' needs arm_xml")

@@ -22,6 +22,8 @@ from armtransfer.tasks.layout import ROOMS, Layout
 
 ACTIONS = ("joint",)
 """The action models a continuous arm has."""
+ARM_KEYWORDS = ("tip_site", "tip_body", "tip_offset", "base_pos", "base_yaw", "joint_step", "cell_size")
+""":func:`continuous_arm`'s keywords for the arm's tool point, mount and step (besides ``xml_path``)."""
 
 
 def parse_spec(spec: str) -> tuple[str | None, str | None]:

@@ -22,10 +22,11 @@ from gymnasium import spaces
 import armtransfer.checks as checks
 from armtransfer.errors import InvalidActionError, InvalidParameterError
 from armtransfer.tasks.catalog import Task
+from armtransfer.tasks.continuous import ARM_KEYWORDS
 from armtransfer.tasks.envs import check_options, rooms_task
 from armtransfer.tasks.robot import cell_robot
 
-ARM_OPTIONS = ("xml_path", "tip_site", "tip_body", "tip_offset", "base_pos", "base_yaw", "joint_step", "cell_size")
+ARM_OPTIONS = ("xml_path", *ARM_KEYWORDS)
 """The keywords that build the arm (``tasks.continuous.continuous_arm``)."""
 REACH = 2.0
 """The observation's bound on the tool point's coordinates (metres): the scene is smaller."""
