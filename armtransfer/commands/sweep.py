@@ -54,8 +54,7 @@ def run_sweep(sweep: sweeps.Sweep, args: argparse.Namespace) -> int:
     """Run every unfinished run of ``sweep`` into the store at ``args.out`` with the executor
     the arguments name; returns the exit code (1 when a run failed). The whole sweep is
     checked (every robot built, every task's cells checked for both robots) before anything
-    is written."""
-    check_executor_options(args)
+    is written. The caller has checked the executor options (:func:`check_executor_options`)."""
     if args.executor == "ray":
         _import_ray()  # say how to install Ray before anything is written
         if args.address:
