@@ -42,6 +42,7 @@ import numpy as np
 
 from armtransfer.errors import InvalidParameterError
 from armtransfer.learning import jitcache as _jitcache
+from armtransfer.learning import sarsa as _sarsa
 from armtransfer.learning import tiles as _tiles
 from armtransfer.learning import traces as _traces
 from armtransfer.learning.config import LearnerConfig
@@ -333,4 +334,4 @@ def _greedy_path(mover: Mover, learner: _Learner, goal: int, cap: int) -> tuple[
 
 
 _jitcache.invalidate_stale(__name__, [_draw, _egreedy, _values, _begin, _greedy, _update],
-                           [_tiles.__file__, _traces.__file__, __file__.replace("linear.py", "sarsa.py")])
+                           [_tiles.__file__, _traces.__file__, _sarsa.__file__])
