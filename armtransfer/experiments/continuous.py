@@ -46,6 +46,9 @@ class Approximation:
     def linear(self) -> linear.LinearConfig:
         return linear.LinearConfig(self.traces, self.greedy_cap)
 
+    def to_json(self) -> dict:
+        return {"tilings": self.tilings, "tile_width_steps": self.width, "traces": self.traces}
+
 
 def run_method(method: str, arm, goal_cell: int, trajs: Sequence[Trajectory] | None, trials: int, seed: int,
                config: LearnerConfig, K: float | str = "auto", approx: Approximation = Approximation(),
@@ -62,8 +65,7 @@ def run_method(method: str, arm, goal_cell: int, trajs: Sequence[Trajectory] | N
         if on_trial is not None:
             on_trial()
     out.extra["state"] = "continuous"
-    out.extra["approximation"] = {"tilings": approx.tilings, "tile_width_steps": approx.width,
-                                  "traces": approx.traces, "features": coding.size}
+    out.extra["approximation"] = {**approx.to_json(), "features": coding.size}
     if shaping is not None:
         out.extra["K"] = shaping.K
     return out
@@ -104,8 +106,7 @@ class ContinuousResult:
                 "source": self.source, "target": self.target,
                 "trajectories": [tr.to_json() for tr in self.trajectories], "seed": self.seed, "trials": self.trials,
                 "config": self.config.to_dict(),
-                "approximation": {"tilings": self.approximation.tilings, "tile_width_steps": self.approximation.width,
-                                  "traces": self.approximation.traces},
+                "approximation": self.approximation.to_json(),
                 "results": {m: summary[r.label] for m, r in self.methods.items()}}
 
     def __repr__(self) -> str:
