@@ -2,8 +2,9 @@
 
 A pool worker started from :func:`guarded_spawn_context` runs :data:`GUARD` first: before
 Python imports anything for it, it checks that its parent is still the driver that started
-it and asks Linux to send it SIGTERM when that parent dies (``PR_SET_PDEATHSIG``). A driver killed while its workers are still importing (a few
-seconds, a few hundred MB each) takes them with it at once.
+it and asks Linux to send it SIGTERM when that parent dies (``PR_SET_PDEATHSIG``). A driver
+killed while its workers are still importing (a few seconds, a few hundred MB each) takes them
+with it at once.
 
 A local Ray instance's processes (its GCS server, raylet, agents and workers) are the
 sweep's children, but a sweep killed with SIGKILL cannot stop them, and they lived on for
@@ -146,8 +147,9 @@ except Exception:
 if os.getppid() != {driver}: os._exit(1)
 """
 """The first lines a guarded worker runs (``prctl(1, ...)`` is PR_SET_PDEATHSIG; where it does
-not exist, the worker's own initializer watches its parent instead): the standard library's
-``os`` and ``ctypes`` only, so that nothing is imported before the driver is known alive."""
+not exist, the worker's own first code watches its parent instead, ``pool.watch_driver``): the
+standard library's ``os`` and ``ctypes`` only, so that nothing is imported before the driver is
+known alive."""
 
 _LAUNCH = threading.Lock()
 
