@@ -38,7 +38,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
-from contract import FORE, INCLUDING, SWEEP_WITH_ARM, session, settle  # noqa: E402  (the tests' helpers)
+from contract import FORE, INCLUDING, SWEEP_WITH_ARM, cmdline, session, settle  # noqa: E402  (the tests' helpers)
 from conftest import SCARA_XML  # noqa: E402  (the tests' bring-your-own arm)
 
 
@@ -537,13 +537,6 @@ def whole(argv: list[str], ran: Ran, d: Path) -> None:
     counts = re.search(r"(\d+)/(\d+) runs in", ran.out) or re.search(r"(\d+) runs, (\d+) already done", ran.out)
     if counts is None or counts.group(1) != counts.group(2) or not list((out / "runs").glob("*.json")):
         raise Failed(f"the store is not whole: {ran.out.strip().splitlines()[:1]}")
-
-
-def cmdline(pid: int) -> bytes:
-    try:
-        return Path(f"/proc/{pid}/cmdline").read_bytes()
-    except OSError:
-        return b""
 
 
 def wait_for(moment: str, proc: subprocess.Popen, d: Path, limit: float = 300) -> str:

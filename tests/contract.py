@@ -41,6 +41,14 @@ def session(sid: int) -> list[int]:
     return out
 
 
+def cmdline(pid: int) -> bytes:
+    """Process ``pid``'s command line (NUL-separated), empty when it has ended meanwhile."""
+    try:
+        return Path(f"/proc/{pid}/cmdline").read_bytes()
+    except OSError:
+        return b""
+
+
 def settle(sid: int, seconds: float = 60.0) -> list[int]:
     """The session's processes left once they had ``seconds`` to end; any left are killed,
     so that a failing check leaves nothing behind either."""

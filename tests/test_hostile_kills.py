@@ -18,7 +18,7 @@ from hypothesis import example, given, settings, strategies as st
 
 from armtransfer.experiments import executors
 from armtransfer.io import clean_stale_staging, staged_directory
-from contract import session, settle
+from contract import cmdline, session, settle
 
 pytestmark = pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc")
 
@@ -195,7 +195,7 @@ def _kill_a_starting_worker(tmp_path: Path, delay: float) -> str:
         deadline = time.time() + 60
         workers: list[int] = []
         while time.time() < deadline and not workers and driver.poll() is None:
-            workers = [p for p in session(driver.pid) if b"spawn_main" in Path(f"/proc/{p}/cmdline").read_bytes()]
+            workers = [p for p in session(driver.pid) if b"spawn_main" in cmdline(p)]
             time.sleep(0.005)
         assert workers, "no worker started"
         time.sleep(delay)
