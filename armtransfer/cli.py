@@ -82,11 +82,49 @@ def _join_xy_values(argv: list[str]) -> list[str]:
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     command = next((a for a in argv if a in COMMANDS), "")
+    hook = _InterruptAgain(sys.unraisablehook)
+    sys.unraisablehook = hook
     try:
         return _main(argv)
     except KeyboardInterrupt:  # Ctrl-C anywhere, start-up (imports, parsing) included
         print(f"armtransfer{' ' + command if command else ''}: interrupted", file=sys.stderr)
         return 130
+    finally:
+        hook.pending.clear()
+        sys.unraisablehook = hook.previous
+
+
+class _InterruptAgain:
+    """An unraisable hook for :func:`main`: a Ctrl-C that lands in Python code a C library
+    called back (numba's compiler calls llvmlite's callbacks through ctypes) cannot leave that
+    callback; Python would print "Exception ignored" and go on as if nothing had happened.
+    Here it is delivered to the main thread again, from a thread, every 50 ms until
+    :func:`main` has answered it; anything else goes to the ``previous`` hook."""
+
+    def __init__(self, previous) -> None:
+        import threading
+
+        self.previous = previous
+        self.pending = threading.Event()
+
+    def __call__(self, unraisable) -> None:
+        if not isinstance(unraisable.exc_value, KeyboardInterrupt):
+            self.previous(unraisable)
+        elif not self.pending.is_set():
+            import threading
+
+            self.pending.set()
+            threading.Thread(target=self._deliver, daemon=True).start()
+
+    def _deliver(self) -> None:
+        import _thread
+        import time
+
+        while True:
+            time.sleep(0.05)  # let the main thread leave this hook first: raised in it, it is lost
+            if not self.pending.is_set():
+                return
+            _thread.interrupt_main()
 
 
 def _main(argv: list[str]) -> int:
