@@ -10,7 +10,7 @@ Each round runs every contender on the same work, in turn: Table I task 1, the f
 transfer, trials back to back until ``--steps`` steps (``armtransfer bench``'s measurement),
 seed = the round. Reported: each contender's median steps/s over the rounds and the median of
 the per-round ratios to the first. ``--against REV ...`` loads the learner's kernel (``sarsa.py`` and
-its guide) as it was at git revision REV of this checkout, from ``armtransfer/learning/`` or, before
+its guide) as it was at git revision REV of this checkout, from ``src/armtransfer/learning/`` or, before
 the move, ``transfer/``, beside today's (a revision whose kernel takes other arguments than
 ``sarsa.learn`` gives them fails in one line).
 """
@@ -39,7 +39,7 @@ from armtransfer.tasks.grid_robots import grid_robot
 ROOT = Path(__file__).resolve().parents[1]
 
 
-LEARNER_FOLDERS = ("armtransfer/learning", "transfer")
+LEARNER_FOLDERS = ("src/armtransfer/learning", "armtransfer/learning", "transfer")
 """Where a revision keeps its learner: today's path, then the one before the move."""
 KERNEL_FILES = ("sarsa.py", "guide.py", "guide/")  # a revision's guide is one file or a package
 """The learner's compiled files, loaded as they were at the revision (a folder: all its files);
@@ -63,7 +63,7 @@ def _git(*args: str) -> str:
 
 def load_revision(rev: str, where: Path):
     """``sarsa`` of git revision ``rev``, with that revision's guide, as package ``rev_<commit>``
-    under ``where``. The learner is read from ``armtransfer/learning/`` or, for a revision before
+    under ``where``. The learner is read from ``src/armtransfer/learning/`` or, for a revision before
     the move, ``transfer/``."""
     tag = "rev_" + _git("rev-parse", "--short=12", f"{rev}^{{commit}}").strip()
     if tag in sys.modules:

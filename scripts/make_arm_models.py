@@ -1,4 +1,4 @@
-"""Write the MJCF of the project's arms (armtransfer/models/<arm>/<arm>.xml) from their dimensions.
+"""Write the MJCF of the project's arms (src/armtransfer/models/<arm>/<arm>.xml) from their dimensions.
 
 The XML files are committed and are what everything loads; this script documents how they
 were derived (planar link lengths, and the published Denavit-Hartenberg tables of the
@@ -19,7 +19,7 @@ from pathlib import Path
 from armtransfer import script
 from armtransfer.models.mjcf import BUILT_IN
 
-MODELS = Path(__file__).resolve().parents[1] / "armtransfer" / "models"
+MODELS = Path(__file__).resolve().parents[1] / "src" / "armtransfer" / "models"
 
 
 def main() -> None:

@@ -32,8 +32,8 @@ MUJOCO = ("mujoco", "dm_control", "mink")
 def _modules() -> dict[str, Path]:
     """Every module of the package, named by its path: the file path is the module path."""
     out = {}
-    for path in sorted((ROOT / "armtransfer").rglob("*.py")):
-        rel = path.relative_to(ROOT).with_suffix("")
+    for path in sorted((ROOT / "src" / "armtransfer").rglob("*.py")):
+        rel = path.relative_to(ROOT / "src").with_suffix("")
         out[".".join(p for p in rel.parts if p != "__init__")] = path
     return out
 
@@ -176,6 +176,6 @@ def test_wheel_installs_only_the_armtransfer_namespace(wheel):
     names = zipfile.ZipFile(wheel).namelist()
     top = {n.split("/")[0] for n in names}
     assert {t for t in top if not t.endswith(".dist-info")} == {"armtransfer"}
-    for module in ("armtransfer/learning/sarsa.py", "armtransfer/ik/compile.py", "armtransfer/tasks/layout.py",
-                   "armtransfer/models/planar2/planar2.xml", "armtransfer/commands/rooms.py"):
-        assert module in names
+    for module in ("learning/sarsa.py", "ik/compile.py", "tasks/layout.py", "models/planar2/planar2.xml",
+                   "commands/rooms.py"):
+        assert "armtransfer/" + module in names

@@ -205,7 +205,7 @@ def test_bench_kernels_fast_mode_times_both_kernels_and_refuses_a_bad_revision()
 
 @pytest.mark.slow  # the fast mode of bench_kernels runs by default
 def test_bench_kernels_loads_a_kernel_of_the_old_tree_and_of_todays():
-    """--against reads the learner from transfer/ (before the move) or armtransfer/learning/, with
+    """--against reads the learner from transfer/ (before the move) or src/armtransfer/learning/, with
     its guide as one file or as a package."""
     import subprocess
     import sys

@@ -141,13 +141,13 @@ def test_readme_reads_in_two_minutes() -> None:
     assert len((ROOT / "README.md").read_text(encoding="utf-8").splitlines()) <= 200
 
 
-PATH_LIKE = re.compile(r"(?<![\w./-])((?:armtransfer|scripts|research|benchmarks|examples|docs|tests|dev)"
+PATH_LIKE = re.compile(r"(?<![\w./-])((?:src/armtransfer|armtransfer|scripts|research|benchmarks|examples|docs|tests|dev)"
                        r"/[\w./-]*\.(?:py|md|toml|json|xml|png|txt))\b")
 LINK = re.compile(r"\]\(([^)#\s]+)(?:#[^)]*)?\)")
 MODULE = re.compile(r"`(armtransfer(?:\.\w+)+)")
 
 def _doc_and_model_pages() -> list[Path]:
-    return [*PAGES, *sorted((ROOT / "armtransfer" / "models").glob("*/README.md"))]
+    return [*PAGES, *sorted((ROOT / "src" / "armtransfer" / "models").glob("*/README.md"))]
 
 
 @pytest.mark.parametrize("page", _doc_and_model_pages(), ids=lambda p: str(p.relative_to(ROOT)))
@@ -161,7 +161,7 @@ def test_every_path_and_link_exists(page: Path) -> None:
 
 def test_every_path_in_the_code_exists() -> None:
     """Docstrings and comments name files by their path; every one must still be there."""
-    files = [p for d in ("armtransfer", *LINKED, "tests") for p in sorted((ROOT / d).rglob("*.py"))
+    files = [p for d in ("src", *LINKED, "tests") for p in sorted((ROOT / d).rglob("*.py"))
              if p != Path(__file__).resolve()]
     missing = sorted({f"{f.relative_to(ROOT)}: {p}" for f in files
                       for p in PATH_LIKE.findall(f.read_text(encoding="utf-8")) if not (ROOT / p).exists()})

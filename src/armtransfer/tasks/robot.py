@@ -1,4 +1,4 @@
-"""A discrete robot: the plain arrays every learner in ``armtransfer/learning/`` runs on.
+"""A discrete robot: the plain arrays every learner in ``src/armtransfer/learning/`` runs on.
 
 A robot is a deterministic MDP over its *own* states (grid cells for the paper's robots,
 joint-lattice points or canonical configurations for arms) plus a map from each state to a

@@ -3,7 +3,7 @@
 Every arm has a site named ``tip`` (the tool tip), a ``home`` keyframe, hinge joints named
 ``joint1..jointN`` and a position actuator per joint named like the joint. ``ARMS`` maps an
 arm name to where its XML is, how many joints it has, which action models it supports
-(first = default) and how it is mounted relative to the table (see ``armtransfer/ik/workspace.py``:
+(first = default) and how it is mounted relative to the table (see ``src/armtransfer/ik/workspace.py``:
 the tabletop is z = 0 and cell (x, y) is centred at (x * cell, y * cell)).
 """
 

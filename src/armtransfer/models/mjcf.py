@@ -1,7 +1,7 @@
 """MJCF text of the project's arms, from their dimensions: planar SCARA-like arms, and spatial
 arms from body frames (Denavit-Hartenberg tables turned into MuJoCo bodies).
 
-The built-in arms (``scripts/make_arm_models.py`` writes armtransfer/models/<arm>/<arm>.xml) and the
+The built-in arms (``scripts/make_arm_models.py`` writes src/armtransfer/models/<arm>/<arm>.xml) and the
 generated ones (``armtransfer.models.generate``) are written by the same functions, so they
 follow one contract: a ``tip`` site, a ``home`` keyframe, hinge joints ``joint1..N`` and a
 position actuator per joint named like it.
@@ -198,10 +198,10 @@ BUILT_IN = {
         home=HOMES["panda_like"], kp=400, rgba="0.9 0.9 0.92 1"),
 }
 
-"""The built-in arms' MJCF writers (``scripts/make_arm_models.py`` writes them to armtransfer/models/)."""
+"""The built-in arms' MJCF writers (``scripts/make_arm_models.py`` writes them to src/armtransfer/models/)."""
 
 # Home configurations of the spatial arms: the tip over the table centre, pointing down,
-# for the mounting in armtransfer/models/__init__.py (found with mink IK and rounded).
+# for the mounting in src/armtransfer/models/__init__.py (found with mink IK and rounded).
 HOMES: dict[str, list[float]] = {
     "ur5e_like": [-0.323, -1.293, 2.381, -2.66, -1.571, 0.148],
     "panda_like": [0.023, 0.417, -0.01, -2.656, 0.057, 3.073, 0.874],
