@@ -42,7 +42,7 @@ import numpy as np
 from armtransfer import script
 from armtransfer.errors import InvalidParameterError
 from armtransfer.experiments import continuous as runs
-from armtransfer.experiments import learning_metrics, metrics, survival
+from armtransfer.experiments.stats import learning_metrics, metrics, survival
 from armtransfer.experiments.experiment import source_trajectory, trial_rng
 from armtransfer.learning import linear
 from armtransfer.learning.config import LearnerConfig
@@ -234,7 +234,7 @@ def markdown(result: dict) -> str:
 
 def survival_figure(result: dict, path: Path) -> None:
     """Kaplan-Meier curves of first exposure, one panel per pair and task, none against pseudo."""
-    from armtransfer.experiments import figures
+    from armtransfer.experiments.reports import figures
 
     cap = result["config"]["max_total_steps"]
     panels = []

@@ -29,9 +29,10 @@ import numpy as np
 from armtransfer import script
 from armtransfer.errors import ArmTransferError
 from armtransfer.io import check_output_dir, staged_directory, write_json_atomic, write_text_atomic
-from armtransfer.experiments import experiment, metrics
+from armtransfer.experiments import experiment
+from armtransfer.experiments.stats import metrics
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.experiments.report import fmt_ci, markdown_table
+from armtransfer.experiments.reports.report import fmt_ci, markdown_table
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.specs import resolve

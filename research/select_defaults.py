@@ -32,7 +32,7 @@ import numpy as np
 from armtransfer import script
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.grid_robots import grid_robot
-from armtransfer.tasks.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS
 from armtransfer.learning import potentials, methods, sarsa
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig

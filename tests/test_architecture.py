@@ -1,10 +1,9 @@
 """The project's one-way data flow, as the README draws it, checked on the imports.
 
-    errors/io -> models -> ik -> tasks -> learning -> experiments -> armtransfer (API, wrappers, command)
+    errors/io -> models -> worlds -> ik -> tasks -> learning -> experiments -> parallel -> armtransfer (API, wrappers, command)
 
 A module may import its own layer and the layers before it, never a later one; imports
-inside functions count too (only ``if TYPE_CHECKING:`` blocks are left out, since they never
-run). The import graph has no cycles, learning/ never imports MuJoCo, and only the
+inside functions and those for type hints count too. The import graph has no cycles, learning/ never imports MuJoCo, and only the
 ``armtransfer`` namespace is installed.
 """
 
@@ -24,8 +23,8 @@ ROOT = Path(__file__).resolve().parents[1]
 FOUNDATION = ("armtransfer.errors", "armtransfer.checks", "armtransfer.io", "armtransfer.cpus",
               "armtransfer.registration")
 # the layers in the order data flows; the rest of armtransfer (API, wrappers, command) comes last
-LAYERS = ["foundation", "armtransfer.models", "armtransfer.ik", "armtransfer.tasks",
-          "armtransfer.learning", "armtransfer.experiments", "armtransfer"]
+LAYERS = ["foundation", "armtransfer.models", "armtransfer.worlds", "armtransfer.ik", "armtransfer.tasks",
+          "armtransfer.learning", "armtransfer.experiments", "armtransfer.parallel", "armtransfer"]
 MUJOCO = ("mujoco", "dm_control", "mink")
 
 
@@ -39,7 +38,8 @@ def _modules() -> dict[str, Path]:
 
 
 def _layer(module: str) -> int:
-    """0 for the foundation, then models, ik, tasks, learning, experiments; the rest of armtransfer last."""
+    """0 for the foundation, then models, worlds, ik, tasks, learning, experiments, parallel; the rest
+    of armtransfer last."""
     if module in FOUNDATION:
         return 0
     for i, prefix in enumerate(LAYERS[1:-1], start=1):
@@ -48,23 +48,15 @@ def _layer(module: str) -> int:
     return len(LAYERS) - 1
 
 
-def _is_type_checking(node: ast.If) -> bool:
-    t = node.test
-    return (isinstance(t, ast.Name) and t.id == "TYPE_CHECKING") or (
-        isinstance(t, ast.Attribute) and t.attr == "TYPE_CHECKING")
-
-
 def _imports(path: Path, module: str) -> set[str]:
-    """Every module that ``path`` imports, wherever in the file (lazy imports included)."""
+    """Every module that ``path`` imports, wherever in the file: lazy imports and imports for type
+    hints (under ``if TYPE_CHECKING:``) included, since a type hint that names a higher layer is a
+    dependency on it all the same."""
     tree = ast.parse(path.read_text())
     found: set[str] = set()
     package = module if path.name == "__init__.py" else module.rpartition(".")[0]
 
     def visit(node: ast.AST) -> None:
-        if isinstance(node, ast.If) and _is_type_checking(node):
-            for child in node.orelse:
-                visit(child)
-            return
         if isinstance(node, ast.Import):
             found.update(a.name for a in node.names)
         elif isinstance(node, ast.ImportFrom):
@@ -128,9 +120,10 @@ def test_layer_check_catches_an_upward_import(tmp_path):
     deps = _imports(bad, "armtransfer.ik.bad")
     assert "armtransfer.learning.sarsa" in deps
     assert _layer("armtransfer.learning.sarsa") > _layer("armtransfer.ik.bad")
-    guarded = tmp_path / "guarded.py"
-    guarded.write_text("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from armtransfer.tasks import layout\n")
-    assert not any(d.startswith("armtransfer.tasks") for d in _imports(guarded, "armtransfer.ik.guarded"))
+    typed = tmp_path / "typed.py"
+    typed.write_text("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from armtransfer.tasks import robot\n")
+    assert "armtransfer.tasks.robot" in _imports(typed, "armtransfer.ik.typed")
+    assert _layer("armtransfer.tasks.robot") > _layer("armtransfer.ik.typed")
 
 
 def test_learning_and_experiments_never_import_mujoco_statically():

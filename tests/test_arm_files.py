@@ -14,7 +14,7 @@ from armtransfer.ik.scene import ContactChecker, build_scene
 from armtransfer.ik.tool import Tool, parse_offset
 from armtransfer.experiments import sweep as sweeps
 from armtransfer.tasks.arms import arm_robot
-from armtransfer.tasks.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS
 
 # A SCARA with a two-finger gripper: slide fingers typed through a default class, a tendon
 # over them driven by one actuator, a motor (no bias) on the elbow, degrees as the file says.

@@ -11,7 +11,9 @@ import pytest
 
 from armtransfer.cli import main
 from armtransfer.errors import InvalidParameterError
-from armtransfer.experiments import benchmark, benchmark_report, benchmark_stats, metrics, suites, survival
+from armtransfer.experiments import benchmark, suites
+from armtransfer.experiments.reports import benchmark_report
+from armtransfer.experiments.stats import benchmark_stats, metrics, survival
 from armtransfer.learning import methods
 from armtransfer.tasks.grid_robots import grid_robot
 

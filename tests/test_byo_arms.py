@@ -20,7 +20,7 @@ import menagerie_like as ml
 from armtransfer.tasks.arms import tasks_solvable
 from armtransfer.tasks.arms import arm_robot
 from armtransfer.tasks.catalog import TABLE_I
-from armtransfer.tasks.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS
 from test_cli import run_cli  # a fresh interpreter; it inherits the session's ARMTRANSFER_CACHE
 
 UR5E_TOOL = (0.0, 0.0, 0.12)

@@ -42,7 +42,7 @@ def test_same_seed_gives_the_same_json_bit_for_bit(tmp_path):
 
 def test_trajectory_file_round_trip_and_custom_task(tmp_path):
     from armtransfer.tasks.grid_robots import grid_robot
-    from armtransfer.tasks.layout import ROOMS
+    from armtransfer.worlds.layout import ROOMS
     from armtransfer.learning import trajectory
 
     traj = trajectory.shortest(grid_robot("coarse"), ROOMS.cell(0, 0), ROOMS.cell(6, 10))

@@ -11,7 +11,7 @@ from armtransfer.tasks.arms import arm_robot, arm_scene
 from armtransfer.ik.scene import ContactChecker
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.errors import ArmTransferError
-from armtransfer.tasks.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS
 
 DEFAULT_ROBOTS = [("planar2", "joint"), ("planar2", "cartesian"), ("ur5e_like", "cartesian"),
                   ("panda_like", "cartesian")]

@@ -19,7 +19,7 @@ from armtransfer.learning.config import LearnerConfig
 from armtransfer.tasks.arms import robot
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.continuous import continuous_arm
-from armtransfer.tasks.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS
 from armtransfer.wrappers import TransferReward
 
 ROOT = Path(__file__).resolve().parents[1]

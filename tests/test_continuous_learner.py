@@ -9,7 +9,7 @@ from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.grid_robots import grid_robot
-from armtransfer.tasks.layout import ROOMS, Layout
+from armtransfer.worlds.layout import ROOMS, Layout
 
 SMALL = Layout(lo=-3, hi=3, walls=(((0, -3), (0, 3)),), doors=((0, 2),))
 

@@ -15,7 +15,7 @@ from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import ActionMapping
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.grid_robots import grid_robot
-from armtransfer.tasks.layout import Layout
+from armtransfer.worlds.layout import Layout
 
 SMALL = Layout(lo=-4, hi=4, walls=(((0, -4), (0, 4)),), doors=((0, 2),))
 """A 9 x 9 world with two rooms and one door: small enough for the dense reference."""

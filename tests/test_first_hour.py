@@ -11,7 +11,7 @@ import pytest
 
 import armtransfer
 from armtransfer.cli import COMMANDS, build_parser, main
-from armtransfer.experiments import report
+from armtransfer.experiments.reports import report
 
 pd = pytest.importorskip("pandas")  # the 'frames' extra, in the 'test' extra too
 

@@ -12,7 +12,7 @@ from armtransfer.experiments.experiment import run_method
 from armtransfer.models import ARMS, generate, mjcf
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.generated import generate_arm, read_sidecar
-from armtransfer.tasks.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS
 from armtransfer.tasks.specs import resolve
 
 

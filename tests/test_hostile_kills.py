@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 from hypothesis import example, given, settings, strategies as st
 
-from armtransfer.experiments import executors
+from armtransfer.parallel import executors
 from armtransfer.io import clean_stale_staging, staged_directory
 from contract import cmdline, session, settle
 
@@ -58,7 +58,7 @@ def test_a_kill_while_workers_start_leaves_no_process(command, tmp_path):
 
 GUARDED = """
 import time
-from armtransfer.experiments.reaper import guarded_spawn_context
+from armtransfer.parallel.reaper import guarded_spawn_context
 child = guarded_spawn_context().Process(target=time.sleep, args=(120,))
 child.start()
 print(child.pid, flush=True)
@@ -97,7 +97,7 @@ def test_a_guarded_worker_ends_with_its_driver_whatever_it_runs():
 
 REAPED = """
 import subprocess, sys, time
-from armtransfer.experiments.reaper import Reaper
+from armtransfer.parallel.reaper import Reaper
 reaper = Reaper()
 time.sleep(0.2)
 grandchild = ("import subprocess, sys, time; p = subprocess.Popen([sys.executable, '-c', 'import time; "
@@ -171,7 +171,7 @@ def answer(run, robots):
 DRIVER = """
 import sys
 sys.path.insert(0, sys.argv[1])
-from armtransfer.experiments.executors import run_local
+from armtransfer.parallel.executors import run_local
 import faults
 
 if __name__ == "__main__":

@@ -12,7 +12,7 @@ from armtransfer.ik.solve import TipIK
 from armtransfer.models import ARMS
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.errors import ArmTransferError
-from armtransfer.tasks.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS
 
 
 @pytest.fixture(scope="module")

@@ -43,7 +43,7 @@ def test_rooms_are_connected_only_through_doors():
     for door in ROOMS.doors:
         x, y = door
         # closing this door makes some cell pairs farther apart or disconnected
-        from armtransfer.tasks.layout import Layout
+        from armtransfer.worlds.layout import Layout
 
         closed = Layout(ROOMS.lo, ROOMS.hi, ROOMS.walls, tuple(d for d in ROOMS.doors if d != door), ROOMS.rooms)
         robot = grid_robot("fine", closed)

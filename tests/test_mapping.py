@@ -9,7 +9,7 @@ from armtransfer.cli import main
 from armtransfer.errors import InvalidMappingError
 from armtransfer.tasks.catalog import table_task
 from armtransfer.tasks.grid_robots import grid_robot
-from armtransfer.tasks.layout import ROOMS, Layout
+from armtransfer.worlds.layout import ROOMS, Layout
 from armtransfer.learning import reference, methods, sarsa
 from armtransfer.experiments import experiment
 from armtransfer.learning import trajectory as trajectories

@@ -4,9 +4,10 @@ import numpy as np
 import pytest
 
 from armtransfer.tasks.grid_robots import grid_robot
-from armtransfer.tasks.layout import Layout
+from armtransfer.worlds.layout import Layout
 from armtransfer.learning import controls, potentials, methods, rewards, sarsa
-from armtransfer.experiments import experiment, learning_metrics
+from armtransfer.experiments import experiment
+from armtransfer.experiments.stats import learning_metrics
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.errors import InvalidParameterError

@@ -8,7 +8,7 @@ import pytest
 
 from armtransfer.ik.scene import build_scene
 from armtransfer.models import ARMS
-from armtransfer.tasks.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS
 from armtransfer.ik.workspace import wall_boxes
 
 NAMED = [

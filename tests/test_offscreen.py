@@ -197,7 +197,7 @@ def test_opengl_failing_while_drawing_is_an_offscreen_error_and_leaves_nothing(t
     from armtransfer.ik import render
     from armtransfer.ik.replay import replay
     from armtransfer.tasks.arms import robot
-    from armtransfer.tasks.layout import ROOMS
+    from armtransfer.worlds.layout import ROOMS
 
     r = robot("planar2:cartesian")
     path = r.shortest_path(r.start_state(ROOMS.free_cell(0, 0)), ROOMS.free_cell(2, 1))

@@ -10,7 +10,7 @@ from armtransfer.ik.quick import QuickIK
 from armtransfer.ik.scene import build_scene
 from armtransfer.ik.solve import MAX_TIP_HEIGHT, TIP_HEIGHT, TipIK, tilt_limit
 from armtransfer.ik.tool import Tool
-from armtransfer.tasks.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS
 
 CASES = {  # a tool its geometry reaches past (7 joints), and a 5-joint arm whose tool may tilt
     "panda_tcp": (Tool(site="tcp"), (0.0, -0.40, 0.0), np.pi / 2),

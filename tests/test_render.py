@@ -12,7 +12,7 @@ from armtransfer.ik.render import (  # noqa: E402
     PanelRenderer, RenderError, RolloutPanel, render_rollouts, rollout_video)
 from armtransfer.ik.replay import ReplayError, polyline_distance, replay  # noqa: E402
 from armtransfer.errors import ArmTransferError  # noqa: E402
-from armtransfer.tasks.layout import ROOMS  # noqa: E402
+from armtransfer.worlds.layout import ROOMS  # noqa: E402
 
 START, GOAL = (0, 0), (4, 5)  # a few cells apart in room 1, a short replay
 

@@ -6,7 +6,7 @@ import pytest
 import menagerie_like as ml
 from armtransfer.ik.replay import ReplayError, replay
 from armtransfer.tasks.arms import arm_robot
-from armtransfer.tasks.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS
 
 SMALL_UR_MOUNT = dict(base_pos=(0.2, 0.0, 0.0), base_yaw=-1.835)
 """A mount of the small arm beside the room it stands in (one the automatic mount found)."""

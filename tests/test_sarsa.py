@@ -5,7 +5,7 @@ import pytest
 
 from armtransfer.errors import InvalidParameterError
 from armtransfer.tasks.grid_robots import grid_robot
-from armtransfer.tasks.layout import Layout
+from armtransfer.worlds.layout import Layout
 from armtransfer.learning import reference, methods, rewards, sarsa
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig

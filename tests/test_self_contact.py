@@ -9,7 +9,7 @@ import pytest
 
 from armtransfer.ik.scene import ContactChecker, build_scene
 from armtransfer.tasks.arms import arm_robot
-from armtransfer.tasks.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS
 
 # Three planar links at one height, so that a fold puts link3 across link1 (a pair MuJoCo
 # does not filter: they are not parent and child). A tail on link2 sits inside the base's

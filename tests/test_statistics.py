@@ -6,11 +6,13 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from armtransfer.experiments import figures, learning_metrics, metrics
+from armtransfer.experiments.reports import figures
+
+from armtransfer.experiments.stats import learning_metrics, metrics
 from armtransfer.experiments.experiment import MethodResult, summarize
-from armtransfer.experiments.report import method_table
+from armtransfer.experiments.reports.report import method_table
 from armtransfer.learning.sarsa import TrialResult
-from armtransfer.experiments.summary import summarize as sweep_summarize, summary_markdown
+from armtransfer.experiments.reports.summary import summarize as sweep_summarize, summary_markdown
 
 
 def test_t_quantiles_come_from_scipy():

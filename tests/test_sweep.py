@@ -12,11 +12,11 @@ import pytest
 
 from armtransfer.cli import main
 from armtransfer.experiments.execute import execute
-from armtransfer.experiments.executors import run_local
+from armtransfer.parallel.executors import run_local
 from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.experiments import sweep as sweeps
 from armtransfer.experiments.store import ResultStore
-from armtransfer.experiments.summary import summarize
+from armtransfer.experiments.reports.summary import summarize
 
 SWEEP = """
 [sweep]

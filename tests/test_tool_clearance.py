@@ -16,7 +16,7 @@ from armtransfer.ik.scene import build_scene, tool_reach
 from armtransfer.ik.solve import MAX_TIP_HEIGHT, TIP_HEIGHT
 from armtransfer.ik.tool import Tool
 from armtransfer.tasks.arms import arm_robot, tasks_solvable
-from armtransfer.tasks.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS
 
 
 @pytest.fixture(scope="module")

@@ -30,7 +30,7 @@ from armtransfer.experiments.continuous import ContinuousResult
 from armtransfer.experiments.results import MappingInfo, TransferResult
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.catalog import Task, as_xy, custom_task, table_task
-from armtransfer.tasks.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.tasks.specs import resolve
 

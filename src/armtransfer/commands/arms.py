@@ -1,4 +1,4 @@
-"""``armtransfer arms``: transfer between arms (see ``armtransfer.arm_transfer``), and
+"""``armtransfer arms``: transfer between arms (see ``armtransfer.commands.arm_transfer``), and
 ``armtransfer arms list``: the arm robots, their DOF, action models and reachability."""
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="only these action models, comma-separated (e.g. joint,cartesian)")
     parser.add_argument("--cell-size", type=float, default=0.01, help="cell size in metres")
     parser.add_argument("--no-cache", action="store_true", help="compile without the cache")
-    from armtransfer import arm_transfer
+    from armtransfer.commands import arm_transfer
 
     arm_transfer.add_arguments(parser)
 
@@ -48,7 +48,7 @@ def run(args: argparse.Namespace) -> int:
         common.refuse_other_options(args, GENERATE_OPTIONS, "'arms generate'")
         return generate(args)
     if args.action != "list":
-        from armtransfer import arm_transfer
+        from armtransfer.commands import arm_transfer
 
         common.refuse_other_options(args, {a.dest for a in common.options_of(args)} - LIST_ONLY - GENERATE_ONLY,
                                     "an arm transfer ('arms' without list or generate)")

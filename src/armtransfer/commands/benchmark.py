@@ -15,7 +15,9 @@ import time
 from pathlib import Path
 
 from armtransfer.commands import common
-from armtransfer.experiments import benchmark, benchmark_report, benchmark_stats, suites
+from armtransfer.experiments import benchmark, suites
+from armtransfer.experiments.reports import benchmark_report
+from armtransfer.experiments.stats import benchmark_stats
 from armtransfer.io import check_output_dir, staged_directory, write_json_atomic, write_text_atomic
 
 HELP = "Compare every method with the baselines that share its learner on a fixed suite, over many source seeds."

@@ -13,13 +13,14 @@ from pathlib import Path
 
 from armtransfer.commands import common
 from armtransfer.io import check_output_dir, staged_directory, write_json_atomic, write_text_atomic
-from armtransfer.experiments import beyond, figures
+from armtransfer.experiments import beyond
+from armtransfer.experiments.reports import figures
 from armtransfer.experiments import reproduce as rep
-from armtransfer.experiments import reproduce_report as rr
+from armtransfer.experiments.reports import reproduce_report as rr
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import ActionMapping
 from armtransfer.tasks.catalog import TABLE_I
-from armtransfer.tasks.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS
 
 HELP = "Reproduce the paper's tables and figures on the rooms world into one report.md."
 EXAMPLE = "armtransfer reproduce --trials 5 --out runs/paper"

@@ -7,8 +7,9 @@ import argparse
 from armtransfer import api
 from armtransfer.commands import common
 from armtransfer.io import check_distinct_outputs, check_writable, write_json_atomic
-from armtransfer.experiments import experiment, report
+from armtransfer.experiments import experiment
 
+from armtransfer.experiments.reports import report
 HELP = ("Transfer a trajectory between two grid robots of the paper's rooms world and print its "
         "Table II-style table.")
 EXAMPLE = "armtransfer rooms --task 2 --trials 5"

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from armtransfer.io import write_json_atomic, write_text_atomic
 from armtransfer.experiments.store import ResultStore
-from armtransfer.experiments.summary import plot, summarize, summary_markdown
+from armtransfer.experiments.reports.summary import plot, summarize, summary_markdown
 
 HELP = "Turn a result store into tables and a plot: summary.md, summary.json and summary.png."
 EXAMPLE = "armtransfer summarize runs/quick"

@@ -8,7 +8,7 @@ import os
 from armtransfer.commands import common
 from armtransfer.experiments.execute import robot_specs
 from armtransfer.tasks.catalog import custom_task
-from armtransfer.experiments.executors import ExecutorError, _check_reachable, _import_ray, run_local, run_ray
+from armtransfer.parallel.executors import ExecutorError, _check_reachable, _import_ray, run_local, run_ray
 from armtransfer.tasks.specs import resolve
 from armtransfer.experiments import sweep as sweeps
 from armtransfer.learning.config import LearnerConfig

@@ -23,7 +23,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from armtransfer.errors import ArmTransferError, InvalidTaskError
-from armtransfer.experiments import experiment, learning_metrics, suites
+from armtransfer.experiments import experiment, suites
+from armtransfer.experiments.stats import learning_metrics
 from armtransfer.learning import methods
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.trajectory import Trajectory

@@ -16,7 +16,7 @@ from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.experiments import experiment
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.experiments.report import fmt_ci, fmt_mean, fmt_num, markdown_table
+from armtransfer.experiments.reports.report import fmt_ci, fmt_mean, fmt_num, markdown_table
 
 METHODS = ("none", *experiment.SHAPING_METHODS)
 TASKS = (1, 2, 3, 4)
@@ -197,7 +197,7 @@ def oracle_markdown(coarse: DiscreteRobot, fine: DiscreteRobot, trials: int, see
                     config: LearnerConfig) -> tuple[str, dict]:
     """The oracle control: a potential from the true map distance (no robot has it)."""
     from armtransfer.learning import potentials, sarsa
-    from armtransfer.experiments import metrics
+    from armtransfer.experiments.stats import metrics
     from armtransfer.learning.shaping import Shaping
 
     out = {}

@@ -18,7 +18,7 @@ from armtransfer.cpus import cpus as _cpus
 from armtransfer.errors import InvalidParameterError
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.learning import controls, farming, methods, potentials, sarsa
-from armtransfer.experiments import metrics
+from armtransfer.experiments.stats import metrics
 from armtransfer.learning.controls import CONTROLS
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
@@ -384,7 +384,7 @@ def control_trajectories(
 
 def add_transfer_metrics(summary: dict, optimal: int, baseline: str = "none") -> None:
     """Add Taylor and Stone's metrics (``transfer.learning_metrics``) to every method."""
-    from armtransfer.experiments import learning_metrics as lm
+    from armtransfer.experiments.stats import learning_metrics as lm
 
     base = summary.get(baseline)
     if base is None:

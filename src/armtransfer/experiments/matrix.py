@@ -27,7 +27,7 @@ from armtransfer.errors import InvalidParameterError
 from armtransfer.experiments import sweep as sweeps
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.methods import with_baselines
-from armtransfer.experiments.report import markdown_table
+from armtransfer.experiments.reports.report import markdown_table
 
 BOOTSTRAP = 2000
 BOOTSTRAP_SEED = 0

@@ -26,8 +26,9 @@ from collections.abc import Callable
 
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.grid_robots import grid_robot
-from armtransfer.tasks.layout import ROOMS
-from armtransfer.experiments import beyond, experiment, metrics, paper
+from armtransfer.worlds.layout import ROOMS
+from armtransfer.experiments import beyond, experiment, paper
+from armtransfer.experiments.stats import metrics
 from armtransfer.learning.mapping import ActionMapping, MacroTable
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig

@@ -6,7 +6,7 @@ with every trial (:class:`~armtransfer.learning.sarsa.TrialResult`). Control run
 given a shuffled or random trajectory) are kept apart, under ``controls[kind][method]``.
 
 ``to_json()`` is exactly what ``armtransfer rooms --json`` and ``armtransfer arms`` write;
-``to_frame()`` is a tidy pandas DataFrame, one row per trial (``armtransfer.experiments.frames``).
+``to_frame()`` is a tidy pandas DataFrame, one row per trial (``armtransfer.experiments.reports.frames``).
 ``repr()`` is a few lines (task, robots, each method's headline numbers), and in Jupyter the
 result shows the table ``armtransfer rooms`` prints.
 """
@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from armtransfer.experiments import frames, report
+from armtransfer.experiments.reports import frames, report
 from armtransfer.experiments.experiment import MethodResult, summary_of
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import ActionMapping

@@ -188,7 +188,7 @@ class ResultStore:
         runs that failed or are not done yet are named in ``df.attrs`` (``failed``, ``missing``),
         so a partial store is never mistaken for a whole one. Needs pandas
         (``pip install 'armtransfer[frames]'``)."""
-        from armtransfer.experiments import frames
+        from armtransfer.experiments.reports import frames
         from armtransfer.experiments.sweep import expand
         from armtransfer.learning.config import LearnerConfig
 

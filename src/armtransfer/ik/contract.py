@@ -24,7 +24,7 @@ from armtransfer.errors import ArmModelError
 from armtransfer.ik.scene import build_scene
 
 if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never imported
-    from armtransfer.tasks.layout import Layout
+    from armtransfer.worlds.layout import Layout
 
 NAMED = (
     (mujoco.mjtObj.mjOBJ_BODY, "nbody", "body"),

@@ -16,7 +16,7 @@ import numpy as np
 from armtransfer.ik.tool import Tool
 
 if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never imported
-    from armtransfer.tasks.layout import Layout
+    from armtransfer.worlds.layout import Layout
 
 
 @dataclass(frozen=True, eq=False)

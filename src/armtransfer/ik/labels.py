@@ -14,7 +14,7 @@ from armtransfer.ik.scene import ArmScene
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never imported
-    from armtransfer.tasks.layout import Layout
+    from armtransfer.worlds.layout import Layout
 
 OFF_TABLE = -1
 

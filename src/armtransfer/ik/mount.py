@@ -40,7 +40,7 @@ from armtransfer.ik.solve import TIP_HEIGHT
 from armtransfer.ik.tool import Tool
 
 if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never imported
-    from armtransfer.tasks.layout import Layout
+    from armtransfer.worlds.layout import Layout
 
 STRIDE = 4
 """Cells between the lattice points the estimate tries (every 4th cell each way)."""

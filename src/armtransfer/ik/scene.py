@@ -40,7 +40,7 @@ from armtransfer.ik.tool import Tool
 from armtransfer.ik.workspace import DEFAULT_CELL, WALL_HEIGHT, build_workspace
 
 if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never imported
-    from armtransfer.tasks.layout import Layout
+    from armtransfer.worlds.layout import Layout
 
 PREFIX = "arm/"
 TOOL_SITE = "tool_tip"

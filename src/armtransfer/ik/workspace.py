@@ -19,7 +19,7 @@ import numpy as np
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never imported
-    from armtransfer.tasks.layout import Layout
+    from armtransfer.worlds.layout import Layout
 
 
 DEFAULT_CELL = 0.01

@@ -17,7 +17,7 @@ from armtransfer.learning import methods as registry
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.shaping import Shaping
 from armtransfer.learning.trajectory import Trajectory
-from armtransfer.tasks.layout import Layout
+from armtransfer.worlds.layout import Layout
 from armtransfer.tasks.robot import cell_robot
 
 CELL_METHODS = tuple(name for name, m in registry.METHODS.items()

@@ -30,7 +30,7 @@ from armtransfer.learning import shaping as modes
 from armtransfer.learning.rewards import as_list, farming_bound, longest_n, union_index
 from armtransfer.learning.shaping import Shaping
 from armtransfer.learning.trajectory import Trajectory
-from armtransfer.tasks.layout import Layout
+from armtransfer.worlds.layout import Layout
 from armtransfer.tasks.robot import DiscreteRobot
 
 HALF_BOUND = 0.5

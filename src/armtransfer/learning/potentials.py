@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from armtransfer.tasks.layout import Layout
+from armtransfer.worlds.layout import Layout
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.learning.trajectory import Trajectory
 

@@ -22,7 +22,7 @@ from pathlib import Path
 
 
 from armtransfer.errors import InvalidTrajectoryError
-from armtransfer.tasks.layout import ROOMS, Layout
+from armtransfer.worlds.layout import ROOMS, Layout
 from armtransfer.tasks.robot import DiscreteRobot
 
 FORMAT = "armtransfer-trajectory/1"

@@ -2,7 +2,7 @@
 
 from armtransfer.tasks.catalog import TABLE_I, Task, custom_task, table_task
 from armtransfer.tasks.grid_robots import grid_robot
-from armtransfer.tasks.layout import ROOMS, Layout
+from armtransfer.worlds.layout import ROOMS, Layout
 from armtransfer.tasks.robot import DiscreteRobot
 
 __all__ = ["ROOMS", "TABLE_I", "DiscreteRobot", "Layout", "Task", "custom_task", "grid_robot", "table_task"]

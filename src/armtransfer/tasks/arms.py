@@ -29,7 +29,7 @@ from armtransfer.ik.description import ArmDescription
 from armtransfer.ik.tool import Tool
 from armtransfer.errors import ArmModelError, UnknownArmError
 from armtransfer.models import ARMS
-from armtransfer.tasks.layout import ROOMS, Layout
+from armtransfer.worlds.layout import ROOMS, Layout
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.ik.workspace import DEFAULT_CELL, WALL_HEIGHT
 

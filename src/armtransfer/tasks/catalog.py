@@ -6,7 +6,7 @@ import numbers
 from dataclasses import dataclass
 
 from armtransfer.errors import InvalidTaskError
-from armtransfer.tasks.layout import ROOMS, Layout
+from armtransfer.worlds.layout import ROOMS, Layout
 
 
 @dataclass(frozen=True)

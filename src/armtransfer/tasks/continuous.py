@@ -18,7 +18,7 @@ import armtransfer.checks as checks
 from armtransfer.errors import ArmModelError, UnknownArmError
 from armtransfer.ik.workspace import DEFAULT_CELL
 from armtransfer.models import ARMS
-from armtransfer.tasks.layout import ROOMS, Layout
+from armtransfer.worlds.layout import ROOMS, Layout
 
 ACTIONS = ("joint",)
 """The action models a continuous arm has."""

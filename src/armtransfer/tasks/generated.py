@@ -32,7 +32,7 @@ from armtransfer.ik.workspace import DEFAULT_CELL
 from armtransfer.models.generate import ArmDraw, check_family, draw_arm, planar_tip_cells, with_home
 from armtransfer.tasks.arms import SIDECAR_FORMAT, read_sidecar
 from armtransfer.tasks.catalog import TABLE_I
-from armtransfer.tasks.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS
 
 MAX_DRAWS = 12
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from armtransfer.errors import UnknownRobotError
-from armtransfer.tasks.layout import ROOMS, Layout
+from armtransfer.worlds.layout import ROOMS, Layout
 from armtransfer.tasks.robot import DiscreteRobot
 
 DIRECTIONS = ((0, 1), (0, -1), (1, 0), (-1, 0))

@@ -21,7 +21,7 @@ import numpy as np
 
 from armtransfer.errors import InvalidCellError
 from armtransfer.ik.description import ArmDescription
-from armtransfer.tasks.layout import ROOMS, Layout
+from armtransfer.worlds.layout import ROOMS, Layout
 
 
 @dataclass(frozen=True, eq=False)

@@ -7,10 +7,10 @@ Every sentence that states a result is built from that run's numbers; the paper'
 from __future__ import annotations
 
 from armtransfer.tasks.catalog import TABLE_I
-from armtransfer.tasks.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS
 from armtransfer.experiments import beyond, paper
 from armtransfer.learning.mapping import ActionMapping
-from armtransfer.experiments.report import fmt_ci, fmt_mean, fmt_num, markdown_table
+from armtransfer.experiments.reports.report import fmt_ci, fmt_mean, fmt_num, markdown_table
 
 TASKS = (1, 2, 3, 4)
 TOP_ENTRIES = 12

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from armtransfer.experiments import figures, suites
-from armtransfer.experiments.report import fmt_num, markdown_table
+from armtransfer.experiments.reports import figures
+
+from armtransfer.experiments import suites
+from armtransfer.experiments.reports.report import fmt_num, markdown_table
 from armtransfer.learning import methods
 
 

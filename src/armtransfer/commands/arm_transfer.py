@@ -31,9 +31,10 @@ from armtransfer.commands.rooms import print_results, results_table
 from armtransfer.errors import InvalidParameterError
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.trajectory import Trajectory
-from armtransfer.tasks.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS
 from armtransfer.tasks.robot import DiscreteRobot
-from armtransfer.experiments import experiment, figures
+from armtransfer.experiments import experiment
+from armtransfer.experiments.reports import figures
 from armtransfer.tasks.specs import CUSTOM, resolve
 from armtransfer.io import check_distinct_outputs, check_writable, copy_atomic, staged_directory, write_json_atomic, write_text_atomic
 

@@ -15,7 +15,7 @@ from typing import cast
 from armtransfer.experiments.execute import execute
 from armtransfer.errors import ArmTransferError
 from armtransfer.cpus import ENV as CPUS_ENV
-from armtransfer.experiments.pool import DONE, Pool
+from armtransfer.parallel.pool import DONE, Pool
 from armtransfer.tasks.robot import DiscreteRobot
 
 Done = Callable[[dict, dict, float], None]  # (run, result, seconds)
@@ -36,7 +36,7 @@ def run_local(
     runs: list[dict], robots: dict[str, DiscreteRobot], workers: int, on_done: Done, on_failed: Failed,
     retries: int = 2, fn: Callable = execute,
 ) -> None:
-    """A process pool over this machine's cores (:class:`~armtransfer.experiments.pool.Pool`).
+    """A process pool over this machine's cores (:class:`~armtransfer.parallel.pool.Pool`).
 
     Each worker holds one run at a time, so when a worker dies (at any moment, its start-up
     included) the run it held is known: that run is given to a fresh worker, up to
@@ -155,7 +155,7 @@ def run_ray(
                 _check_reachable(address)
                 ray.init(address=address, log_to_driver=False, configure_logging=False)
             else:  # a local instance: its processes are stopped with the sweep, even a killed one
-                from armtransfer.experiments.reaper import Reaper, children_of
+                from armtransfer.parallel.reaper import Reaper, children_of
 
                 reaper = Reaper()
                 before = children_of(os.getpid())

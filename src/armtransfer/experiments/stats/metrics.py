@@ -34,7 +34,7 @@ def mean_ci(values: Sequence[float | None]) -> tuple[float | None, list[float] |
 
     For quantities defined only for some trials (e.g. greedy path lengths of converged
     trials). Exploration steps are censored: use :func:`exploration_stats`."""
-    from armtransfer.experiments.survival import bootstrap_ci
+    from armtransfer.experiments.stats.survival import bootstrap_ci
 
     xs = np.array([v for v in values if v is not None], dtype=np.float64)
     if len(xs) == 0:
@@ -102,7 +102,7 @@ def exploration_stats(values: Sequence[int | None], cap: int) -> dict:
         "median_is_lower_bound": False, "cap_dominated": False}
     if n == 0:
         return out
-    from armtransfer.experiments.survival import bootstrap_ci
+    from armtransfer.experiments.stats.survival import bootstrap_ci
 
     xs = censor(values, cap)
     mean = float(xs.mean())

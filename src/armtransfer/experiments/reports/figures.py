@@ -103,7 +103,7 @@ def curve_means(curves: dict[str, list[list[int]]], greedy: dict[str, list[int |
 def _matrix(trials: list[list[int]], greedy: list[int | None] | None, max_episodes: int) -> np.ndarray:
     """[trials, episodes]: every trial's ``learning_metrics.curve`` over the longest trial's
     episodes (at most ``max_episodes``)."""
-    from armtransfer.experiments.learning_metrics import curve
+    from armtransfer.experiments.stats.learning_metrics import curve
 
     n = min(max_episodes, max(len(t) for t in trials))
     g = greedy or [None] * len(trials)

@@ -64,7 +64,7 @@ class Reaper:
     when they were stopped."""
 
     def __init__(self) -> None:
-        self.proc = subprocess.Popen([sys.executable, "-c", "from armtransfer.experiments.reaper import main; main()"],
+        self.proc = subprocess.Popen([sys.executable, "-c", "from armtransfer.parallel.reaper import main; main()"],
                                      stdin=subprocess.PIPE, text=True, start_new_session=True,
                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         assert self.proc.stdin is not None  # stdin=PIPE always opens it

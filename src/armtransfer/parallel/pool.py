@@ -8,7 +8,7 @@ with its workers: no worker's death can leave it waiting on a pipe that nobody r
 the standard library's pool can (a worker killed while it started left a sweep waiting for
 good).
 
-Workers start from :func:`~armtransfer.experiments.reaper.guarded_spawn_context`, so they end
+Workers start from :func:`~armtransfer.parallel.reaper.guarded_spawn_context`, so they end
 with the driver whatever the moment; they ignore Ctrl-C, which is the driver's to handle.
 """
 
@@ -25,7 +25,7 @@ from multiprocessing.process import BaseProcess
 
 from armtransfer.errors import ArmTransferError
 from armtransfer.cpus import ENV as CPUS_ENV
-from armtransfer.experiments.reaper import guarded_spawn_context
+from armtransfer.parallel.reaper import guarded_spawn_context
 
 Task = Callable[[dict, dict], object]
 """What a worker runs: ``fn(run, robots)``, its answer sent back to the driver."""

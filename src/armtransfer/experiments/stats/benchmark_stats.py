@@ -28,8 +28,8 @@ from collections import defaultdict
 
 import numpy as np
 
-from armtransfer.experiments import survival
-from armtransfer.experiments.metrics import median_is_lower_bound
+from armtransfer.experiments.stats import survival
+from armtransfer.experiments.stats.metrics import median_is_lower_bound
 
 
 def _seed_median(values: list, cap: float) -> tuple[float, bool]:
