@@ -186,3 +186,64 @@ def test_every_module_named_exists(page: Path) -> None:
                 break
             obj = getattr(obj, name)
     assert not wrong, f"{page.relative_to(ROOT)} names modules or attributes that do not exist: {wrong}"
+
+
+def _linked_pages(page: Path) -> set[Path]:
+    """The Markdown pages of the repository a page links to."""
+    found = set()
+    for target in LINK.findall(page.read_text(encoding="utf-8")):
+        if re.match(r"[a-z]+:", target):
+            continue
+        path = (page.parent / target).resolve()
+        if path.suffix == ".md" and path.is_file() and path.is_relative_to(ROOT):
+            found.add(path)
+    return found
+
+
+def reachable_from_readme() -> set[Path]:
+    """Every page a reader gets to from README.md by following links, README.md included."""
+    seen, todo = set(), [ROOT / "README.md"]
+    while todo:
+        page = todo.pop()
+        if page not in seen:
+            seen.add(page)
+            todo.extend(_linked_pages(page) - seen)
+    return seen
+
+
+def test_every_docs_page_is_reachable_from_the_readme() -> None:
+    pages = set((ROOT / "docs").rglob("*.md"))
+    orphans = sorted(str(p.relative_to(ROOT)) for p in pages - reachable_from_readme())
+    assert not orphans, f"docs pages no link leads to from README.md: {orphans}"
+
+
+def test_reachability_follows_links_only(tmp_path: Path) -> None:
+    """The checker itself: a page linked from nowhere is not reached."""
+    reached = reachable_from_readme()
+    assert ROOT / "docs" / "api.md" in reached and ROOT / "BENCHMARKS.md" in reached
+    assert _linked_pages(ROOT / "docs" / "setup.md") <= reached
+    orphan = tmp_path / "orphan.md"
+    orphan.write_text("# Linked from nowhere\n\n[the README](README.md)\n")
+    assert orphan.resolve() not in reached
+
+
+ISSUE_NUMBER = re.compile(r"\bissues?\s*#?\d+|(?<![\w&/])#\d+\b|\bthe issue's\b", re.IGNORECASE)
+"""What a reader of the docs cannot look up: the tracker's numbers, and "the issue's" target."""
+
+
+def _reader_pages() -> list[Path]:
+    return [ROOT / "README.md", ROOT / "BENCHMARKS.md", *sorted((ROOT / "docs").rglob("*.md"))]
+
+
+@pytest.mark.parametrize("page", _reader_pages(), ids=lambda p: str(p.relative_to(ROOT)))
+def test_no_page_names_an_issue(page: Path) -> None:
+    found = [(n, m.group(0)) for n, line in enumerate(page.read_text(encoding="utf-8").splitlines(), 1)
+             for m in ISSUE_NUMBER.finditer(line)]
+    assert not found, f"{page.relative_to(ROOT)} names issues a reader cannot look up (line, text): {found}"
+
+
+def test_issue_pattern_catches_the_forms_seen() -> None:
+    for text in ("on the scene (issue 11).", "see #36", "Issue #4 says", "The issue's target"):
+        assert ISSUE_NUMBER.search(text), text
+    for text in ("a known issue", "results.md#menagerie-arms", "colour &#8212;", "step 36"):
+        assert not ISSUE_NUMBER.search(text), text
