@@ -14,6 +14,8 @@ from functools import cache
 
 import numpy as np
 
+from armtransfer.errors import InvalidParameterError
+
 GLYPH_WIDTH, GLYPH_HEIGHT = 5, 8
 ADVANCE, LINE = GLYPH_WIDTH + 1, GLYPH_HEIGHT + 2
 """Pixels (at scale 1) from one character to the next, and from one line to the next."""
@@ -136,8 +138,10 @@ def draw_lines(image: np.ndarray, lines: Sequence[str], *, corner: str = "top-le
     """Draw ``lines`` into ``image`` (in place, and returned) on a box darkened by ``box_alpha``
     in ``corner`` (``top-left``, ``top-right``, ``bottom-left``, ``bottom-right``); text that
     does not fit the image is cut at its edge."""
+    if not (isinstance(scale, int) and scale >= 1):
+        raise InvalidParameterError(f"scale must be a whole number from 1 up, got {scale!r}")
     if corner not in ("top-left", "top-right", "bottom-left", "bottom-right"):
-        raise ValueError(f"unknown corner {corner!r}; valid corners: top-left, top-right, bottom-left, bottom-right")
+        raise InvalidParameterError(f"unknown corner {corner!r}; valid corners: top-left, top-right, bottom-left, bottom-right")
     lines = [t for t in lines]
     if not lines:
         return image
