@@ -65,9 +65,13 @@ def baseline_of(name: str) -> str | None:
     return named[0] if named else None
 
 
-def methods_to_run(wanted: tuple[str, ...] = suites.METHODS) -> tuple[list[str], list[str]]:
+def methods_to_run(wanted: tuple[str, ...] | None = None) -> tuple[list[str], list[str]]:
     """(the methods to run, in registry order: those of ``wanted`` this build has and every
-    baseline they name; those of ``wanted`` this build does not have)."""
+    baseline they name; those of ``wanted`` this build does not have). ``wanted`` defaults to
+    ``suites.METHODS`` and every method of an installed plugin or registered in this process:
+    a researcher's method is put through the suite beside the built-in ones."""
+    if wanted is None:
+        wanted = (*suites.METHODS, *(m for m in methods.METHODS if m not in methods.BUILTIN))
     chosen: set[str] = set()
 
     def add(name: str) -> None:
