@@ -80,9 +80,10 @@ def test_sweep_and_matrix_run_it_in_worker_processes(site, tmp_path):
     assert f"| {NAME} " in done.stdout
 
 
-@pytest.mark.slow  # the fast suite with every method: about a minute
+@pytest.mark.slow  # the fast suite, the plugin's method and its baseline: 10-30 s
 def test_benchmark_runs_it_against_none(site, tmp_path):
-    cli(site, tmp_path, "benchmark", "--suite", "fast", "--out", "bench")
+    cli(site, tmp_path, "benchmark", "--suite", "fast", "--method", NAME, "--out", "bench")
     results = json.loads((tmp_path / "bench" / "results.json").read_text())
-    assert NAME in results["methods"] and results["baselines"][NAME] == ["none"]
+    assert results["methods"] == ["none", NAME] and results["baselines"][NAME] == ["none"]
+    assert {r["method"] for r in results["records"]} == {"none", NAME}
     assert f"`{NAME}`" in (tmp_path / "bench" / "report.md").read_text()

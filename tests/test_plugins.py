@@ -235,6 +235,24 @@ def test_names_are_checked(registered):
         armtransfer.register_method(index_potential)  # type: ignore[arg-type]
 
 
+def test_the_benchmark_runs_every_plugin_method_beside_the_suites(registered):
+    from armtransfer.experiments import benchmark, suites
+
+    registered(armtransfer.potential_method("mine", "one", index_potential))
+    ran, missing = benchmark.methods_to_run()
+    assert ran[-1] == "mine" and set(suites.METHODS) <= set(ran) and missing == []
+    assert benchmark.methods_to_run(("mine",)) == (["none", "mine"], [])
+
+
+def test_benchmark_method_option_lists_the_valid_names_on_a_typo(tmp_path, capsys):
+    from armtransfer.cli import main
+
+    assert main(["benchmark", "--suite", "fast", "--method", "pseudoo", "--out", str(tmp_path / "b")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("armtransfer benchmark: error: unknown method 'pseudoo'; valid methods: none, pseudo")
+    assert len(err.strip().splitlines()) == 1 and not (tmp_path / "b").exists()
+
+
 def test_worker_processes_refuse_a_run_time_method_in_one_line(registered):
     from armtransfer.commands.sweep import check_runs
 

@@ -140,17 +140,18 @@ def case_cells(case: suites.Case, source: DiscreteRobot, target: DiscreteRobot, 
     return draw_task(source, target, rng)
 
 
-def plan_size(suite: suites.Suite) -> int:
-    """Trials the suite runs (for a progress bar)."""
-    run, _ = methods_to_run()
+def plan_size(suite: suites.Suite, wanted: tuple[str, ...] | None = None) -> int:
+    """Trials the suite runs with the methods ``wanted`` (:func:`methods_to_run`; for a progress bar)."""
+    run, _ = methods_to_run(wanted)
     return sum(len(s.cases) * s.source_seeds * s.trials * len(run) for s in suite.sections)
 
 
 def run_suite(suite: suites.Suite, seed: int = 0, tick: Callable[[], None] | None = None,
-              threads: int | None = None) -> tuple[list[dict], dict]:
-    """Every run of ``suite``: (records, one per (section, case, source seed, method), and the
-    wall times of the run, kept apart so that the records depend on ``seed`` alone)."""
-    run, _ = methods_to_run()
+              threads: int | None = None, wanted: tuple[str, ...] | None = None) -> tuple[list[dict], dict]:
+    """Every run of ``suite`` with the methods ``wanted`` and their baselines (:func:`methods_to_run`):
+    (records, one per (section, case, source seed, method), and the wall times of the run, kept
+    apart so that the records depend on ``seed`` alone)."""
+    run, _ = methods_to_run(wanted)
     robots = Robots({})
     records: list[dict] = []
     timings: dict = {"runs": []}

@@ -14,6 +14,7 @@ registered later.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable, Iterator, MutableMapping, Sequence
 from typing import Generic, TypeVar, overload
 
@@ -28,19 +29,23 @@ class Registry(MutableMapping[str, V], Generic[V]):
         self.builtin: frozenset[str] = frozenset(builtin)
         self._load = load
         self._state = "unloaded"  # -> "loading" -> "loaded"
+        self._lock = threading.RLock()  # another thread waits for the load; the loading one sees its entries
 
     def ensure_loaded(self) -> None:
         """Run the loader once; while it runs (its plugins may look in the registry) only the
         entries so far are seen."""
-        if self._state != "unloaded" or self._load is None:
+        if self._state == "loaded" or self._load is None:
             return
-        self._state = "loading"
-        try:
-            self._load(self)
-        except BaseException:
-            self._state = "unloaded"
-            raise
-        self._state = "loaded"
+        with self._lock:
+            if self._state != "unloaded":  # loaded meanwhile, or this thread's loader looking in
+                return
+            self._state = "loading"
+            try:
+                self._load(self)
+            except BaseException:
+                self._state = "unloaded"
+                raise
+            self._state = "loaded"
 
     def add(self, name: str, value: V) -> None:
         """Add an entry without reading the plugins first (what the loader itself uses)."""
