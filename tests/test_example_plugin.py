@@ -5,6 +5,7 @@ method, ``breadcrumbs``, is then a method of every command, with ``none`` as its
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import os
 import shutil
@@ -26,7 +27,10 @@ def site(tmp_path_factory) -> Path:
     tmp = tmp_path_factory.mktemp("plugin")
     shutil.copytree(PLUGIN, tmp / "src", ignore=shutil.ignore_patterns("build", "*.egg-info", "__pycache__"))
     target = tmp / "site"
-    done = subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--no-build-isolation",
+    # built with this environment's setuptools (no download); a Python whose venvs come without
+    # setuptools (3.12+) builds it in pip's isolated environment instead
+    isolation = [] if importlib.util.find_spec("setuptools") is None else ["--no-build-isolation"]
+    done = subprocess.run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", *isolation,
                            "--target", str(target), str(tmp / "src")], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
     assert list(target.glob("armtransfer_example_plugin-*.dist-info"))
