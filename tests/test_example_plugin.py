@@ -91,3 +91,12 @@ def test_benchmark_runs_it_against_none(site, tmp_path):
     assert results["methods"] == ["none", NAME] and results["baselines"][NAME] == ["none"]
     assert {r["method"] for r in results["records"]} == {"none", NAME}
     assert f"`{NAME}`" in (tmp_path / "bench" / "report.md").read_text()
+
+
+@pytest.mark.slow  # starts a local Ray instance: 10-30 s
+def test_ray_workers_find_it_by_its_entry_point(site, tmp_path):
+    pytest.importorskip("ray", reason="Ray is the cluster extra: pip install -e '.[cluster]'")
+    (tmp_path / "s.toml").write_text(f'[sweep]\nname = "plugin"\ntasks = [1]\npairs = [["coarse", "fine"]]\n'
+                                     f'methods = ["none", "{NAME}"]\nseeds = [0]\ntrials = 2\n')
+    done = cli(site, tmp_path, "sweep", "s.toml", "--out", "sweep", "--executor", "ray", "--workers", "2")
+    assert "2/2 runs in sweep; 0 failed" in done.stdout
