@@ -253,6 +253,46 @@ def test_benchmark_method_option_lists_the_valid_names_on_a_typo(tmp_path, capsy
     assert len(err.strip().splitlines()) == 1 and not (tmp_path / "b").exists()
 
 
+def test_a_sweep_tries_a_plugin_on_each_target_robot_before_it_writes(monkeypatch, tmp_path, task1):
+    """A fault that shows only on one robot (here: any robot with more states than the rooms has
+    cells) stops a sweep in one line naming the plugin and the robot, before its store exists.
+    The plugin is made to look installed (its origin), as the worker processes need."""
+    from dataclasses import replace as with_
+
+    from armtransfer.commands.sweep import check_runs
+
+    def only_cells(cells, trajectory):
+        if len(cells) != 2601:
+            raise ValueError(f"{len(cells)} states")
+        return np.zeros(len(cells))
+
+    m = armtransfer.potential_method("cells-only", "works on the rooms' cells only", only_cells)
+    monkeypatch.setitem(methods.METHODS, "cells-only", with_(m, origin="plugin cells 0.1"))
+    runs = list(sweeps.expand(sweeps.normalise({"sweep": {"tasks": [1], "methods": ["none", "cells-only"],
+                                                          "pairs": [["coarse", "fine"]]}})))
+    with pytest.raises(PluginError, match=r"^plugin cells 0.1, on robot fine: method 'cells-only': its potential "
+                                          r"raised ValueError: \d+ states$"):
+        check_runs(runs)
+
+
+def test_the_benchmark_stops_on_a_plugin_fault_in_one_line_and_writes_nothing(registered, tmp_path, capsys):
+    """A method that refuses a case is recorded as failing it; a plugin that raises is a bug, and
+    the benchmark stops at it (its report is written only when complete)."""
+    from armtransfer.cli import main
+
+    def cells_only(cells, trajectory):
+        if len(cells) != 2601:
+            raise ValueError(f"{len(cells)} states")
+        return np.zeros(len(cells))
+
+    registered(armtransfer.potential_method("cells-only", "works on the rooms' cells only", cells_only))
+    out = tmp_path / "bench"
+    assert main(["benchmark", "--suite", "fast", "--method", "cells-only", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("armtransfer benchmark: error: method 'cells-only': its potential raised ValueError")
+    assert len(err.strip().splitlines()) == 1 and not out.exists() and list(tmp_path.iterdir()) == []
+
+
 def test_worker_processes_refuse_a_run_time_method_in_one_line(registered):
     from armtransfer.commands.sweep import check_runs
 

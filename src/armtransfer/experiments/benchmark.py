@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from armtransfer.errors import ArmTransferError, InvalidTaskError
+from armtransfer.errors import ArmTransferError, InvalidTaskError, PluginError
 from armtransfer.experiments import experiment, suites
 from armtransfer.experiments.stats import learning_metrics
 from armtransfer.learning import methods
@@ -211,6 +211,8 @@ def _run_one(name: str, base: dict, target: DiscreteRobot, start: int, goal: int
             given = [traj] if needs and traj is not None else None
             res = experiment.run_method(name, target, start, goal, given, trials, seed, config, wind=wind,
                                         on_trial=tick, threads=threads)
+        except PluginError:  # a plugin's bug, not a case its method refuses: the run stops, in one line
+            raise
         except ArmTransferError as err:
             rec["error"] = str(err)
     if res is None:

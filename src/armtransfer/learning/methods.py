@@ -183,6 +183,17 @@ def refuse_run_time(names: Iterable[str], where: str) -> None:
                 f"group {plugins.GROUP} (docs/extending.md), or run it with armtransfer.transfer(...)")
 
 
+def probe_on(names: Iterable[str], robots: Iterable[DiscreteRobot]) -> None:
+    """Build every plugin method among ``names`` once on each of ``robots`` (``plugins.probe``): a
+    fault that shows only on one robot is a one-line error before a run that writes starts."""
+    robots = list(robots)
+    for name in dict.fromkeys(names):
+        m = get(name)
+        if m.origin != "armtransfer":
+            for robot in robots:
+                plugins.probe(m, f"{m.origin}, on robot {robot.name}", robot)
+
+
 def get(name: str) -> Method:
     """The method called ``name``; an unknown name is a one-line error listing the valid ones."""
     try:

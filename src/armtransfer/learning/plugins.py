@@ -156,17 +156,27 @@ def _probe_trajectory() -> Trajectory:
     return Trajectory(cells, (0,) * len(cells), ROOMS.cell(-8, 12), source="probe")
 
 
-def probe(method: Method, where: str) -> None:
-    """Build ``method``'s shaping once on the paper's rooms (every cell a state) with a short
-    trajectory: a plugin that raises, or returns the wrong shape or non-finite numbers, is refused
-    now, in one line naming ``where`` it came from, rather than in the middle of a run."""
+def _trajectory_on(robot: DiscreteRobot) -> Trajectory:
+    """A trajectory over the first distinct cells the robot's states perceive (up to 20), ending
+    at another: cells of the robot's own world, whatever its layout."""
+    labels = list(dict.fromkeys(int(c) for c in robot.label[:10_000]))[:21]
+    cells = tuple(labels[:-1]) if len(labels) > 1 else tuple(labels)
+    return Trajectory(cells, (0,) * len(cells), labels[-1], source="probe")
+
+
+def probe(method: Method, where: str, robot: DiscreteRobot | None = None) -> None:
+    """Build ``method``'s shaping once, on ``robot`` with a trajectory over its own cells, or (None)
+    on the paper's rooms (every cell a state) with a short path: a plugin that raises, or returns
+    the wrong shape or non-finite numbers, is refused now, in one line naming ``where`` it came
+    from, rather than in the middle of a run."""
     if method.build is None:
         return
-    robot = cell_robot(ROOMS)
+    traj = _probe_trajectory() if robot is None else _trajectory_on(robot)
+    robot = cell_robot(ROOMS) if robot is None else robot
     try:
         if method.bonus_per_k is not None:
-            method.bonus_per_k(robot, [_probe_trajectory()])
-        method.build(robot, [_probe_trajectory()], 1.0, 1.0)
+            method.bonus_per_k(robot, [traj])
+        method.build(robot, [traj], 1.0, 1.0)
     except PluginError as err:
         raise PluginError(f"{where}: {err}") from None
 
