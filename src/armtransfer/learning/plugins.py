@@ -103,7 +103,7 @@ def _values(name: str, fn: CellFunction, robot: DiscreteRobot, trajs: list[Traje
             raw = fn(given_cells, trajectory_xy(traj, robot))
         except ArmTransferError as err:
             raise PluginError(f"method {name!r}: its {what} raised: {err}") from None
-        except Exception as err:  # noqa: BLE001 - a plugin's bug, said in one line
+        except (Exception, SystemExit) as err:  # noqa: BLE001 - a plugin's bug, said in one line
             raise PluginError(f"method {name!r}: its {what} raised {type(err).__name__}: {err}".splitlines()[0]) from None
         try:
             values = np.asarray(raw, dtype=np.float64)
@@ -178,7 +178,10 @@ def probe(method: Method, where: str, robot: DiscreteRobot | None = None) -> Non
             method.bonus_per_k(robot, [traj])
         method.build(robot, [traj], 1.0, 1.0)
     except PluginError as err:
-        raise PluginError(f"{where}: {err}") from None
+        said, named = str(err), f"method {method.name!r}: "
+        if where.startswith(named[:-2]) and said.startswith(named):  # name the method once
+            said = said[len(named):]
+        raise PluginError(f"{where}: {said}") from None
 
 
 def _describe(ep) -> str:
@@ -198,7 +201,7 @@ def load_entry_points(registry) -> None:
         where = _describe(ep)
         try:
             obj = ep.load()
-        except Exception as err:  # noqa: BLE001 - any failure to import is the plugin's, said in one line
+        except (Exception, SystemExit) as err:  # noqa: BLE001 - any failure to import is the plugin's, in one line
             raise PluginError(f"{where} fails to import: {type(err).__name__}: {err}".splitlines()[0]) from None
         if not isinstance(obj, Method):
             raise PluginError(f"{where} is {type(obj).__name__}, not a method; make it with "
