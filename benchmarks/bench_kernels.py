@@ -5,6 +5,7 @@ baseline of ``armtransfer bench`` moves by half within an hour here) cancels out
     python benchmarks/bench_kernels.py --against 7f3bd4f    # ... and against an older commit's kernel
     python benchmarks/bench_kernels.py --against 7f3bd4f main  # ... and against several
     python benchmarks/bench_kernels.py --fast               # a smoke run
+    python benchmarks/bench_kernels.py --method potential breadcrumbs  # methods' shaping, side by side
 
 Each round runs every contender on the same work, in turn: Table I task 1, the fine robot, no
 transfer, trials back to back until ``--steps`` steps (``armtransfer bench``'s measurement),
@@ -12,7 +13,9 @@ seed = the round. Reported: each contender's median steps/s over the rounds and 
 the per-round ratios to the first. ``--against REV ...`` loads the learner's kernel (``sarsa.py`` and
 its guide) as it was at git revision REV of this checkout, from ``src/armtransfer/learning/`` or, before
 the move, ``transfer/``, beside today's (a revision whose kernel takes other arguments than
-``sarsa.learn`` gives them fails in one line).
+``sarsa.learn`` gives them fails in one line). ``--method NAME ...`` times the plain kernel with
+each method's shaping instead (built once for the fine robot from the coarse robot's shortest path
+of task 1, K='auto'): a plugin's method (``docs/extending.md``) beside a built-in one.
 """
 
 from __future__ import annotations
@@ -104,6 +107,24 @@ def measure(learn, steps: int, seed: int) -> float:
     return done / (time.perf_counter() - t0)
 
 
+def with_method(name: str):
+    """``sarsa.learn`` with method ``name``'s shaping for task 1 (fine robot, the coarse robot's
+    shortest path, K='auto'); a method without a reward term of its own is refused."""
+    import functools
+
+    from armtransfer.learning import methods, trajectory
+
+    m = methods.get(name)
+    if not m.shaped or m.chooses or m.macros:
+        raise ArmTransferError(f"--method takes methods whose transfer is a reward term; valid methods: "
+                               f"{', '.join(n for n in methods.REWARD_ONLY if not methods.get(n).macros)}")
+    start, goal = table_task(1).cells()
+    traj = trajectory.shortest(grid_robot("coarse"), start, goal)
+    config = LearnerConfig()
+    shaping = methods.build_shaping(name, grid_robot("fine"), [traj], "auto", config.step_reward, gamma=config.gamma)
+    return functools.partial(sarsa.learn, shaping=shaping)
+
+
 def guided_kernel_without_guide(*args, **kwargs):
     """``sarsa.learn`` on the kernel compiled with the guide, for a run that has none."""
     plain = sarsa._run_trial
@@ -121,6 +142,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--against", metavar="REV", nargs="+", default=[],
                    help="also time the kernel of each of these git revisions")
     p.add_argument("--fast", action="store_true", help="a smoke run: 2 rounds of 20,000 steps")
+    p.add_argument("--method", metavar="NAME", nargs="+", default=[],
+                   help="time the plain kernel with each of these methods' shaping instead (task 1, fine robot)")
     args = p.parse_args(argv)
     return script.run(_run, args)
 
@@ -131,6 +154,10 @@ def _run(args: argparse.Namespace) -> int:
     rounds, steps = (2, 20_000) if args.fast else (args.rounds, args.steps)
     contenders = {"plain kernel (no guide compiled in)": sarsa.learn,
                   "guided kernel, run without a guide": guided_kernel_without_guide}
+    if args.method:
+        if args.against:
+            raise ArmTransferError("--method and --against do not go together")
+        contenders = {f"method {name}": with_method(name) for name in args.method}
     with tempfile.TemporaryDirectory() as tmp:
         for rev in args.against:
             contenders[f"kernel at {rev}"] = load_revision(rev, Path(tmp)).learn
@@ -144,7 +171,8 @@ def _run(args: argparse.Namespace) -> int:
             for name, learn in contenders.items():
                 rates[name].append(measure(learn, steps, r))
     first = next(iter(rates))
-    print(f"{rounds} rounds of {steps:,} steps each (Table I task 1, fine, no transfer)")
+    what = "coarse's shortest path transferred" if args.method else "no transfer"
+    print(f"{rounds} rounds of {steps:,} steps each (Table I task 1, fine, {what})")
     for name, xs in rates.items():
         ratio = statistics.median(x / y for x, y in zip(xs, rates[first]))
         print(f"  {name}: median {statistics.median(xs):,.0f} steps/s, "

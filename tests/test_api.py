@@ -93,11 +93,7 @@ def test_a_new_method_needs_only_a_registry_entry(monkeypatch):
         return Shaping(modes.MODE_FIRST_VISIT, 2 * base.bonus, base.traj_index, base.phi, k)
 
     new = registry.Method("double", "first-visit paying twice", paper=False, build=double_bonus, auto_k=5.0)
-    monkeypatch.setitem(registry.METHODS, "double", new)
-    monkeypatch.setattr(registry, "SHAPED", registry.SHAPED + ("double",))
-    import armtransfer.experiments.experiment as experiment
-
-    monkeypatch.setattr(experiment, "SHAPING_METHODS", registry.SHAPED)
+    monkeypatch.setitem(registry.METHODS, "double", new)  # SHAPED and the controls' list see it
     r = armtransfer.transfer(methods=["none", "double"], trials=2, seed=0)
     assert r.methods["double"].extra["K"] == 5.0
     assert "double" in r.controls["shuffled"]

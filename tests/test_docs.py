@@ -32,7 +32,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
-PYTHON_PAGES = ("README.md", "docs/api.md")
+PYTHON_PAGES = ("README.md", "docs/api.md", "docs/extending.md")
 """Pages whose ```python blocks stand alone and are run too."""
 LINKED = ("scripts", "research", "benchmarks", "examples", "dev", "tests")
 """Repository folders a block may name by a relative path."""

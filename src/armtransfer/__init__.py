@@ -20,6 +20,10 @@ The public names below are loaded on first use, so importing any part stays chea
     import armtransfer
     result = armtransfer.transfer(source="coarse", target="fine", task=1,
                                   methods=["none", "pseudo"], trials=3, seed=1)
+
+A transfer method of one's own: ``armtransfer.potential_method`` (or ``bonus_method``), declared
+by an installed package under the entry-point group ``armtransfer.methods`` or given to
+``armtransfer.register_method`` (docs/extending.md).
 """
 
 from __future__ import annotations
@@ -36,6 +40,9 @@ _LAZY = {
     "LearnerConfig": "armtransfer.learning.config",
     "METHODS": "armtransfer.learning.methods",
     "Method": "armtransfer.learning.methods",
+    "register_method": "armtransfer.learning.methods",
+    "potential_method": "armtransfer.learning.plugins",
+    "bonus_method": "armtransfer.learning.plugins",
     "resolve_robot": "armtransfer.tasks.specs",
     "register_envs": "armtransfer.registration",
     "TransferReward": "armtransfer.wrappers",

@@ -210,7 +210,7 @@ def transfer(
 def _cell_methods() -> tuple[str, ...]:
     from armtransfer.learning.cells import CELL_METHODS
 
-    return CELL_METHODS
+    return tuple(CELL_METHODS)
 
 
 def _transfer_continuous(source, target, the_task: Task, method_names: list[str], specs, trials: int, seed: int,

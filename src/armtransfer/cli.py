@@ -130,7 +130,12 @@ class _InterruptAgain:
 def _main(argv: list[str]) -> int:
     from armtransfer.errors import ArmTransferError
 
-    parser = build_parser()
+    try:
+        parser = build_parser()  # reads the methods of installed plugins: a broken one is one line
+    except ArmTransferError as err:
+        command = next((a for a in argv if a in COMMANDS), "")
+        print(f"armtransfer{' ' + command if command else ''}: error: {err}", file=sys.stderr)
+        return 2
     args = parser.parse_args(_join_xy_values(argv))
     try:
         from armtransfer.commands.common import refuse_empty

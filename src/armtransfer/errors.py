@@ -53,3 +53,8 @@ class InvalidMappingError(ArmTransferError):
 
 class OutputError(ArmTransferError):
     """An output path cannot be written."""
+
+
+class PluginError(ArmTransferError):
+    """A transfer method from outside the package cannot be used: it fails to import, raises,
+    returns the wrong shape or a non-finite number, or takes a name already taken."""

@@ -31,6 +31,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="output directory, absent or empty; written whole or not at all "
                         "(default runs/benchmark-<suite>-<timestamp>)")
     p.add_argument("--seed", type=common.non_negative_int, default=0, help="random seed, >= 0 (default 0)")
+    p.add_argument("--method", nargs="+", default=None, metavar="METHOD",
+                   help="run only these methods, each beside its baselines (default: the suite's methods and "
+                        "every method of an installed plugin); a method's records are the same bytes either way")
 
 
 def results_bytes(suite: suites.Suite, seed: int, ran: list[str], missing: list[str], records: list[dict],
@@ -46,10 +49,15 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else Path("runs") / _dt.datetime.now().strftime(
         f"benchmark-{suite.name}-%Y%m%d-%H%M%S")
     check_output_dir(out)  # before the long run, not after
-    ran, missing = benchmark.methods_to_run()
+    wanted = None
+    if args.method is not None:
+        from armtransfer.learning import methods
+
+        wanted = tuple(methods.get(m).name for m in args.method)  # a typo lists the valid names
+    ran, missing = benchmark.methods_to_run(wanted)
     t0 = time.perf_counter()
-    with common.progress_bar(benchmark.plan_size(suite), f"benchmark {suite.name}") as bar:
-        records, timings = benchmark.run_suite(suite, args.seed, tick=bar.update)
+    with common.progress_bar(benchmark.plan_size(suite, wanted), f"benchmark {suite.name}") as bar:
+        records, timings = benchmark.run_suite(suite, args.seed, tick=bar.update, wanted=wanted)
     summary = benchmark_stats.summarize(records)
     with staged_directory(out) as tmp:  # out appears only complete
         (tmp / "results.json").write_bytes(results_bytes(suite, args.seed, ran, missing, records, summary))

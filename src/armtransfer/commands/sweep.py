@@ -73,6 +73,9 @@ def check_runs(runs: list[dict]) -> dict:
     at, is a one-line error naming the run's robot and task."""
     if not runs:
         raise sweeps.SweepFileError("the sweep has no runs")
+    from armtransfer.learning.methods import probe_on, refuse_run_time
+
+    refuse_run_time((run["method"] for run in runs), "a sweep's runs")
     arms = {name: arm for run in runs for name, arm in run.get("arms", {}).items()}
     robots = {spec: resolve(spec, arms=arms) for spec in robot_specs(runs)}
     seen = set()
@@ -87,6 +90,7 @@ def check_runs(runs: list[dict]) -> dict:
             robots[spec].start_state(start)
             robots[spec].start_state(goal, what="goal")
     _check_farming_bounds(runs, robots)
+    probe_on((run["method"] for run in runs), [robots[s] for s in dict.fromkeys(run["target"] for run in runs)])
     return robots
 
 

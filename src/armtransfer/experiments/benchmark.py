@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from armtransfer.errors import ArmTransferError, InvalidTaskError
+from armtransfer.errors import ArmTransferError, InvalidTaskError, PluginError
 from armtransfer.experiments import experiment, suites
 from armtransfer.experiments.stats import learning_metrics
 from armtransfer.learning import methods
@@ -65,9 +65,13 @@ def baseline_of(name: str) -> str | None:
     return named[0] if named else None
 
 
-def methods_to_run(wanted: tuple[str, ...] = suites.METHODS) -> tuple[list[str], list[str]]:
+def methods_to_run(wanted: tuple[str, ...] | None = None) -> tuple[list[str], list[str]]:
     """(the methods to run, in registry order: those of ``wanted`` this build has and every
-    baseline they name; those of ``wanted`` this build does not have)."""
+    baseline they name; those of ``wanted`` this build does not have). ``wanted`` defaults to
+    ``suites.METHODS`` and every method of an installed plugin or registered in this process:
+    a researcher's method is put through the suite beside the built-in ones."""
+    if wanted is None:
+        wanted = (*suites.METHODS, *(m for m in methods.METHODS if m not in methods.BUILTIN))
     chosen: set[str] = set()
 
     def add(name: str) -> None:
@@ -136,17 +140,18 @@ def case_cells(case: suites.Case, source: DiscreteRobot, target: DiscreteRobot, 
     return draw_task(source, target, rng)
 
 
-def plan_size(suite: suites.Suite) -> int:
-    """Trials the suite runs (for a progress bar)."""
-    run, _ = methods_to_run()
+def plan_size(suite: suites.Suite, wanted: tuple[str, ...] | None = None) -> int:
+    """Trials the suite runs with the methods ``wanted`` (:func:`methods_to_run`; for a progress bar)."""
+    run, _ = methods_to_run(wanted)
     return sum(len(s.cases) * s.source_seeds * s.trials * len(run) for s in suite.sections)
 
 
 def run_suite(suite: suites.Suite, seed: int = 0, tick: Callable[[], None] | None = None,
-              threads: int | None = None) -> tuple[list[dict], dict]:
-    """Every run of ``suite``: (records, one per (section, case, source seed, method), and the
-    wall times of the run, kept apart so that the records depend on ``seed`` alone)."""
-    run, _ = methods_to_run()
+              threads: int | None = None, wanted: tuple[str, ...] | None = None) -> tuple[list[dict], dict]:
+    """Every run of ``suite`` with the methods ``wanted`` and their baselines (:func:`methods_to_run`):
+    (records, one per (section, case, source seed, method), and the wall times of the run, kept
+    apart so that the records depend on ``seed`` alone)."""
+    run, _ = methods_to_run(wanted)
     robots = Robots({})
     records: list[dict] = []
     timings: dict = {"runs": []}
@@ -206,6 +211,8 @@ def _run_one(name: str, base: dict, target: DiscreteRobot, start: int, goal: int
             given = [traj] if needs and traj is not None else None
             res = experiment.run_method(name, target, start, goal, given, trials, seed, config, wind=wind,
                                         on_trial=tick, threads=threads)
+        except PluginError:  # a plugin's bug, not a case its method refuses: the run stops, in one line
+            raise
         except ArmTransferError as err:
             rec["error"] = str(err)
     if res is None:

@@ -14,11 +14,14 @@ from dataclasses import replace
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.experiments import experiment
+from armtransfer.learning import methods
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.experiments.reports.report import fmt_ci, fmt_mean, fmt_num, markdown_table
 
-METHODS = ("none", *experiment.SHAPING_METHODS)
+SHAPING = methods.BUILTIN_SHAPED
+"""The built-in transfer methods (a plugin's are not part of the paper's reproduction)."""
+METHODS = ("none", *SHAPING)
 TASKS = (1, 2, 3, 4)
 TARGET_RATIO = 10.0
 """Issue target: exploration steps at most this many times the optimal distance."""
@@ -69,7 +72,7 @@ def best_method(res: dict) -> str:
     def worst(m: str) -> float:
         return max(res[t]["results"][m]["mean"] / res[t]["distance"] for t in TASKS)
 
-    return min(experiment.SHAPING_METHODS, key=worst)
+    return min(SHAPING, key=worst)
 
 
 def methods_markdown(res: dict) -> str:
@@ -108,7 +111,7 @@ def methods_markdown(res: dict) -> str:
     ]
     worse = []
     for t in TASKS:
-        for m in experiment.SHAPING_METHODS:
+        for m in SHAPING:
             ci = res[t]["results"][m]["improvement_ci95"]
             if ci is not None and ci[1] < 0:
                 worse.append((t, m))
@@ -136,7 +139,7 @@ def controls_markdown(res: dict, max_steps: int) -> str:
     rows = []
     for t in TASKS:
         r = res[t]["results"]
-        for m in experiment.SHAPING_METHODS:
+        for m in SHAPING:
             rows.append([str(t), m] + [_steps(r[k]) for k in (m, f"{m} [shuffled]", f"{m} [random]")])
     return (
         "### Controls: the same methods with a shuffled and a random trajectory\n\n"
@@ -157,7 +160,7 @@ def _controls_sentence(res: dict) -> str:
     worse = []
     for t in TASKS:
         r = res[t]["results"]
-        for m in experiment.SHAPING_METHODS:
+        for m in SHAPING:
             for kind in ("shuffled", "random"):
                 ci = r[f"{m} [{kind}]"].get("improvement_ci95")
                 if ci is not None and ci[1] < 0:

@@ -22,13 +22,15 @@ from armtransfer.experiments.stats import metrics
 from armtransfer.learning.controls import CONTROLS
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.lazy_registry import Names
 from armtransfer.learning.mapping import DEFAULT_MAX_SPAN, ActionMapping, MacroTable
 from armtransfer.learning.trajectory import Trajectory
 
 T = TypeVar("T")
 SHAPING_METHODS = methods.SHAPED
-METHODS = tuple(methods.METHODS)
-"""Every method's name, from the registry ``armtransfer.learning.methods``."""
+METHODS = Names(methods.METHODS, lambda name, m: True)
+"""Every method's name, from the registry ``armtransfer.learning.methods`` (a live view: a
+plugin's method is among them once the registry has read it)."""
 
 
 def trial_threads() -> int:

@@ -48,10 +48,11 @@ from armtransfer.tasks.catalog import TABLE_I, parse_xy
 from armtransfer.errors import ArmTransferError
 from armtransfer.learning import methods as _methods
 from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.lazy_registry import Names
 
 RUN_FORMAT = "armtransfer-run/1"
-METHODS = tuple(name for name, m in _methods.METHODS.items() if not m.macros)
-"""Every method but `mapping`, whose protocol (tasks in order, one mapping carried from task
+METHODS = Names(_methods.METHODS, lambda name, m: not m.macros)
+"""Every method (a plugin's too) but `mapping`, whose protocol (tasks in order, one mapping carried from task
 to task) is not a grid of independent runs: use `armtransfer rooms --method mapping --mapping PATH`."""
 
 # key -> (default, is a list axis)

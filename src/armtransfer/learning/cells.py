@@ -15,14 +15,14 @@ from collections.abc import Sequence
 from armtransfer.errors import InvalidParameterError
 from armtransfer.learning import methods as registry
 from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.lazy_registry import Names
 from armtransfer.learning.shaping import Shaping
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.worlds.layout import Layout
 from armtransfer.tasks.robot import cell_robot
 
-CELL_METHODS = tuple(name for name, m in registry.METHODS.items()
-                     if not (m.chooses or m.macros or m.is_baseline) and name != "dense")
-"""The methods a robot known only by its label can learn with: no transfer and the reward terms
+CELL_METHODS = Names(registry.METHODS, lambda name, m: not (m.chooses or m.macros or m.is_baseline) and name != "dense")
+"""The methods (a plugin's too: it is paid on labels alone) a robot known only by its label can learn with: no transfer and the reward terms
 paid by the cell reached (``dense`` needs distances over the robot's own states; ``guided``
 and its kin model a table of moves; ``mapping`` needs state numbers for its macros)."""
 

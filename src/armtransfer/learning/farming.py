@@ -176,20 +176,38 @@ def analyse(robot: DiscreteRobot, start_state: int, goal_cell: int, bonus: np.nd
     return FarmingResult(len(trap) > 0, trap, V, sweeps)
 
 
-def _bonus_per_k(robot: DiscreteRobot, trajs: Sequence[Trajectory]) -> np.ndarray:
+def _bonus_per_k(robot: DiscreteRobot, trajs: Sequence[Trajectory], method: str = "pseudo") -> np.ndarray:
+    """The method's bonus per unit of K at every state: the paper's index i, or a plugin's own
+    (``Method.bonus_per_k``)."""
+    per_k = methods.get(method).bonus_per_k
+    if per_k is not None:
+        return per_k(robot, list(trajs))
     eff, _ = rewards.union_index(robot, list(trajs))
     return eff
 
 
+def _old_bound(robot: DiscreteRobot, trajs: Sequence[Trajectory], step_reward: float, method: str) -> float:
+    """The K at and above which standing still on the largest bonus pays: -step_reward/n for the
+    paper's pseudo reward, -step_reward/(the largest bonus per K) for a plugin's."""
+    m = methods.get(method)
+    if m.bonus_per_k is not None:
+        return methods.bonus_bound(m, robot, trajs, step_reward)
+    return rewards.farming_bound(step_reward, trajs)
+
+
 def is_farmable(robot: DiscreteRobot, start_state: int, goal_cell: int,
-                trajs: Trajectory | Sequence[Trajectory], K: float, config, wind: float = 0.0) -> bool:
-    """Exact: does the pseudo reward with this K make some optimal greedy policy loop?"""
+                trajs: Trajectory | Sequence[Trajectory], K: float, config, wind: float = 0.0,
+                method: str = "pseudo") -> bool:
+    """Exact: does ``method``'s state bonus (the pseudo reward) with this K make some optimal
+    greedy policy loop?"""
     trajs = rewards.as_list(trajs)
     if config.gamma >= 1.0:
         # undiscounted: every step pays step_reward + bonus < 0 below the old bound, so any
         # loop costs and the old bound is exact
+        if methods.get(method).bonus_per_k is not None:
+            return K >= _old_bound(robot, trajs, config.step_reward, method)
         return config.step_reward + rewards.longest_n(trajs) * K >= 0
-    res = analyse(robot, start_state, goal_cell, K * _bonus_per_k(robot, trajs),
+    res = analyse(robot, start_state, goal_cell, K * _bonus_per_k(robot, trajs, method),
                   config.step_reward, config.goal_reward, config.gamma, wind)
     return res.farmable
 
@@ -207,7 +225,7 @@ class SafeK:
 
 def largest_safe_k(robot: DiscreteRobot, start_state: int, goal_cell: int,
                    trajs: Trajectory | Sequence[Trajectory], config, wind: float = 0.0,
-                   rel_tol: float = 1e-3, grid: int = 8) -> SafeK:
+                   rel_tol: float = 1e-3, grid: int = 8, method: str = "pseudo") -> SafeK:
     """The largest safe K below the old bound, by bisection, then checked on a grid.
 
     Farmability need not be monotone in K (a larger K changes which detour pays), so after
@@ -216,8 +234,8 @@ def largest_safe_k(robot: DiscreteRobot, start_state: int, goal_cell: int,
     lead to the goal (the goal cannot be reached: not a farming problem).
     """
     trajs = rewards.as_list(trajs)
-    old = rewards.farming_bound(config.step_reward, trajs)
-    per_k = _bonus_per_k(robot, trajs)
+    old = _old_bound(robot, trajs, config.step_reward, method)
+    per_k = _bonus_per_k(robot, trajs, method)
     evals = 0
     V = None
 
@@ -225,6 +243,8 @@ def largest_safe_k(robot: DiscreteRobot, start_state: int, goal_cell: int,
         nonlocal evals, V
         evals += 1
         if config.gamma >= 1.0:
+            if methods.get(method).bonus_per_k is not None:
+                return k >= old
             return config.step_reward + rewards.longest_n(trajs) * k >= 0
         res = analyse(robot, start_state, goal_cell, k * per_k, config.step_reward,
                       config.goal_reward, config.gamma, wind, V0=V)
@@ -256,18 +276,21 @@ def largest_safe_k(robot: DiscreteRobot, start_state: int, goal_cell: int,
 
 
 def auto_k(robot: DiscreteRobot, start_state: int, goal_cell: int,
-           trajs: Trajectory | Sequence[Trajectory], config, wind: float = 0.0) -> float:
+           trajs: Trajectory | Sequence[Trajectory], config, wind: float = 0.0, method: str = "pseudo") -> float:
     """K='auto' for pseudo/mapping, verified safe by VI: half the old bound when value
     iteration finds it safe (one solve, the usual case); otherwise min(half the old bound,
     SAFETY_FRACTION x the largest safe K), halved until VI accepts it (when not monotone)."""
     trajs = rewards.as_list(trajs)
-    half = methods.HALF_BOUND * rewards.farming_bound(config.step_reward, trajs)
-    if not is_farmable(robot, start_state, goal_cell, trajs, half, config, wind):
+    old = _old_bound(robot, trajs, config.step_reward, method)
+    if not np.isfinite(old):  # a plugin's bonus that pays nowhere: nothing to farm, nothing to gain
+        return 0.0
+    half = methods.HALF_BOUND * old
+    if not is_farmable(robot, start_state, goal_cell, trajs, half, config, wind, method):
         return half
-    safe = largest_safe_k(robot, start_state, goal_cell, trajs, config, wind)
+    safe = largest_safe_k(robot, start_state, goal_cell, trajs, config, wind, method=method)
     k = min(half, SAFETY_FRACTION * safe.k)
     for _ in range(60):
-        if not is_farmable(robot, start_state, goal_cell, trajs, k, config, wind):
+        if not is_farmable(robot, start_state, goal_cell, trajs, k, config, wind, method):
             return k
         k *= 0.5
     return 0.0
@@ -289,10 +312,10 @@ def check_k(method: str, robot: DiscreteRobot, start_state: int, goal_cell: int,
     if not m.farmable:
         return k
     if K is None or K == "auto":
-        return auto_k(robot, start_state, goal_cell, trajs, config, wind)
-    old = rewards.farming_bound(config.step_reward, trajs)
-    if k >= old or is_farmable(robot, start_state, goal_cell, trajs, k, config, wind):
-        safe = largest_safe_k(robot, start_state, goal_cell, trajs, config, wind)
+        return auto_k(robot, start_state, goal_cell, trajs, config, wind, m.name)
+    old = _old_bound(robot, trajs, config.step_reward, m.name)
+    if k >= old or is_farmable(robot, start_state, goal_cell, trajs, k, config, wind, m.name):
+        safe = largest_safe_k(robot, start_state, goal_cell, trajs, config, wind, method=m.name)
         raise InvalidParameterError(
             f"K={k:g} can be farmed on this task (gamma={config.gamma:g}, wind={wind:g}): "
             f"the largest safe K is {safe.k:.6g} (old bound -step_reward/n = {old:.6g})"

@@ -4,9 +4,11 @@ the wrappers and the scripts read.
 A method is a name, a one-line description, whether it is the paper's, how its shaping
 arrays are built from a robot and the transferred trajectories (``None``: no shaping), its
 automatic K, whether a too-large K can be farmed, whether it runs mapped macros, and the
-baselines its gain is measured against. Adding a method is one :class:`Method` entry in
-:data:`METHODS` (and, for a new kind of reward term, a mode in ``armtransfer.learning.shaping``
-that the kernel understands).
+baselines its gain is measured against. Adding a built-in method is one :class:`Method` entry
+in :data:`METHODS` (and, for a new kind of reward term, a mode in ``armtransfer.learning.shaping``
+that the kernel understands). A method from outside the package (``armtransfer.learning.plugins``:
+an installed package's entry point, or :func:`register_method` in a notebook) joins
+:data:`METHODS` on its first use, after the built-in ones.
 
 Baselines. A method's gain is measured against a method that shares its learner and differs
 only in what it is told: ``none`` for the reward terms on Algorithm 1 (``pseudo``, ``dense``,
@@ -18,89 +20,21 @@ no-transfer one first, and :func:`with_baselines` adds them to a list of methods
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from collections.abc import Iterable, Sequence
+from dataclasses import replace
 
 import numpy as np
 
-from armtransfer.errors import InvalidParameterError
-from armtransfer.learning import guide, potentials
-from armtransfer.learning.config import LearnerConfig
+from armtransfer.errors import InvalidParameterError, PluginError
+from armtransfer.learning import guide, plugins, potentials
 from armtransfer.learning import shaping as modes
+from armtransfer.learning.lazy_registry import Names, Registry
+from armtransfer.learning.method import DEFAULT_GAMMA, HALF_BOUND, Builder, Method
 from armtransfer.learning.rewards import as_list, farming_bound, longest_n, union_index
 from armtransfer.learning.shaping import Shaping
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.worlds.layout import Layout
 from armtransfer.tasks.robot import DiscreteRobot
-
-HALF_BOUND = 0.5
-"""K='auto' of a method without its own ``auto_k`` starts at this fraction of the farming
-bound -step_reward/n (a farmable method's is then verified by value iteration, see
-``armtransfer.learning.farming``)."""
-
-DEFAULT_GAMMA = LearnerConfig().gamma
-"""The discount :func:`build_shaping` bounds potentials for unless told the learner's."""
-
-Builder = Callable[[DiscreteRobot, list[Trajectory], float, float], Shaping]
-"""(robot, trajectories, K, beta) -> the shaping arrays."""
-
-
-@dataclass(frozen=True)
-class Method:
-    name: str
-    description: str
-    """One line, for --help and reports."""
-    paper: bool
-    """The paper's own method (section III), not one added here."""
-    build: Builder | None = None
-    """The shaping arrays; None for a method without shaping (``none``)."""
-    auto_k: float | None = None
-    """K for ``K='auto'`` in units of -step_reward; None: half the farming bound -step_reward/n.
-    Chosen on held-out start/goal pairs by research/select_defaults.py, never on Table I."""
-    farmable: bool = False
-    """A state bonus that a loop could collect forever: K is checked against farming."""
-    macros: bool = False
-    """Runs the action sequence mapping's macros (needs exactly one trajectory)."""
-    chooses: bool = False
-    """Changes how the learner chooses actions, not only its rewards (so no reward wrapper can
-    give it to another learner)."""
-    baselines: tuple[str, ...] = ()
-    """The methods this one's gain is measured against: each shares its learner (the same
-    updates, the same way of choosing actions) and is told less; the first is told nothing
-    (no transfer). Empty for a method that is itself no transfer (``none``, ``plan``)."""
-    is_baseline: bool = False
-    """Exists to be compared against (run beside the methods naming it in ``baselines``), not a
-    transfer method of its own: the controls (shuffled and random trajectories) and the paper's
-    tables leave it out."""
-    uses_trajectory: bool = True
-    """Reads the transferred trajectories; False for a shaped method that transfers nothing
-    (``plan``), which is then built without them."""
-
-    @property
-    def shaped(self) -> bool:
-        return self.build is not None
-
-    @property
-    def baseline(self) -> str | None:
-        """The no-transfer method that shares this one's learner (None: it is one itself)."""
-        return self.baselines[0] if self.baselines else None
-
-    def resolve_k(self, K: float | str | None, step_reward: float, trajs: Sequence[Trajectory]) -> float:
-        """The K this method uses: ``K`` itself, or its automatic K for 'auto'/None."""
-        if K is None or K == "auto":
-            if step_reward >= 0:
-                raise InvalidParameterError("K='auto' needs a negative step reward (it is scaled by -step_reward)")
-            if self.auto_k is not None:
-                return self.auto_k * -step_reward
-            return HALF_BOUND * farming_bound(step_reward, trajs)
-        try:
-            k = float(K)
-        except (TypeError, ValueError):
-            raise InvalidParameterError(f"K must be a non-negative number or 'auto', got {K!r}") from None
-        if not np.isfinite(k) or k < 0:
-            raise InvalidParameterError(f"K must be a non-negative number or 'auto', got {K!r}")
-        return k
-
 
 def _pseudo(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
     eff, ids = union_index(robot, trajs)
@@ -179,7 +113,7 @@ def _pseudo_plan(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: 
     return Shaping(sh.mode, sh.bonus, sh.traj_index, sh.phi, k, guide=planner_guide(robot))
 
 
-METHODS: dict[str, Method] = {
+_BUILTIN: dict[str, Method] = {
     m.name: m
     for m in (
         Method("none", "Algorithm 1 without transfer", paper=True),
@@ -209,14 +143,55 @@ METHODS: dict[str, Method] = {
                baselines=("plan",), is_baseline=True),
     )
 }
-"""Every method, ``none`` first. The order is the order of reports."""
+"""The built-in methods, ``none`` first."""
 
-SHAPED = tuple(name for name, m in METHODS.items() if m.shaped and not m.macros and not m.is_baseline)
-"""The transfer methods without macros (the controls run these); the baselines are left out."""
+METHODS: Registry[Method] = Registry(_BUILTIN, plugins.load_entry_points)
+"""Every method, ``none`` first: the built-in ones, then those of installed plugins (read on the
+first use) and those registered in this process. The order is the order of reports."""
 
-REWARD_ONLY = tuple(name for name, m in METHODS.items() if m.shaped and not m.chooses)
-"""The methods whose transfer is a reward term alone (what ``armtransfer.wrappers`` can add)."""
-"""The methods that are a reward term only (controls run these)."""
+BUILTIN = tuple(_BUILTIN)
+"""The built-in methods' names (what the paper's reproduction and its reports run)."""
+
+BUILTIN_SHAPED = tuple(name for name, m in _BUILTIN.items() if m.shaped and not m.macros and not m.is_baseline)
+"""The built-in transfer methods without macros: what ``reproduce`` compares beyond the paper,
+whatever plugins are installed."""
+
+SHAPED = Names(METHODS, lambda name, m: m.shaped and not m.macros and not m.is_baseline,
+               "The transfer methods without macros (the controls run these); the baselines are left out.")
+
+REWARD_ONLY = Names(METHODS, lambda name, m: m.shaped and not m.chooses,
+                    "The methods whose transfer is a reward term alone (what ``armtransfer.wrappers`` can add).")
+
+
+def register_method(method: Method, replace: bool = False) -> Method:
+    """Make ``method`` (``armtransfer.potential_method(...)`` or ``armtransfer.bonus_method(...)``)
+    a method of this process, everywhere a built-in one is (``plugins.register``): a notebook's
+    way. Worker processes (a sweep's pool, Ray) do not see it: an installed package's entry point
+    is seen by every process (:func:`refuse_run_time`)."""
+    return plugins.register(METHODS, method, replace=replace)
+
+
+def refuse_run_time(names: Iterable[str], where: str) -> None:
+    """A method registered in this process only (:func:`register_method`) cannot run in other
+    processes, which import the package afresh: a one-line error, before anything is written."""
+    for name in dict.fromkeys(names):
+        m = get(name)
+        if m.origin == plugins.RUN_TIME:
+            raise PluginError(
+                f"method {name!r} was registered in this process (register_method) and {where} run in other "
+                f"processes, which cannot see it; install it as a package declaring it under the entry-point "
+                f"group {plugins.GROUP} (docs/extending.md), or run it with armtransfer.transfer(...)")
+
+
+def probe_on(names: Iterable[str], robots: Iterable[DiscreteRobot]) -> None:
+    """Build every plugin method among ``names`` once on each of ``robots`` (``plugins.probe``): a
+    fault that shows only on one robot is a one-line error before a run that writes starts."""
+    robots = list(robots)
+    for name in dict.fromkeys(names):
+        m = get(name)
+        if m.origin != "armtransfer":
+            for robot in robots:
+                plugins.probe(m, f"{m.origin}, on robot {robot.name}", robot)
 
 
 def get(name: str) -> Method:
@@ -267,8 +242,11 @@ def build_shaping(
     if m.uses_trajectory and trajs is None:
         raise InvalidParameterError(f"method {method!r} needs at least one trajectory")
     trajs = as_list(trajs) if trajs is not None and m.uses_trajectory else []
-    k = m.resolve_k(K, step_reward, trajs)
-    if m.farmable:
+    if m.farmable and m.bonus_per_k is not None:  # a plugin's state bonus: its own largest bonus
+        k = _check_bonus_k(m, robot, trajs, K, step_reward)
+    else:
+        k = m.resolve_k(K, step_reward, trajs)
+    if m.farmable and m.bonus_per_k is None:
         n = longest_n(trajs)
         if step_reward + n * k >= 0:
             raise InvalidParameterError(
@@ -280,3 +258,29 @@ def build_shaping(
     if sh.mode == modes.MODE_POTENTIAL:
         sh = replace(sh, phi=potentials.bounded(sh.phi, gamma, step_reward))
     return sh
+
+
+def bonus_bound(m: Method, robot: DiscreteRobot, trajs: Sequence[Trajectory], step_reward: float) -> float:
+    """The K at and above which standing on the state of ``m``'s largest bonus pays at least as much
+    as moving on: -step_reward / (the largest bonus per K) (inf: no bonus anywhere)."""
+    assert m.bonus_per_k is not None
+    top = float(np.max(m.bonus_per_k(robot, list(trajs)), initial=0.0))
+    return -step_reward / top if top > 0 else float("inf")
+
+
+def _check_bonus_k(m: Method, robot: DiscreteRobot, trajs: list[Trajectory], K: float | str | None,
+                   step_reward: float) -> float:
+    """A plugin's state-bonus K: 'auto' is half the bound :func:`bonus_bound` (``farming.check_k``
+    verifies it by value iteration on the task), a given K is refused at or above the bound."""
+    if (K is None or K == "auto") and m.auto_k is None:
+        if step_reward >= 0:
+            raise InvalidParameterError("K='auto' needs a negative step reward (it is scaled by -step_reward)")
+        bound = bonus_bound(m, robot, trajs, step_reward)
+        return HALF_BOUND * bound if np.isfinite(bound) else 0.0
+    k = m.resolve_k(K, step_reward, trajs)
+    bound = bonus_bound(m, robot, trajs, step_reward)
+    if k >= bound:
+        raise InvalidParameterError(
+            f"K={k:g} can be farmed: step reward {step_reward:g} + method {m.name!r}'s largest bonus "
+            f"{-step_reward / bound:g}*K >= 0; use K < {bound:.6g}")
+    return k

@@ -1,0 +1,1 @@
+"""An example plugin for armtransfer: one transfer method, ``breadcrumbs`` (``method.py``)."""

@@ -1,0 +1,127 @@
+"""A name -> entry mapping that reads its installed plugins on first use, and live views of it.
+
+``armtransfer.learning.methods.METHODS`` is one: its built-in entries are there from the start;
+the entries other packages declare (Python entry points, ``armtransfer.learning.plugins``) are
+read the first time anything looks in the mapping, never at import, so that importing the package
+stays cheap and a plugin's import cost is paid only by a run that reads the registry. A loader
+that raises leaves the mapping unloaded: the next look raises the same error again, so a broken
+plugin cannot be half-registered.
+
+:class:`Names` is a tuple-like view of the names whose entry passes a test, computed on every
+use, so a module can hold, say, "the reward-only methods" as a constant and still see a method
+registered later.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable, Iterator, MutableMapping, Sequence
+from typing import Generic, TypeVar, overload
+
+V = TypeVar("V")
+
+
+class Registry(MutableMapping[str, V], Generic[V]):
+    """The built-in entries, then (on first use) what ``load(registry)`` adds."""
+
+    def __init__(self, builtin: dict[str, V], load: Callable[["Registry[V]"], None] | None = None) -> None:
+        self._entries: dict[str, V] = dict(builtin)
+        self.builtin: frozenset[str] = frozenset(builtin)
+        self._load = load
+        self._state = "unloaded"  # -> "loading" -> "loaded"
+        self._lock = threading.RLock()  # another thread waits for the load; the loading one sees its entries
+
+    def ensure_loaded(self) -> None:
+        """Run the loader once; while it runs (its plugins may look in the registry) only the
+        entries so far are seen."""
+        if self._state == "loaded" or self._load is None:
+            return
+        with self._lock:
+            if self._state != "unloaded":  # loaded meanwhile, or this thread's loader looking in
+                return
+            self._state = "loading"
+            try:
+                self._load(self)
+            except BaseException:
+                self._state = "unloaded"
+                raise
+            self._state = "loaded"
+
+    def add(self, name: str, value: V) -> None:
+        """Add an entry without reading the plugins first (what the loader itself uses)."""
+        self._entries[name] = value
+
+    def peek(self) -> dict[str, V]:
+        """The entries so far, without reading the plugins."""
+        return dict(self._entries)
+
+    def __getitem__(self, name: str) -> V:
+        self.ensure_loaded()
+        return self._entries[name]
+
+    def __setitem__(self, name: str, value: V) -> None:
+        self.ensure_loaded()
+        self._entries[name] = value
+
+    def __delitem__(self, name: str) -> None:
+        self.ensure_loaded()
+        del self._entries[name]
+
+    def __iter__(self) -> Iterator[str]:
+        self.ensure_loaded()
+        return iter(list(self._entries))
+
+    def __len__(self) -> int:
+        self.ensure_loaded()
+        return len(self._entries)
+
+    def __contains__(self, name: object) -> bool:
+        self.ensure_loaded()
+        return name in self._entries
+
+    def __repr__(self) -> str:
+        return f"Registry({list(self._entries)!r}, {self._state})"
+
+
+class Names(Sequence[str], Generic[V]):
+    """The names of ``registry`` whose entry passes ``test``, in the registry's order, computed
+    on every use (a tuple-like view: iterate it, index it, test ``in``, join it)."""
+
+    def __init__(self, registry: Registry[V], test: Callable[[str, V], bool], doc: str = "") -> None:
+        self._registry = registry
+        self._test = test
+        self.__doc__ = doc or None
+
+    def _names(self) -> tuple[str, ...]:
+        return tuple(name for name, entry in self._registry.items() if self._test(name, entry))
+
+    @overload
+    def __getitem__(self, i: int) -> str: ...
+
+    @overload
+    def __getitem__(self, i: slice) -> tuple[str, ...]: ...
+
+    def __getitem__(self, i: int | slice) -> str | tuple[str, ...]:
+        return self._names()[i]
+
+    def __len__(self) -> int:
+        return len(self._names())
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._names())
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._names()
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, Names):
+            return self._names() == other._names()
+        if isinstance(other, (tuple, list)):
+            return self._names() == tuple(other)
+        return NotImplemented
+
+    def __hash__(self) -> int:
+        return id(self)
+
+    def __repr__(self) -> str:
+        return repr(self._names())
