@@ -19,7 +19,7 @@ from pathlib import Path
 
 import armtransfer.checks as checks
 from armtransfer.errors import InvalidCellError, InvalidParameterError, InvalidTaskError
-from armtransfer.learning import farming, potentials
+from armtransfer.learning import potentials
 from armtransfer.experiments import experiment
 from armtransfer.learning import methods as registry
 from armtransfer.learning import trajectory as trajectories
@@ -171,20 +171,22 @@ def transfer(
             mapping_obj.check_new_task(start_cell, goal_cell, tgt.layout)
     shaped = any(registry.get(m).shaped and registry.get(m).uses_trajectory for m in method_names)
     trajs = resolve_trajectories(specs, src, the_task, config, seed) if shaped else []
-    # every method's K, checked before any learning: a farmable method's K by value iteration
-    # over the shaped task (refused in one line naming the largest safe K; 'auto' is verified)
-    k_per_method = {}
+    # every method's shaping, made before any learning and used by its run: a farmable method's
+    # K checked by value iteration over the shaped task (refused in one line naming the largest
+    # safe K; 'auto' is verified), the controls given the same K
+    beta = potentials.DENSE_BETA if beta is None else beta
+    shapings = {}
     for m in method_names:
-        if registry.get(m).shaped:
-            k_per_method[m] = farming.check_k(m, tgt, tgt.start_state(start_cell), goal_cell, trajs, K, config,
-                                              wind)
-            registry.build_shaping(m, tgt, trajs, k_per_method[m], config.step_reward, beta=beta, gamma=config.gamma)
+        made = experiment.method_shaping(m, tgt, tgt.start_state(start_cell), goal_cell, trajs, K, config, wind,
+                                         beta)
+        if made is not None:
+            shapings[m] = made
 
     entries_before = 0 if mapping_obj is None else len(mapping_obj)
     runs, learned = experiment.run_all(
         src, tgt, start_cell, goal_cell, method_names, trajs, trials, seed, config,
-        wind=wind, K=k_per_method, beta=potentials.DENSE_BETA if beta is None else beta,
-        mapping=mapping_obj, max_span=max_span, controls=controls, tick=progress,
+        wind=wind, K={m: sh.K for m, sh in shapings.items()}, beta=beta,
+        mapping=mapping_obj, max_span=max_span, controls=controls, tick=progress, shapings=shapings,
     )
     by_method = {r.method: r for r in runs if r.control is None}
     by_control: dict[str, dict] = {}

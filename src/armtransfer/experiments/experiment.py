@@ -24,6 +24,7 @@ from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.lazy_registry import Names
 from armtransfer.learning.mapping import DEFAULT_MAX_SPAN, ActionMapping, MacroTable
+from armtransfer.learning.shaping import Shaping
 from armtransfer.learning.trajectory import Trajectory
 
 T = TypeVar("T")
@@ -127,6 +128,35 @@ class MethodResult:
                 f"of those reached {mean}>")
 
 
+def method_shaping(
+    method: str,
+    target: DiscreteRobot,
+    start_state: int,
+    goal_cell: int,
+    trajs: Trajectory | Sequence[Trajectory] | None,
+    K: float | str | None,
+    config: LearnerConfig,
+    wind: float = 0.0,
+    beta: float = potentials.DENSE_BETA,
+) -> Shaping | None:
+    """What ``method`` is paid with on this task from ``trajs`` (None for a method without
+    shaping): its K checked (a farmable method's by value iteration over the shaped task;
+    'auto' comes out verified), its arrays built, and its self-loops checked. Each raises one
+    line before any learning; :func:`run_method` calls this once per run (once per trial when
+    each trial has its own trajectories), or takes its answer made earlier."""
+    m = methods.get(method)
+    if not m.shaped:
+        return None
+    if trajs is None and m.uses_trajectory:
+        raise InvalidParameterError(f"method {method!r} needs a trajectory")
+    k = K
+    if m.farmable:
+        k = farming.check_k(method, target, start_state, goal_cell, [] if trajs is None else trajs, K, config, wind)
+    sh = methods.build_shaping(method, target, trajs, k, config.step_reward, beta=beta, gamma=config.gamma)
+    farming.check_self_loops(method, target, goal_cell, sh, config, wind)
+    return sh
+
+
 def run_method(
     method: str,
     target: DiscreteRobot,
@@ -143,26 +173,23 @@ def run_method(
     beta: float = potentials.DENSE_BETA,
     control: str | None = None,
     threads: int | None = None,
+    shaping: Shaping | None = None,
 ) -> MethodResult:
     """``trials`` independent trials of one method on the target robot, on ``threads``
     threads (None: :func:`trial_threads`); the results do not depend on how many. ``traj``:
-    the transferred trajectories, or a function giving each trial its own."""
+    the transferred trajectories, or a function giving each trial its own. ``shaping``: what
+    :func:`method_shaping` made already for this method and ``traj`` (its K is then not
+    checked again); None makes it here."""
     if trials < 1:
         raise InvalidParameterError(f"trials must be a positive integer, got {trials}")
     start_state = target.start_state(start_cell)
     m = methods.get(method)
+    if shaping is not None and (callable(traj) or not m.shaped):
+        raise InvalidParameterError(f"a shaping made in advance goes with one shaped method's trajectories, "
+                                    f"not with {method!r}" + (" and a trajectory per trial" if callable(traj) else ""))
 
     def shaping_for(trajs):
-        if not m.shaped:
-            return None
-        if trajs is None and m.uses_trajectory:
-            raise InvalidParameterError(f"method {method!r} needs a trajectory")
-        k = K
-        if m.farmable:  # the exact check: value iteration over this task ('auto' comes out verified)
-            k = farming.check_k(method, target, start_state, goal_cell, trajs, K, config, wind)
-        sh = methods.build_shaping(method, target, trajs, k, config.step_reward, beta=beta, gamma=config.gamma)
-        farming.check_self_loops(method, target, goal_cell, sh, config, wind)
-        return sh
+        return method_shaping(method, target, start_state, goal_cell, trajs, K, config, wind, beta)
 
     out = MethodResult(method, control=control)
     if callable(traj):  # each trial its own trajectories (the controls: one draw per trial)
@@ -177,12 +204,14 @@ def run_method(
         if m.shaped:
             out.extra["K"] = [sh.K for sh in shapings]
         return out
-    shaping = shaping_for(traj)
+    if shaping is None:
+        shaping = shaping_for(traj)
+    made = shaping
     out.trials = map_trials(lambda trial: sarsa.learn(target, start_state, goal_cell, config, trial_rng(seed, trial),
-                                                      shaping=shaping, wind=wind, macros=macros),
+                                                      shaping=made, wind=wind, macros=macros),
                             trials, threads, on_trial)
-    if shaping is not None:
-        out.extra["K"] = shaping.K
+    if made is not None:
+        out.extra["K"] = made.K
     return out
 
 
@@ -224,18 +253,19 @@ def run_mapping(
     K: float | str | None = "auto",
     on_trial: Callable[[], None] | None = None,
     max_span: int = DEFAULT_MAX_SPAN,
+    shaping: Shaping | None = None,
 ) -> tuple[MethodResult, ActionMapping]:
     """Method ``mapping``: pseudo rewards plus the macros ``mapping`` gives on ``traj``.
 
     Every trial uses ``mapping`` as given (the mappings of earlier tasks only), so trials
     stay independent and deterministic. Returns the result, with ``mapped_fraction`` per
     trial in ``extra``, and a new mapping: ``mapping`` plus what each converged trial's
-    greedy path teaches, added in trial order.
+    greedy path teaches, added in trial order. ``shaping``: see :func:`run_method`.
     """
     table = MacroTable(mapping, traj, target)
     res = run_method(
         "mapping", target, start_cell, goal_cell, traj, trials, seed, config,
-        wind=wind, K=K, macros=table if len(table) else None, on_trial=on_trial,
+        wind=wind, K=K, macros=table if len(table) else None, on_trial=on_trial, shaping=shaping,
     )
     learned = mapping.copy()
     learned.learned_on(start_cell, goal_cell)
@@ -424,10 +454,13 @@ def run_all(
     max_span: int = DEFAULT_MAX_SPAN,
     controls: bool = True,
     tick: Callable[[], None] | None = None,
+    shapings: dict[str, Shaping] | None = None,
 ) -> tuple[list[MethodResult], ActionMapping | None]:
     """Every method on one task, then (``controls``) every reward-only method again with each
-    control trajectory. ``K`` is one K for every method or a dict of K per method. Returns the results in that order and, for ``mapping``, the mapping
-    updated from this task's converged trials."""
+    control trajectory. ``K`` is one K for every method or a dict of K per method;
+    ``shapings`` holds the shaping :func:`method_shaping` made already for a method and
+    ``trajs`` (its K is not checked again). Returns the results in that order and, for
+    ``mapping``, the mapping updated from this task's converged trials."""
     chosen = [methods.get(m) for m in method_names]
     if any(m.shaped and m.uses_trajectory for m in chosen) and not trajs:
         raise InvalidParameterError("the transfer methods need a trajectory")
@@ -440,7 +473,7 @@ def run_all(
         return K.get(name, "auto") if isinstance(K, dict) else K
 
     for m in chosen:
-        kw = dict(wind=wind, K=k_of(m.name), on_trial=tick)
+        kw = dict(wind=wind, K=k_of(m.name), on_trial=tick, shaping=(shapings or {}).get(m.name))
         if m.macros:
             if mapping is None:
                 mapping = ActionMapping.for_robots(source, target)
