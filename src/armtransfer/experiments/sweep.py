@@ -45,6 +45,7 @@ from pathlib import Path
 
 from armtransfer.tasks.catalog import TABLE_I, parse_xy
 from armtransfer.errors import ArmTransferError
+from armtransfer.io import read_input
 from armtransfer.learning import methods as _methods
 from armtransfer.learning.config import LearnerConfig
 
@@ -279,10 +280,9 @@ def expand(spec: dict) -> list[dict]:
 def load(path: str | os.PathLike, max_runs: int = MAX_RUNS) -> Sweep:
     p = Path(path)
     where = f"sweep file {str(p)!r}"
+    data = read_input(p, "sweep file", SweepFileError)
     try:
-        raw = tomllib.loads(p.read_text())
-    except OSError as err:
-        raise SweepFileError(f"cannot read {where}: {err.strerror}") from None
+        raw = tomllib.loads(data.decode("utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
         raise SweepFileError(f"{where} is not valid TOML: {str(err).splitlines()[0]}") from None
     except RecursionError:

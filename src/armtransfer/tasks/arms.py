@@ -28,6 +28,7 @@ from armtransfer.ik.actions import ACTION_MODELS, action_model
 from armtransfer.ik.description import ArmDescription
 from armtransfer.ik.tool import Tool
 from armtransfer.errors import ArmModelError, UnknownArmError
+from armtransfer.io import check_input, read_input
 from armtransfer.models import ARMS
 from armtransfer.worlds.layout import ROOMS, Layout
 from armtransfer.tasks.robot import DiscreteRobot
@@ -112,6 +113,10 @@ def file_arm_name(path: Path) -> str:
     import xml.etree.ElementTree as ET
 
     try:
+        check_input(path, "arm MJCF", ArmModelError)  # a FIFO would hang the parser
+    except ArmModelError:
+        return path.stem  # the error is the reader's to give
+    try:
         for _, element in ET.iterparse(str(path), events=("start",)):
             name = (element.get("model") or "").strip()
             return name or path.stem
@@ -156,10 +161,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
         for what, value in (("tip_site", tip_site), ("tip_body", tip_body), ("arm_name", arm_name)):
             if value is not None:
                 checks.name(value, what, error=ArmModelError)
-        try:
-            xml_bytes = path.read_bytes()
-        except OSError as err:
-            raise ArmModelError(f"cannot read arm MJCF {str(path)!r}: {err.strerror or err}") from None
+        xml_bytes = read_input(path, "arm MJCF", ArmModelError)
         tool = make_tool(tip_site, tip_body, tip_offset)
         name = arm_name or arm or file_arm_name(path)
         kind, source = "custom", "given"
