@@ -27,9 +27,11 @@ def parser(doc: str | None) -> OneLineParser:
 
 def run(body: Callable[..., int | None], *args) -> int:
     """``body(*args)``'s exit code, or 2 after one line on stderr for an ``ArmTransferError``."""
+    from armtransfer.environment import check_environment
     from armtransfer.errors import ArmTransferError
 
     try:
+        check_environment()  # before anything is written, as the command does
         return int(body(*args) or 0)
     except ArmTransferError as e:
         print(f"error: {e}", file=sys.stderr)

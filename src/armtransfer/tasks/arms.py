@@ -522,7 +522,10 @@ def read_sidecar(xml_path: str | os.PathLike) -> dict | None:
     from armtransfer.io import parse_json_bytes
 
     path = Path(xml_path).with_suffix(".json")
-    raw = _cache.read_regular(path)
+    try:
+        raw: bytes | None = read_input(path, "generated arm's file", ArmModelError)
+    except ArmModelError:  # absent, or no regular file of a readable size: not the generator's
+        raw = None
     try:
         data = parse_json_bytes(raw) if raw is not None else None
     except ValueError:
