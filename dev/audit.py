@@ -59,18 +59,20 @@ class Runner:
         self.in_process = in_process
         self.cache = cache
 
-    def env(self, folder: Path, own_cache: bool) -> dict:
-        return {**os.environ, "ARMTRANSFER_CACHE": str(folder / "cache" if own_cache else self.cache)}
+    def env(self, folder: Path, own_cache: bool, extra: dict | None = None) -> dict:
+        return {**os.environ, "ARMTRANSFER_CACHE": str(folder / "cache" if own_cache else self.cache), **(extra or {})}
 
-    def cli(self, folder: Path, *argv: str, own_cache: bool = False, timeout: float = 300) -> Ran:
+    def cli(self, folder: Path, *argv: str, own_cache: bool = False, timeout: float = 300,
+            env: dict | None = None) -> Ran:
+        """``env``: variables set for this command only."""
         if not self.in_process:
             proc = subprocess.run([sys.executable, "-m", "armtransfer.cli", *argv], cwd=folder, capture_output=True,
-                                  text=True, env=self.env(folder, own_cache), timeout=timeout)
+                                  text=True, env=self.env(folder, own_cache, env), timeout=timeout)
             return Ran(proc.returncode, proc.stdout, proc.stderr)
         from armtransfer.cli import main
 
         out, err = io.StringIO(), io.StringIO()
-        with inside(folder, self.env(folder, own_cache)), contextlib.redirect_stdout(out), \
+        with inside(folder, self.env(folder, own_cache, env)), contextlib.redirect_stdout(out), \
                 contextlib.redirect_stderr(err):
             try:
                 code = main(list(argv))
@@ -131,13 +133,20 @@ def completed(ran: Ran, folder: Path) -> None:
         raise Failed(f"left {left[:3]} behind")
 
 
-def cli_refused(argv: list[str], *words: str, setup: Callable[[Path], None] | None = None, own_cache=False):
-    """A case: the command ``argv`` run after ``setup`` is refused in one line naming ``words``."""
+def cli_refused(argv: list[str], *words: str, setup: Callable[[Path], None] | None = None, own_cache=False,
+                env: dict | None = None, within: float = 0):
+    """A case: the command ``argv`` run after ``setup`` (with the variables ``env``) is refused
+    in one line naming ``words`` (and, with ``within``, in at most that many seconds)."""
     def case(r: Runner, d: Path) -> str:
         if setup:
             setup(d)
         before = listing(d)
-        return refused(r.cli(d, *argv, own_cache=own_cache), before, d, *words)
+        t0 = time.monotonic()
+        line = refused(r.cli(d, *argv, own_cache=own_cache, env=env), before, d, *words)
+        secs = time.monotonic() - t0
+        if within and secs > within:
+            raise Failed(f"refused, but after {secs:.0f} s")
+        return line
     return case
 
 
@@ -431,6 +440,196 @@ def transfer_reward(env_id: str, task: int):
     return call
 
 
+# ---- the nine causes of the second audit -------------------------------------------------
+
+LONG = "x" * 300
+"""A file name longer than any file system takes (255 bytes)."""
+
+
+def fifo(name: str) -> Callable[[Path], None]:
+    def setup(d: Path) -> None:
+        os.mkfifo(d / name)
+    return setup
+
+
+def padded_arm(d: Path) -> None:
+    """The scara, valid, padded with a 60 MB comment."""
+    with open(d / "padded.xml", "w") as fh:
+        fh.write(SCARA_XML.replace("<worldbody>", "<!--" + "x" * 60_000_000 + "--><worldbody>", 1))
+
+
+_STORES: dict[bool, Path] = {}
+"""The one-run store, made once per process and runner kind, copied into each case's folder."""
+
+
+def one_run_store(d: Path, r: Runner) -> Path:
+    """A finished one-run store ``d/store`` of the one-run sweep ``d/s.toml``."""
+    import atexit
+    import shutil
+
+    (d / "s.toml").write_text(SWEEP.format(seeds=[0]).replace('"none", "pseudo"', '"none"'))
+    if r.in_process not in _STORES:
+        made = Path(tempfile.mkdtemp(prefix="armtransfer-audit-store-"))
+        atexit.register(shutil.rmtree, made, True)
+        (made / "s.toml").write_bytes((d / "s.toml").read_bytes())
+        completed(r.cli(made, "sweep", "s.toml", "--out", "store", "--workers", "1"), made)
+        _STORES[r.in_process] = made / "store"
+    shutil.copytree(_STORES[r.in_process], d / "store", symlinks=True)
+    return d / "store"
+
+
+def edited_store(edit: Callable[[Path], None], argv: list[str], *words: str):
+    """A case: a finished store edited by ``edit`` (given the store); ``argv`` is refused in
+    one line naming ``words``, and nothing is written."""
+    def case(r: Runner, d: Path) -> str:
+        store = one_run_store(d, r)
+        edit(store)
+        before = listing(d)
+        return refused(r.cli(d, *argv), before, d, *words)
+    return case
+
+
+def edit_json(name: str, change: Callable[[dict], object]) -> Callable[[Path], None]:
+    def edit(store: Path) -> None:
+        path = store / name
+        data = json.loads(path.read_text())
+        change(data)
+        path.write_text(json.dumps(data))
+    return edit
+
+
+def failed_record(key: object) -> Callable[[Path], None]:
+    """The store's run recorded as failed too, its record's ``key`` replaced by ``key``."""
+    def edit(store: Path) -> None:
+        (run,) = (store / "runs").glob("*.json")
+        record = json.loads(run.read_text())
+        (store / "failed" / run.name).write_text(json.dumps({"key": key, "config": record["config"], "error": "x",
+                                                             "attempts": 1}))
+    return edit
+
+
+def edited_method(r: Runner, d: Path) -> str:
+    """A run file whose method was edited is not summarised under the edited name: it is set
+    aside (the run will be redone)."""
+    store = one_run_store(d, r)
+    (run,) = (store / "runs").glob("*.json")
+    record = json.loads(run.read_text())
+    record["config"]["method"] = "pseudo"
+    run.write_text(json.dumps(record))
+    ran = r.cli(d, "summarize", "store")
+    completed(ran, d)
+    if "pseudo" in (store / "summary.md").read_text() or not (store / "bad" / run.name).is_file():
+        raise Failed("the edited run is summarised as it claims")
+    if "does not match its key" not in ran.err:
+        raise Failed(f"not said: {ran.err.strip()[:100]}")
+    return "exit 0, set aside: does not match its key"
+
+
+def seeds_x_to_frame(r: Runner, d: Path) -> str:
+    from armtransfer.errors import ArmTransferError
+    from armtransfer.experiments.store import ResultStore
+
+    store = one_run_store(d, r)
+    edit_json("sweep.json", lambda m: m["spec"].__setitem__("seeds", ["x"]))(store)
+    try:
+        ResultStore.open_existing(store).to_frame()
+    except ArmTransferError as err:
+        if "sweep.json" not in str(err) or "seeds" not in str(err) or "\n" in str(err):
+            raise Failed(f"{type(err).__name__}: {str(err)[:100]}") from None
+        return f"{type(err).__name__}, one line naming the field"
+    except Exception as err:  # noqa: BLE001 - the finding
+        raise Failed(f"{type(err).__name__} (not an ArmTransferError): {str(err)[:100]}") from None
+    raise Failed("accepted")
+
+
+def unwritable_runs(r: Runner, d: Path) -> str:
+    """Resuming a store whose runs/ takes no files (a link to /sys, which root cannot write
+    either) is refused before any run, and its files are left as they were."""
+    store = one_run_store(d, r)
+    for run in (store / "runs").glob("*.json"):
+        run.unlink()
+    (store / "runs").rmdir()
+    os.symlink("/sys", store / "runs")
+    data = {p: p.read_bytes() for p in store.rglob("*") if p.is_file() and not p.is_symlink() and "runs" not in p.parts}
+    before = listing(d)
+    line = refused(no_learning(lambda: r.cli(d, "sweep", "s.toml", "--out", "store", "--workers", "1"))
+                   if r.in_process else r.cli(d, "sweep", "s.toml", "--out", "store", "--workers", "1"),
+                   before, d, "runs", "does not take new files")
+    if any(p.read_bytes() != b for p, b in data.items()):
+        raise Failed("a file of the store was rewritten")
+    return line
+
+
+def full_disk_store(r: Runner, d: Path) -> str:
+    """A store whose first file cannot be written (the disk is full: ENOSPC, injected at the
+    write) is refused and leaves nothing, no .lock, in a new or an empty --out."""
+    import errno as _errno
+
+    from armtransfer.errors import ArmTransferError
+    from armtransfer.experiments import store as _store
+    from armtransfer.experiments import sweep as _sweep
+
+    (d / "s.toml").write_text(SWEEP.format(seeds=[0]))
+    (d / "empty").mkdir()
+    before = listing(d)
+    real = _store.write_json_atomic
+
+    def full(path, data):
+        raise OSError(_errno.ENOSPC, os.strerror(_errno.ENOSPC), str(path))
+
+    _store.write_json_atomic = full
+    try:
+        for out in ("new/store", "empty"):
+            try:
+                _store.ResultStore.open_for(d / out, _sweep.load(d / "s.toml"))
+            except (OSError, ArmTransferError):
+                pass
+            else:
+                raise Failed(f"{out}: opened on a full disk")
+    finally:
+        _store.write_json_atomic = real
+    if listing(d) != before:
+        raise Failed(f"left {sorted(set(listing(d)) - set(before))[:3]} behind")
+    return "refused, nothing left (no .lock)"
+
+
+def stdout(argv: list[str], redirect: str, env: dict | None = None, expect: str = "refused",
+           setup: Callable[[Path], None] | None = None):
+    """A case: ``armtransfer ARGV`` with stdout ``redirect``ed (always a new process: a shell's
+    redirection): 'full' (/dev/full), 'closed' (>&-), or 'ascii' (``env`` makes it ASCII-only).
+    'refused': one line on stderr, non-zero exit, no traceback; else exit 0 and ``expect``
+    printed."""
+    def case(r: Runner, d: Path) -> str:
+        import shlex
+
+        if setup:
+            setup(d)
+        line = f"{shlex.quote(sys.executable)} -m armtransfer.cli {' '.join(map(shlex.quote, argv))}"
+        shell = {"full": f"{line} >/dev/full", "closed": f"{line} >&-", "ascii": line}[redirect]
+        proc = subprocess.run(["bash", "-c", shell], cwd=d, capture_output=True, text=True, timeout=300,
+                              env=r.env(d, False, env))
+        lines = proc.stderr.strip().splitlines()
+        if expect != "refused":
+            completed(Ran(proc.returncode, proc.stdout, proc.stderr), d)
+            if "Traceback" in proc.stderr or expect not in proc.stdout:
+                raise Failed(f"{expect!r} not printed: {proc.stdout.strip()[-100:]}")
+            return f"exit 0, {expect} printed"
+        if proc.returncode == 0 or len(lines) != 1 or "Traceback" in proc.stderr or "stdout" not in lines[0]:
+            raise Failed(f"exit {proc.returncode}, {len(lines)} stderr lines: {(lines or [''])[-1][:100]}")
+        return f"exit {proc.returncode}, one line"
+    return case
+
+
+def continuous_reset_bogus():
+    e = env("armtransfer/ContinuousArmRooms-v0")()
+    e.reset(seed=0, options={"bogus": 1})
+
+
+def nonempty_generate_out(d: Path) -> None:
+    (d / "g").mkdir()
+    (d / "g" / "mine.txt").write_text("keep\n")
+
+
 # ---- Ray, determinism ------------------------------------------------------------------
 
 def ray_address_not_ray(r: Runner, d: Path) -> str:
@@ -680,6 +879,90 @@ CASES: list[Case] = [
          api_refused(transfer_reward("armtransfer/Rooms-v0", 2), "InvalidTrajectoryError", "the task is")),
     Case("TransferReward, a grid robot's trajectory on an arm", "refused",
          api_refused(transfer_reward("armtransfer/ArmRooms-v0", 1), "InvalidTrajectoryError", "grid robot")),
+    # the second audit's nine causes: 1. environment variables, checked before anything is written
+    *[Case(f"ARMTRANSFER_CPUS={v} sweep", "refused", cli_refused(
+        ["sweep", "s.toml", "--out", "st"], "ARMTRANSFER_CPUS", setup=write("s.toml", SWEEP.format(seeds=[0])),
+        env={"ARMTRANSFER_CPUS": v})) for v in ("0", "abc", "-3", "1000000000")],
+    Case("ARMTRANSFER_CACHE below a file", "refused",
+         cli_refused(["rooms", "--trials", "1", "--json", "o.json"], "ARMTRANSFER_CACHE",
+                     setup=write("f", "x"), env={"ARMTRANSFER_CACHE": "f/cache"})),
+    # 2. input files: regular files only, bounded
+    Case("a FIFO as a sweep file", "refused", cli_refused(["sweep", "f", "--out", "st"], "FIFO", setup=fifo("f"),
+                                                        within=30)),
+    Case("a FIFO as a trajectory file", "refused",
+         cli_refused(["rooms", "--method", "pseudo", "--trajectory", "f", "--json", "o.json"], "FIFO",
+                     setup=fifo("f"), within=30)),
+    Case("a FIFO as a mapping file", "refused",
+         cli_refused(["rooms", "--method", "mapping", "--mapping", "f", "--json", "o.json"], "FIFO",
+                     setup=fifo("f"), within=30)),
+    Case("a device as an arm file", "refused",
+         cli_refused(["arms", "list", "--arm", "planar2", "--arm-xml", "/dev/zero"], "character device", within=30)),
+    Case("an arm file padded with a 60 MB comment", "refused at once",
+         cli_refused(["arms", "list", "--arm", "planar2", "--arm-xml", "padded.xml", "--tip-site", "pen_tip"],
+                     "over the bound", setup=padded_arm, within=30)),
+    # 3. an OS error on a path: one line naming it
+    *[Case(f"{name} a 300-character name", "refused",
+           cli_refused(argv, "File name too long", setup=write("s.toml", SWEEP.format(seeds=[0]))))
+      for name, argv in (("rooms --json", ["rooms", "--json", f"{LONG}.json", "--trials", "1"]),
+                         ("sweep --out", ["sweep", "s.toml", "--out", LONG]),
+                         ("summarize DIR", ["summarize", LONG]),
+                         ("arms --out", [*FAST_ARMS, "--out", LONG]),
+                         ("bench --json", ["bench", "--json", f"{LONG}.json"]),
+                         ("arms generate --out", ["arms", "generate", "--family", "planar", "--dof", "2", "--out",
+                                                  LONG]),
+                         ("matrix --out", ["matrix", "--robots", "coarse,fine", "--methods", "none", "pseudo",
+                                           "--out", LONG]),
+                         ("reproduce --out", ["reproduce", "--out", LONG]),
+                         ("benchmark --out", ["benchmark", "--suite", "standard", "--out", LONG]))],
+    Case("ARMTRANSFER_CACHE a 300-character name", "refused",
+         cli_refused(["arms", "list", "--arm", "planar2"], "ARMTRANSFER_CACHE", "File name too long",
+                     env={"ARMTRANSFER_CACHE": LONG})),
+    Case("--arm-name of 400 characters", "refused",
+         cli_refused(["arms", "list", "--arm", "planar2", "--arm-xml", "scara.xml", "--tip-site", "pen_tip",
+                      "--arm-name", "n" * 400], "--arm-name", "400 characters", setup=scara)),
+    # 4. the store's own files, checked on read
+    Case("sweep.json without spec: summarize", "refused",
+         edited_store(edit_json("sweep.json", lambda m: m.pop("spec")), ["summarize", "store"], "sweep.json", "spec")),
+    Case("sweep.json spec a string: summarize", "refused",
+         edited_store(edit_json("sweep.json", lambda m: m.__setitem__("spec", "x")), ["summarize", "store"],
+                      "sweep.json", "spec")),
+    Case("failed record whose key is a list: summarize", "refused",
+         edited_store(failed_record([1]), ["summarize", "store"], "failed", "field 'key'")),
+    Case("failed record whose key is a number: summarize", "refused",
+         edited_store(failed_record(3), ["summarize", "store"], "failed", "field 'key'")),
+    # 5. stdout that cannot be written
+    Case("arms list >/dev/full", "one line, non-zero", stdout(["arms", "list", "--arm", "planar2"], "full"),
+         slow=True),
+    Case("rooms >/dev/full", "one line, non-zero", stdout(["rooms", "--trials", "1"], "full")),
+    Case("--version >/dev/full", "one line, non-zero", stdout(["--version"], "full")),
+    Case("--help >/dev/full", "one line, non-zero", stdout(["--help"], "full")),
+    Case("--version >&-", "one line, non-zero", stdout(["--version"], "closed")),
+    Case("rooms >&-", "one line, non-zero", stdout(["rooms", "--trials", "1"], "closed")),
+    # 6. an unencodable stdout
+    Case("a non-ASCII store name under an ASCII locale", "completes, escaped",
+         stdout(["sweep", "s.toml", "--out", "st\u00e9", "--workers", "1"], "ascii", expect="st\\xe9",
+                env={"PYTHONIOENCODING": "ascii", "LC_ALL": "C"}, setup=write("s.toml", SWEEP.format(seeds=[0])))),
+    # 7. a refusal before the work it would waste, nothing left behind
+    Case("resume a store whose runs/ takes no files", "refused before running", unwritable_runs),
+    Case("a store on a full disk", "refused, no .lock", full_disk_store),
+    # 8. arm names checked against the built-ins and NAME:ACTIONS
+    Case("--arm-name planar2", "refused",
+         cli_refused(["arms", "list", "--arm", "planar2", "--arm-xml", "scara.xml", "--tip-site", "pen_tip",
+                      "--arm-name", "planar2"], "name of a built-in robot", setup=scara)),
+    Case('model="a:b"', "refused",
+         cli_refused(["arms", "list", "--arm", "planar2", "--arm-xml", "ab.xml", "--tip-site", "pen_tip"],
+                     "model attribute", "NAME:ACTIONS", setup=write("ab.xml", SCARA_XML.replace("my_scara", "a:b")))),
+    Case("a newline in --arm-name", "refused",
+         cli_refused(["arms", "list", "--arm", "planar2", "--arm-xml", "scara.xml", "--tip-site", "pen_tip",
+                      "--arm-name", "a\nb"], "--arm-name", "letters", setup=scara)),
+    # 9. the remaining gaps
+    Case("a run file whose method was edited: summarize", "set aside, not summarised", edited_method),
+    Case('seeds ["x"] in sweep.json: to_frame()', "refused", seeds_x_to_frame),
+    Case('ContinuousArmRooms-v0 reset(options={"bogus": 1})', "refused",
+         api_refused(continuous_reset_bogus, "InvalidParameterError", "bogus")),
+    Case("arms generate into a non-empty --out", "refused",
+         cli_refused(["arms", "generate", "--family", "planar", "--dof", "2", "--out", "g"], "not empty",
+                     setup=nonempty_generate_out)),
     # Ray, determinism
     Case("Ray address served by a plain TCP listener", "refused fast, no store", ray_address_not_ray, slow=True),
     Case("two stores of one sweep", "byte-identical", same_sweep_same_bytes, slow=True),

@@ -107,7 +107,7 @@ def test_the_matrix_takes_the_file_as_custom_or_by_its_name(tmp_path, scara_xml)
                                                                       "or my_scara:ACTIONS)"),
     (["--robots", "planar2:joint,coarse", "--tip-site", "pen"], "--tip-site goes with --arm-xml"),
     (["--robots", "planar2:joint,custom:joint", "--arm-xml", "{xml}", "--arm-name", "coarse"],
-     "named 'coarse', as a built-in robot is"),
+     "--arm-name 'coarse' is the name of a built-in robot"),
     (["--robots", "planar2:joint,custom:joint,my_scara:joint", "--arm-xml", "{xml}"],
      "lists each robot once"),
     (["--robots", "planar2:joint,custom:joint"], "robot 'custom' needs --arm-xml"),

@@ -42,6 +42,11 @@ def test_the_audit_covers_every_class_of_the_contract():
     names = " ".join(c.name for c in audit.CASES)
     for word in ("--out", "cache", "mount", "<include>", "10**20", "NaN", "TOML", "''", "--method bogus",
                  "[arms.", "jumps", "XML", "transfer(", "step(", "TransferReward", "Ray", "two stores",
-                 "SIGKILL sweep", "SIGKILL matrix", "SIGKILL arms"):
+                 "SIGKILL sweep", "SIGKILL matrix", "SIGKILL arms",
+                 # the second audit's nine causes
+                 "ARMTRANSFER_CPUS", "ARMTRANSFER_CACHE", "FIFO", "60 MB", "300-character", "sweep.json",
+                 "failed record", "/dev/full", ">&-", "ASCII locale", "runs/ takes no files", "full disk",
+                 "--arm-name planar2", 'model="a:b"', "newline", "method was edited", 'seeds ["x"]', "reset(",
+                 "arms generate into a non-empty"):
         assert word in names, f"no audit case for {word!r}"
     assert len({c.name for c in audit.CASES}) == len(audit.CASES)

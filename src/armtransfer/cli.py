@@ -8,6 +8,7 @@ one line on stderr with exit code 2; anything else is a bug and keeps its traceb
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
 import sys
 import textwrap
@@ -139,12 +140,33 @@ def _main(argv: list[str]) -> int:
     args = parser.parse_args(_join_xy_values(argv))
     try:
         from armtransfer.commands.common import refuse_empty
+        from armtransfer.environment import check_environment
 
         refuse_empty(args)
+        check_environment()  # before anything is written
         return int(args._run(args) or 0)
     except ArmTransferError as err:
         print(f"armtransfer {args.command}: error: {err}", file=sys.stderr)
         return 2
+    except OSError as err:
+        if isinstance(err, BrokenPipeError) or not _on_a_path(err):
+            raise  # a bug keeps its traceback
+        from armtransfer.io import path_error
+
+        print(f"armtransfer {args.command}: error: {path_error(err)}", file=sys.stderr)
+        return 2
+
+
+_DISK_ERRNOS = frozenset(getattr(errno, name) for name in ("ENOSPC", "EDQUOT", "EROFS", "EIO", "EFBIG")
+                         if hasattr(errno, name))
+
+
+def _on_a_path(err: OSError) -> bool:
+    """Whether ``err`` is the file system's answer about a path the user chose (a name too
+    long, no permission, a full or read-only disk, a file where a folder belongs, ...): one
+    line naming the path, exit 2. Every path a command writes is checked before its work; this
+    catches the ones the file system refuses anyway."""
+    return err.filename is not None or err.errno in _DISK_ERRNOS
 
 
 def run() -> None:

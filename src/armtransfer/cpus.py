@@ -16,16 +16,19 @@ from armtransfer.errors import InvalidParameterError
 ENV = "ARMTRANSFER_CPUS"
 """The environment variable that sets :func:`cpus` (default: the CPUs this process may use)."""
 
+MAX_CPUS = 4096
+"""The most threads ``$ARMTRANSFER_CPUS`` may ask for (a larger value is a mistake)."""
+
 
 def cpus() -> int:
     """``$ARMTRANSFER_CPUS``, else the CPUs this process may use."""
     value = os.environ.get(ENV, "").strip()
     if value:
         try:
-            n = int(value)
+            n = int(value) if len(value) <= 12 else 0
         except ValueError:
             n = 0
-        if n < 1:
-            raise InvalidParameterError(f"{ENV} must be a positive integer, got {value!r}")
+        if not 1 <= n <= MAX_CPUS:
+            raise InvalidParameterError(f"{ENV} must be an integer in 1..{MAX_CPUS:,}, got {value[:40]!r}")
         return n
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)

@@ -6,6 +6,7 @@ import fcntl
 import json
 import os
 import shutil
+import stat
 import tempfile
 import time
 from collections.abc import Iterator
@@ -74,6 +75,12 @@ def check_output_dir(out: str | os.PathLike, flag: str = "--out") -> None:
     """Fail early when ``out`` cannot become a new output directory: it must be absent or an
     empty directory, somewhere writable."""
     out = Path(out)
+    try:
+        os.stat(out)
+    except FileNotFoundError:
+        pass
+    except OSError as err:
+        raise path_error(err, out, "write") from None
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
         raise OutputError(f"output directory {str(out)!r} exists and is not empty; choose a new {flag}")
     check_writable(out / "results.json")
@@ -217,11 +224,29 @@ def check_distinct_outputs(files: dict[str, object], dirs: dict[str, object] | N
                                       "put it elsewhere")
 
 
+def path_error(err: OSError, path: str | os.PathLike | None = None, verb: str = "use") -> OutputError:
+    """An OS error on a path (a name too long, a full or read-only disk, no permission, a file
+    where a folder belongs, ...) as one line naming the path: ``cannot use 'PATH': REASON``."""
+    where = path if path is not None else err.filename
+    if where is None:
+        return OutputError(f"cannot {verb} a file: {err.strerror or err}")
+    shown = os.fsdecode(where) if isinstance(where, bytes) else str(where)
+    if len(shown) > 120:  # a name too long to use is too long to show whole
+        shown = f"{shown[:60]}...{shown[-40:]} ({len(shown)} characters)"
+    return OutputError(f"cannot {verb} {shown!r}: {err.strerror or err}")
+
+
 def check_writable(path: str | os.PathLike) -> None:
     """Fail early (before any work) when ``path`` cannot be created: its nearest existing
     directory must take a new file (tried for real: permission bits say nothing for root or
     for special file systems such as /proc)."""
     p = Path(path)
+    try:
+        os.stat(p)  # a name too long, a loop of links, ... (a missing file is fine)
+    except FileNotFoundError:
+        pass
+    except OSError as err:
+        raise path_error(err, p, "write") from None
     if p.is_dir():
         raise OutputError(f"cannot write {str(p)!r}: it is a directory")
     probe = p.parent if str(p.parent) else Path(".")
@@ -256,11 +281,61 @@ def read_json(path: str | os.PathLike, what: str, error: type[ArmTransferError])
     """Parse a JSON file; an unreadable or malformed one raises ``error`` with one line
     naming ``what`` ("trajectory file", "mapping file", ...) and the problem."""
     p = Path(path)
-    try:
-        raw = p.read_bytes()
-    except OSError as err:
-        raise error(f"cannot read {what} {str(p)!r}: {err.strerror}") from None
+    raw = read_input(p, what, error)
     try:
         return parse_json_bytes(raw)
     except ValueError as err:
         raise error(f"{what} {str(p)!r} {err}") from None
+
+
+MAX_INPUT_BYTES = 16 * 2**20
+"""The largest input file read (a trajectory, a mapping, a sweep file, an arm file): 16 MiB,
+far above any real one; a larger file is refused before it is read."""
+
+_KINDS = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
+          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+
+
+def _refuse_unless_regular(st: os.stat_result, p: Path, what: str, error: type[ArmTransferError], limit: int) -> None:
+    if not stat.S_ISREG(st.st_mode):
+        kind = next((name for test, name in _KINDS if test(st.st_mode)), "not a regular file")
+        raise error(f"{what} {str(p)!r} is {kind}, not a regular file")
+    if st.st_size > limit:
+        raise error(f"{what} {str(p)!r} is {st.st_size:,} bytes, over the bound of {limit:,} bytes for an input file")
+
+
+def check_input(path: str | os.PathLike, what: str, error: type[ArmTransferError], limit: int = MAX_INPUT_BYTES) -> Path:
+    """``path`` when it is a regular file (links followed) of at most ``limit`` bytes, for a
+    reader that opens it itself (MuJoCo's); else ``error``, one line naming ``what``, the path
+    and the problem: a FIFO would hang the reader, a device or a padded file read without
+    bound. Nothing is opened."""
+    p = Path(path)
+    try:
+        st = os.stat(p)
+    except OSError as err:
+        raise error(f"cannot read {what} {str(p)!r}: {err.strerror or err}") from None
+    _refuse_unless_regular(st, p, what, error, limit)
+    return p
+
+
+def read_input(path: str | os.PathLike, what: str, error: type[ArmTransferError], limit: int = MAX_INPUT_BYTES) -> bytes:
+    """The bytes of the input file ``path``: opened only when it is a regular file (without
+    blocking, so a FIFO is refused, not waited on) and read only up to ``limit`` bytes. Every
+    input file this project reads goes through here (or :func:`check_input`); anything else is
+    ``error``, one line naming ``what`` ("trajectory file", "sweep file", ...) and the path."""
+    p = Path(path)
+    try:
+        fd = os.open(p, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+    except OSError as err:
+        raise error(f"cannot read {what} {str(p)!r}: {err.strerror or err}") from None
+    try:
+        _refuse_unless_regular(os.fstat(fd), p, what, error, limit)
+        with os.fdopen(fd, "rb", closefd=False) as fh:
+            data = fh.read(limit + 1)
+    except OSError as err:
+        raise error(f"cannot read {what} {str(p)!r}: {err.strerror or err}") from None
+    finally:
+        os.close(fd)
+    if len(data) > limit:  # it grew after the check
+        raise error(f"{what} {str(p)!r} is over the bound of {limit:,} bytes for an input file")
+    return data

@@ -27,9 +27,11 @@ def parser(doc: str | None) -> OneLineParser:
 
 def run(body: Callable[..., int | None], *args) -> int:
     """``body(*args)``'s exit code, or 2 after one line on stderr for an ``ArmTransferError``."""
+    from armtransfer.environment import check_environment
     from armtransfer.errors import ArmTransferError
 
     try:
+        check_environment()  # before anything is written, as the command does
         return int(body(*args) or 0)
     except ArmTransferError as e:
         print(f"error: {e}", file=sys.stderr)
@@ -46,6 +48,60 @@ def stdout_closed() -> int:
     return 141
 
 
+class StdoutError(Exception):
+    """stdout cannot be written (a full disk, ``>/dev/full``, an I/O error); the one line."""
+
+
+class GuardedStdout:
+    """sys.stdout for :func:`exit_with`: a write or flush that fails with an OS error other
+    than a closed pipe raises :class:`StdoutError` once (one line, not a traceback; argparse's
+    --help and --version would swallow an OSError and exit 0 with their text lost), and every
+    later write is dropped. Characters the stream cannot encode (``PYTHONIOENCODING=ascii``)
+    are written escaped (``\xe9``) instead of raising."""
+
+    def __init__(self, stream) -> None:
+        self._stream = stream
+        self.failed: StdoutError | None = None
+        try:
+            stream.reconfigure(errors="backslashreplace")
+        except (AttributeError, ValueError, OSError):
+            pass
+
+    def _guard(self, call, *args):
+        if self.failed is not None:
+            return None
+        try:
+            return call(*args)
+        except BrokenPipeError:
+            raise
+        except OSError as err:
+            self.failed = StdoutError(f"cannot write to stdout: {err.strerror or err}")
+            _discard_stdout(self._stream)
+            raise self.failed from None
+
+    def write(self, text: str) -> int:
+        result = self._guard(self._stream.write, text)
+        return len(text) if result is None else result
+
+    def flush(self) -> None:
+        self._guard(self._stream.flush)
+
+    def __getattr__(self, name: str):
+        return getattr(self._stream, name)
+
+
+def _discard_stdout(stream) -> None:
+    """Point fd 1 at /dev/null and drop ``stream``'s buffer, so that the interpreter's last
+    flush does not fail again (with a second message) at exit."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, stream.fileno())
+        os.close(devnull)
+        stream.flush()
+    except (OSError, ValueError, AttributeError):
+        pass
+
+
 def exit_with(main: Callable[[], int | None]) -> NoReturn:
     """A script's (and the command's) ``__main__``: ``sys.exit(main())``, quiet when its
     reader stops reading.
@@ -54,6 +110,13 @@ def exit_with(main: Callable[[], int | None]) -> NoReturn:
     raised while a C extension runs Python code marks the interpreter, which then ends itself
     with SIGINT at shutdown even though ``main`` caught it, and the shell would see a signal
     instead of code 130."""
+    prog = os.path.basename(sys.argv[0]) if sys.argv and sys.argv[0] not in ("", "-c", "-m") else "armtransfer"
+    if prog in ("__main__.py", "cli.py"):
+        prog = "armtransfer"
+    if sys.stdout is None:  # started with stdout closed (>&-): fd 1 may be any file opened later
+        print(f"{prog}: error: stdout is closed; run it with stdout open (e.g. >/dev/null)", file=sys.stderr)
+        sys.exit(2)
+    stdout = sys.stdout = GuardedStdout(sys.stdout)
     code: str | int | None
     try:
         try:
@@ -63,6 +126,12 @@ def exit_with(main: Callable[[], int | None]) -> NoReturn:
         sys.stdout.flush()  # inside the try: a closed pipe shows here, not at shutdown
     except BrokenPipeError:
         code = stdout_closed()
+    except StdoutError as err:
+        print(f"{prog}: error: {err}", file=sys.stderr)
+        code = 2
+    if stdout.failed is not None and code in (0, None):  # failed, and the failure was swallowed
+        print(f"{prog}: error: {stdout.failed}", file=sys.stderr)
+        code = 2
     if code == 130:
         sys.stderr.flush()
         os._exit(130)

@@ -135,6 +135,9 @@ def generate(args: argparse.Namespace) -> int:
     known = FAMILIES.get(args.family)  # None: an unknown family, which check_family names before any dof
     dof = args.dof if args.dof is not None or known is None else known[0]
     check_family(args.family, dof)
+    from armtransfer.io import check_output_dir
+
+    check_output_dir(args.out)  # absent or empty, as --out's help says
     with common.phase("drawing and compiling"):
         arm = generate_arm(args.family, dof, args.seed, args.out, progress=common.interactive())
     for line in arm.rejected:

@@ -300,6 +300,10 @@ def arm_file_options(args: argparse.Namespace) -> dict:
         raise ArmModelError("give --tip-site or --tip-body, not both")
     if args.arm_name is not None and not args.arm_name.strip():
         raise ArmModelError("--arm-name must not be empty")
+    if args.arm_name is not None:
+        from armtransfer.tasks.arms import check_arm_name
+
+        check_arm_name(args.arm_name, "--arm-name")
     return dict(tip_site=args.tip_site, tip_body=args.tip_body,
                 tip_offset=parse_offset(args.tip_offset) if args.tip_offset is not None else None,
                 tool=parse_held(args.tool).spec() if getattr(args, "tool", None) is not None else None,

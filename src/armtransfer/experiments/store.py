@@ -15,13 +15,14 @@ from __future__ import annotations
 
 import fcntl
 import os
+import shutil
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, cast
 
 from armtransfer.errors import ArmTransferError
-from armtransfer.io import OutputError, parse_json_bytes, write_json_atomic
-from armtransfer.experiments.sweep import Sweep
+from armtransfer.io import OutputError, check_writable, parse_json_bytes, read_input, write_json_atomic
+from armtransfer.experiments.sweep import Sweep, SweepFileError, check_stored, content_key
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -60,17 +61,28 @@ class ResultStore:
             raise StoreError(
                 f"output directory {str(store.root)!r} is not empty and holds no sweep; choose a new --out"
             )
+        created = _highest_missing(store.root)  # removed again if the store cannot be opened
+        had_lock = os.path.lexists(store.root / LOCK)
         store.lock()
-        if not meta_path.exists():
-            write_json_atomic(meta_path, {"format": STORE_FORMAT, "name": sweep.name, "key": sweep.key,
-                                          "spec": sweep.spec})
-        for d in (store.runs_dir, store.failed_dir, store.timings_dir):
-            try:
-                d.mkdir(parents=True, exist_ok=True)
-            except OSError as err:
-                raise OutputError(f"cannot write {str(d)!r}: {err.strerror}") from None
-            for tmp in d.glob(".*.tmp"):
-                tmp.unlink(missing_ok=True)
+        try:
+            if not meta_path.exists():
+                write_json_atomic(meta_path, {"format": STORE_FORMAT, "name": sweep.name, "key": sweep.key,
+                                              "spec": sweep.spec})
+            for d in (store.runs_dir, store.failed_dir, store.timings_dir):
+                try:
+                    d.mkdir(parents=True, exist_ok=True)
+                except OSError as err:
+                    raise OutputError(f"cannot write {str(d)!r}: {err.strerror}") from None
+                check_writable(d / "probe.json")  # before any run: a run's result is never lost to it
+                for tmp in d.glob(".*.tmp"):
+                    tmp.unlink(missing_ok=True)
+        except BaseException:
+            store.unlock()
+            if created is not None:
+                shutil.rmtree(created, ignore_errors=True)
+            elif not had_lock:
+                (store.root / LOCK).unlink(missing_ok=True)
+            raise
         return store
 
     def lock(self) -> None:
@@ -108,11 +120,22 @@ class ResultStore:
     def _read_meta(self) -> dict:
         path = self.root / "sweep.json"
         try:
-            meta = parse_json_bytes(path.read_bytes())
-        except (OSError, ValueError):
+            meta = parse_json_bytes(read_input(path, "sweep.json", StoreError))
+        except (StoreError, ValueError):
             raise StoreError(f"{str(path)!r} is unreadable; this is not a sweep directory") from None
         if not isinstance(meta, dict) or meta.get("format") != STORE_FORMAT:
             raise StoreError(f"{str(path)!r} is not an armtransfer sweep")
+        for field, kind in (("name", str), ("key", str)):
+            if not isinstance(meta.get(field), kind) or not meta[field]:
+                raise StoreError(f"{str(path)!r}: field {field!r} must be a non-empty string, got "
+                                 f"{meta.get(field)!r:.60}")
+        try:
+            check_stored(meta.get("spec"), repr(str(path)))
+        except SweepFileError as err:
+            raise StoreError(str(err)) from None
+        if content_key(meta["spec"]) != meta["key"]:
+            raise StoreError(f"{str(path)!r}: field 'spec' does not match field 'key' (the file was edited); "
+                             "this store cannot be trusted")
         return meta
 
     @property
@@ -128,12 +151,12 @@ class ResultStore:
         the wrong shape is reported on stderr and set aside into DIR/bad/ (so the run is
         redone), never fatal."""
         path = self.run_path(key)
-        try:
-            raw = path.read_bytes()
-        except FileNotFoundError:
+        if not os.path.lexists(path):
             return None
-        except OSError as err:
-            self._set_aside(path, f"cannot be read ({err.strerror})")
+        try:
+            raw = read_input(path, "run file", StoreError)
+        except StoreError as err:  # a FIFO, a device, a folder, no permission, beyond the bound
+            self._set_aside(path, f"cannot be read ({str(err).rpartition(repr(str(path)))[2].strip(' :')})")
             return None
         try:
             record = parse_json_bytes(raw)
@@ -162,8 +185,8 @@ class ResultStore:
 
     def write_run(self, run: dict, result: dict, elapsed: float) -> None:
         key = run["key"]
-        write_json_atomic(self.timings_dir / f"{key}.json", {"key": key, "elapsed_seconds": round(elapsed, 3)})
         write_json_atomic(self.run_path(key), {"key": key, "config": run, "result": result})
+        write_json_atomic(self.timings_dir / f"{key}.json", {"key": key, "elapsed_seconds": round(elapsed, 3)})
         (self.failed_dir / f"{key}.json").unlink(missing_ok=True)
 
     def write_failure(self, run: dict, error: str, attempts: int) -> None:
@@ -211,18 +234,46 @@ class ResultStore:
         return df
 
     def failures(self) -> list[dict]:
+        """Every failed run's record, checked: a record that cannot be read, or whose ``key``,
+        ``config`` or ``error`` is missing or of the wrong kind, is a ``StoreError`` naming the
+        file and the field."""
         out = []
         for path in sorted(self.failed_dir.glob("*.json")):
             try:
-                record = parse_json_bytes(path.read_bytes())
-            except (OSError, ValueError):
-                continue
-            if isinstance(record, dict):
-                out.append(record)
+                record = parse_json_bytes(read_input(path, "failed record", StoreError))
+            except ValueError as err:
+                raise StoreError(f"failed record {str(path)!r} {err}") from None
+            problem = _failure_problem(record, path.stem)
+            if problem:
+                raise StoreError(f"failed record {str(path)!r}: {problem}")
+            out.append(cast(dict, record))
         return out
 
 
+def _highest_missing(path: Path) -> Path | None:
+    """The highest folder of ``path`` that does not exist yet (None: ``path`` exists)."""
+    if os.path.lexists(path):
+        return None
+    top = path
+    while not os.path.lexists(top.parent) and top.parent != top:
+        top = top.parent
+    return top
+
+
 RESULT_LISTS = ("exploration_steps", "total_steps", "greedy_steps", "converged")
+
+
+def _failure_problem(record: object, key: str) -> str | None:
+    """What is wrong with a failed record (None: a failure record of run ``key``)."""
+    if not isinstance(record, dict):
+        return f"is not a table but {type(record).__name__}"
+    if record.get("key") != key:
+        return f"field 'key' must be the file's name {key!r}, got {record.get('key')!r:.60}"
+    if not isinstance(record.get("config"), dict) or record["config"].get("key") != key:
+        return "field 'config' must be the run's configuration, with its key"
+    if not isinstance(record.get("error"), str):
+        return f"field 'error' must be a string, got {type(record.get('error')).__name__}"
+    return None
 
 
 def _run_problem(record: object, key: str) -> str | None:
@@ -231,6 +282,8 @@ def _run_problem(record: object, key: str) -> str | None:
         return f"is not a run record of {key}"
     if not isinstance(record.get("config"), dict) or record["config"].get("key") != key:
         return "has no configuration of its run"
+    if content_key({k: v for k, v in record["config"].items() if k != "key"}) != key:
+        return "has a configuration that does not match its key (it was edited)"
     result = record.get("result")
     if not isinstance(result, dict):
         return "has no result"

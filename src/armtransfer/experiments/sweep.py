@@ -46,6 +46,8 @@ from pathlib import Path
 
 from armtransfer.tasks.catalog import TABLE_I, parse_xy
 from armtransfer.errors import ArmTransferError
+from armtransfer.io import read_input
+from armtransfer.tasks.arms import ARM_NAME, ARM_NAME_FORM
 from armtransfer.learning import methods as _methods
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.lazy_registry import Names
@@ -136,6 +138,8 @@ def _arms(raw: object, where: str, base: Path | None) -> dict:
         w = f"{where}: arms.{name}"
         if not name or ":" in name or not isinstance(body, dict):
             raise SweepFileError(f"{w}: an arm is a table [arms.NAME] with a NAME without ':'")
+        if not ARM_NAME.fullmatch(name):
+            raise SweepFileError(f"{where}: arms.{name!r}: an arm's NAME must be {ARM_NAME_FORM}")
         for key, value in body.items():
             if key not in ARM_KEYS:
                 raise SweepFileError(f"{w}: unknown key {key!r}; valid keys: {', '.join(ARM_KEYS)}")
@@ -252,6 +256,28 @@ def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, ba
     return spec
 
 
+def check_stored(spec: object, where: str) -> dict:
+    """A spec read back from a store (``sweep.json``), checked as a sweep file is: a table with
+    every key of a normalised spec and nothing else, each value valid and already in normal
+    form; else ``SweepFileError``, one line naming ``where`` and the field."""
+    if not isinstance(spec, dict):
+        raise SweepFileError(f"{where}: field 'spec' " + ("is missing" if spec is None else f"must be a table, got {type(spec).__name__}"))
+    keys = {*_SCALARS, *_AXES, "arms"}
+    for key in sorted(keys - set(spec)):
+        raise SweepFileError(f"{where}: field 'spec' has no {key!r}")
+    for key in sorted(set(spec) - keys, key=str):
+        raise SweepFileError(f"{where}: field 'spec' has an unknown key {key!r}; valid keys: {', '.join(sorted(keys))}")
+    body = {k: v for k, v in spec.items() if k != "arms"}
+    if isinstance(spec["start_goal"], list):  # stored as cells; a sweep file writes "X,Y"
+        body["start_goal"] = [[f"{c[0]},{c[1]}" if isinstance(c, list) and len(c) == 2 else c for c in sg]
+                              if isinstance(sg, list) else sg for sg in spec["start_goal"]]
+    again = normalise({"sweep": body, "arms": spec["arms"]}, f"{where}: field 'spec'", max_runs=2**62)
+    for key in sorted(keys):
+        if again[key] != spec[key] or json.dumps(again[key]) != json.dumps(spec[key]):
+            raise SweepFileError(f"{where}: field 'spec': {key} is not as a sweep writes it ({spec[key]!r:.80})")
+    return spec
+
+
 def expand(spec: dict) -> list[dict]:
     """Every run of the sweep, in a fixed order, each a flat configuration."""
     tasks = [{"task": t, "start": list(TABLE_I[t].start), "goal": list(TABLE_I[t].goal)} for t in spec["tasks"]]
@@ -289,10 +315,9 @@ def expand(spec: dict) -> list[dict]:
 def load(path: str | os.PathLike, max_runs: int = MAX_RUNS) -> Sweep:
     p = Path(path)
     where = f"sweep file {str(p)!r}"
+    data = read_input(p, "sweep file", SweepFileError)
     try:
-        raw = tomllib.loads(p.read_text())
-    except OSError as err:
-        raise SweepFileError(f"cannot read {where}: {err.strerror}") from None
+        raw = tomllib.loads(data.decode("utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
         raise SweepFileError(f"{where} is not valid TOML: {str(err).splitlines()[0]}") from None
     except RecursionError:

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import os
 import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -36,6 +37,7 @@ import mujoco
 import numpy as np
 
 from armtransfer.errors import ArmModelError
+from armtransfer.io import check_input
 from armtransfer.ik.tool import Tool
 from armtransfer.ik.workspace import DEFAULT_CELL, WALL_HEIGHT, build_workspace
 
@@ -207,8 +209,10 @@ FINITE_FIELDS = ("qpos0", "body_pos", "body_quat", "body_mass", "body_inertia", 
 
 
 def _load_arm(path: Path) -> tuple[mujoco.MjSpec, mujoco.MjModel]:
-    if not path.is_file():
+    if not path.exists():
         raise ArmModelError(f"cannot read arm MJCF {str(path)!r}: no such file")
+    check_input(path, "arm MJCF", ArmModelError)  # MuJoCo reads it: never a FIFO, a device or without bound
+    _includes(path, path.parent, set())  # and the files it includes
     with _mujoco_warnings() as caught:
         try:
             with warnings.catch_warnings():
@@ -231,7 +235,7 @@ def model_files(path: Path) -> list[Path]:
     parsed spec names, each resolved as MuJoCo resolves it (``meshdir``/``texturedir``
     relative to the model file). Files that are missing are listed too: their absence is
     part of what the model is. Nothing else is read, whatever the folders hold."""
-    path = Path(path)
+    path = check_input(Path(path), "arm MJCF", ArmModelError)
     files = [path, *_includes(path, path.parent, set())]
     with _mujoco_warnings(), warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -267,6 +271,8 @@ def _includes(path: Path, root: Path, seen: set[Path]) -> list[Path]:
             continue
         seen.add(found)
         out.append(found)
+        if os.path.lexists(found):  # MuJoCo reads it too: never a FIFO, a device or without bound
+            check_input(found, "file included by the arm MJCF", ArmModelError)
         if found.is_file():
             out.extend(_includes(found, root, seen))
     return out

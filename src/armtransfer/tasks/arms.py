@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import sys
 import time
 from typing import cast
@@ -28,6 +29,7 @@ from armtransfer.ik.actions import ACTION_MODELS, action_model
 from armtransfer.ik.description import ArmDescription
 from armtransfer.ik.tool import Tool, parse_held
 from armtransfer.errors import ArmModelError, UnknownArmError
+from armtransfer.io import check_input, read_input
 from armtransfer.models import ARMS
 from armtransfer.worlds.layout import ROOMS, Layout
 from armtransfer.tasks.robot import DiscreteRobot
@@ -109,10 +111,40 @@ def make_tool(tip_site: str | None = None, tip_body: str | None = None, tip_offs
     return Tool(site=tip_site or "tip", offset=offset, held=held)
 
 
+ARM_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.+-]{0,63}")
+"""A bring-your-own arm's name: it is written ``NAME:ACTIONS`` on the command line, in lists
+separated by commas, in file names and in tables, so it is 1 to 64 letters, digits, '_', '.',
+'+' or '-' (no ':', ',', space or control character)."""
+ARM_NAME_FORM = "1 to 64 letters, digits, '_', '.', '+' or '-', not starting with '.', '+' or '-'"
+RESERVED_NAMES = ("custom", "gen")
+"""Names a robot spec gives a meaning of its own (``custom[:ACTIONS]``, ``gen:...``)."""
+
+
+def check_arm_name(name: object, what: str) -> str:
+    """``name`` when a bring-your-own arm may go by it: :data:`ARM_NAME`'s form, and not the
+    name of a built-in arm or grid robot (two different robots would share one name in tables,
+    results and the cache); else ``ArmModelError``, one line naming the valid forms."""
+    from armtransfer.tasks.grid_robots import GRID_ROBOTS
+
+    if not isinstance(name, str) or not ARM_NAME.fullmatch(name):
+        shown = repr(name) if not isinstance(name, str) or len(name) <= 60 else f"{name[:40]!r}... ({len(name)} characters)"
+        raise ArmModelError(f"{what} must be {ARM_NAME_FORM} (a robot is written NAME:ACTIONS), got {shown}; "
+                            "give another with --arm-name (arm_name=)")
+    taken = {*ARMS, *GRID_ROBOTS, *RESERVED_NAMES}
+    if name in taken:
+        raise ArmModelError(f"{what} {name!r} is the name of a built-in robot; give the arm another with "
+                            f"--arm-name (arm_name=), not one of {', '.join(sorted(taken))}")
+    return name
+
+
 def file_arm_name(path: Path) -> str:
     """A bring-your-own arm's name: its MJCF ``model`` attribute, else the file's stem."""
     import xml.etree.ElementTree as ET
 
+    try:
+        check_input(path, "arm MJCF", ArmModelError)  # a FIFO would hang the parser
+    except ArmModelError:
+        return path.stem  # the error is the reader's to give
     try:
         for _, element in ET.iterparse(str(path), events=("start",)):
             name = (element.get("model") or "").strip()
@@ -161,12 +193,11 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
         for what, value in (("tip_site", tip_site), ("tip_body", tip_body), ("arm_name", arm_name)):
             if value is not None:
                 checks.name(value, what, error=ArmModelError)
-        try:
-            xml_bytes = path.read_bytes()
-        except OSError as err:
-            raise ArmModelError(f"cannot read arm MJCF {str(path)!r}: {err.strerror or err}") from None
+        xml_bytes = read_input(path, "arm MJCF", ArmModelError)
         tool = make_tool(tip_site, tip_body, tip_offset, stylus)
         name = arm_name or arm or file_arm_name(path)
+        check_arm_name(name, "--arm-name (arm_name)" if arm_name or arm else
+                       f"the name of {path.name} (its MJCF model attribute)")
         kind, source = "custom", "given"
         generated = read_sidecar(path) if base_pos is None else None
         if generated is not None:  # mounted as it was generated, unless told otherwise
@@ -497,7 +528,10 @@ def read_sidecar(xml_path: str | os.PathLike) -> dict | None:
     from armtransfer.io import parse_json_bytes
 
     path = Path(xml_path).with_suffix(".json")
-    raw = _cache.read_regular(path)
+    try:
+        raw: bytes | None = read_input(path, "generated arm's file", ArmModelError)
+    except ArmModelError:  # absent, or no regular file of a readable size: not the generator's
+        raw = None
     try:
         data = parse_json_bytes(raw) if raw is not None else None
     except ValueError:

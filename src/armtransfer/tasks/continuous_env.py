@@ -23,7 +23,7 @@ import armtransfer.checks as checks
 from armtransfer.errors import InvalidActionError, InvalidParameterError
 from armtransfer.tasks.catalog import Task
 from armtransfer.tasks.continuous import ARM_KEYWORDS
-from armtransfer.tasks.envs import check_options, rooms_task
+from armtransfer.tasks.envs import check_options, check_reset_options, rooms_task
 from armtransfer.tasks.robot import cell_robot
 
 ARM_OPTIONS = ("xml_path", *ARM_KEYWORDS)
@@ -67,6 +67,7 @@ class ContinuousArmRoomsEnv(gym.Env):
         return int(info["label"])
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        check_reset_options(options)
         super().reset(seed=seed)
         label = self.arm.reset()
         return self._obs(), {"label": label}

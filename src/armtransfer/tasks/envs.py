@@ -89,6 +89,7 @@ class RobotRoomsEnv(RoomsRules, gym.Env):
         self._snapshot = None
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        check_reset_options(options)
         super().reset(seed=seed)
         self.state = self.start_state
         return int(self.state), {"label": int(self.robot.label[self.state])}
@@ -187,6 +188,18 @@ def make_rooms_env(
 
 TASK_OPTIONS = ("wind", "step_reward", "goal_reward", "render_mode")
 """The keywords of an environment that set up its task (beside task, start and goal)."""
+
+
+def check_reset_options(options: object) -> None:
+    """``reset(options=...)`` of every environment here: no reset option exists (the task is
+    chosen when the environment is made), so anything but None or ``{}`` is an error, not
+    silently ignored."""
+    if options is None or (isinstance(options, dict) and not options):
+        return
+    if not isinstance(options, dict):
+        raise InvalidParameterError(f"reset options must be a dict or None, got {type(options).__name__}")
+    raise InvalidParameterError(f"unknown reset option {next(iter(options))!r}; these environments take no reset "
+                                "options (the task is chosen when the environment is made)")
 
 
 def check_options(kwargs: dict, extra: tuple[str, ...] = ()) -> None:
