@@ -82,9 +82,9 @@ def world_task(layout: Layout, task: object = None) -> Task:
     else:
         name = str(task)
     if layout is ROOMS or layout == ROOMS:
-        if name.isdigit() and len(name) < 8 and int(name) in TABLE_I:
-            return TABLE_I[int(name)]
-        return table_task(name[:40])  # the one-line error listing Table I's tasks
+        if name.isdigit() and name.isascii() and len(name) < 40:
+            return table_task(int(name))  # the one-line error listing Table I's tasks when unknown
+        raise InvalidTaskError(f"unknown task {name[:40]!r}; valid tasks: {', '.join(str(k) for k in TABLE_I)}")
     found = layout.task(name)
     if found is None:
         raise InvalidTaskError(f"unknown task {name[:40]!r} in world {layout.name}; valid tasks: "

@@ -103,3 +103,28 @@ def _xy(value: object, what: str) -> tuple[int, int]:
             or any(isinstance(v, bool) or not isinstance(v, numbers.Integral) for v in value)):
         raise InvalidWorldError(f"{what} must be two integers [x, y], got {value!r}")
     return int(value[0]), int(value[1])
+
+
+def layout_data(layout: Layout) -> dict:
+    """A world as the content of a layout file (name, grid rows, tasks): what a sweep's runs
+    carry, so that a run names its world by content and any worker can rebuild it."""
+    rows = layout.ascii({door: "D" for door in layout.doors}).splitlines()
+    return {"name": layout.name, "grid": rows,
+            "tasks": {name: {"start": list(start), "goal": list(goal)} for name, start, goal in layout.tasks}}
+
+
+def layout_of_data(data: dict, where: str) -> Layout:
+    """The world of :func:`layout_data`'s content: a built-in or generated world by its name
+    when its content is the same (so it is the very layout the command builds), else as a
+    layout file's content."""
+    from armtransfer.worlds.resolve import world
+
+    name = data.get("name") if isinstance(data, dict) else None
+    if isinstance(name, str):
+        try:
+            named = world(name) if "/" not in name and not name.endswith((".toml", ".json")) else None
+        except InvalidWorldError:
+            named = None
+        if named is not None and layout_data(named) == data:
+            return named
+    return parse_layout(data, str(name), where)
