@@ -31,6 +31,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="output directory, absent or empty; written whole or not at all "
                         "(default runs/benchmark-<suite>-<timestamp>)")
     p.add_argument("--seed", type=common.non_negative_int, default=0, help="random seed, >= 0 (default 0)")
+    common.add_world_argument(p)
 
 
 def results_bytes(suite: suites.Suite, seed: int, ran: list[str], missing: list[str], records: list[dict],
@@ -42,6 +43,7 @@ def results_bytes(suite: suites.Suite, seed: int, ran: list[str], missing: list[
 
 
 def run(args: argparse.Namespace) -> int:
+    common.refuse_world(args, "benchmark", "its suites are fixed, with their tasks set in the rooms world")
     suite = suites.get(args.suite)
     out = Path(args.out) if args.out else Path("runs") / _dt.datetime.now().strftime(
         f"benchmark-{suite.name}-%Y%m%d-%H%M%S")

@@ -95,6 +95,16 @@ def world_of(args: argparse.Namespace):
     return world(getattr(args, "world", None))
 
 
+def refuse_world(args: argparse.Namespace, command: str, why: str) -> None:
+    """``command`` runs on the paper's rooms only: any other world is a one-line error saying
+    ``why`` (a world that does not load names its own fault first)."""
+    from armtransfer.worlds.resolve import DEFAULT_WORLD, is_default
+
+    if getattr(args, "world", None) is not None and not is_default(world_of(args)):
+        raise InvalidParameterError(f"--world {str(args.world)[:100]} does not apply to {command}: {why}; "
+                                    f"valid worlds: {DEFAULT_WORLD}")
+
+
 def add_task_arguments(p: argparse.ArgumentParser) -> None:
     add_world_argument(p)
     p.add_argument("--task", default=None, metavar="NAME",
