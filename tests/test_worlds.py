@@ -13,11 +13,11 @@ from armtransfer.errors import InvalidTaskError, InvalidWorldError
 from armtransfer.tasks.catalog import TABLE_I, world_task, world_tasks
 from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.worlds.check import distance
-from armtransfer.worlds.files import layout_data, layout_of_data, load_layout
+from armtransfer.worlds.files import layout_data, load_layout
 from armtransfer.worlds.generate import SIDES, generated_world
 from armtransfer.worlds.grid import grid_rows, layout_from_rows
 from armtransfer.worlds.layout import ROOMS, Layout
-from armtransfer.worlds.resolve import WORLDS, world
+from armtransfer.worlds.resolve import WORLDS, layout_of_data, world
 
 SMALL = """\
 name = "corridor"

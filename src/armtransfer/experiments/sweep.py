@@ -49,8 +49,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from armtransfer.tasks.catalog import TABLE_I, parse_xy, world_task
-from armtransfer.worlds.files import layout_data, layout_of_data
-from armtransfer.worlds.resolve import is_default
+from armtransfer.worlds.files import layout_data
+from armtransfer.worlds.resolve import is_default, layout_of_data
 from armtransfer.worlds.resolve import world as resolve_world
 from armtransfer.errors import ArmTransferError
 from armtransfer.learning import methods as _methods

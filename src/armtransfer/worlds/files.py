@@ -112,19 +112,3 @@ def layout_data(layout: Layout) -> dict:
     return {"name": layout.name, "grid": rows,
             "tasks": {name: {"start": list(start), "goal": list(goal)} for name, start, goal in layout.tasks}}
 
-
-def layout_of_data(data: dict, where: str) -> Layout:
-    """The world of :func:`layout_data`'s content: a built-in or generated world by its name
-    when its content is the same (so it is the very layout the command builds), else as a
-    layout file's content."""
-    from armtransfer.worlds.resolve import world
-
-    name = data.get("name") if isinstance(data, dict) else None
-    if isinstance(name, str):
-        try:
-            named = world(name) if "/" not in name and not name.endswith((".toml", ".json")) else None
-        except InvalidWorldError:
-            named = None
-        if named is not None and layout_data(named) == data:
-            return named
-    return parse_layout(data, str(name), where)

@@ -14,7 +14,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from armtransfer.errors import InvalidWorldError
-from armtransfer.worlds.files import load_layout
+from armtransfer.worlds.files import layout_data, load_layout, parse_layout
 from armtransfer.worlds.generate import PREFIX, generated_world, parse_generated
 from armtransfer.worlds.layout import ROOMS, Layout
 
@@ -59,6 +59,21 @@ def is_default(layout: Layout) -> bool:
     """True for the paper's rooms world, whose outputs name no world (they are the bytes they
     were before worlds could be chosen)."""
     return layout is ROOMS or layout == ROOMS
+
+
+def layout_of_data(data: dict, where: str) -> Layout:
+    """The world of ``worlds.files.layout_data``'s content: a built-in or generated world by
+    its name when its content is the same (so it is the very layout the commands build),
+    else the world of that content, checked as a layout file's."""
+    name = data.get("name") if isinstance(data, dict) else None
+    if isinstance(name, str) and (name in FILE_WORLDS or name.split(":")[0] == PREFIX):
+        try:
+            named = world(name)
+        except InvalidWorldError:
+            named = None
+        if named is not None and layout_data(named) == data:
+            return named
+    return parse_layout(data, str(name), where)
 
 
 @lru_cache(maxsize=None)
