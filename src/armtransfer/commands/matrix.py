@@ -56,8 +56,12 @@ def world_tasks(parts: list[str] | None, layout) -> list:
         if dash and lo.isdigit() and hi.isdigit():
             first, last = known(str(int(lo))), known(str(int(hi)))  # both ends first: '1-9999999999' lists nothing
             out.extend(known(str(t)) for t in range(int(first), int(last) + 1))
+        elif part.isdigit():
+            out.append(known(str(int(part))))
+        elif rooms:
+            raise InvalidTaskError(f"tasks are numbers or ranges like 1-4 or 1,3, got {text[:80]!r}")
         else:
-            out.append(known(str(int(part)) if part.isdigit() else part))
+            out.append(known(part))
     return [int(t) for t in out] if rooms else out
 
 
