@@ -115,6 +115,7 @@ BAD = [
     (SMALL.replace('name = "corridor"', 'size = 7'), "unknown key 'size'; valid keys: name, description, grid, tasks"),
     (SMALL.split("[tasks]")[0], "tasks must be a table of at least one task"),
     ("grid = 'no", "not valid TOML"),
+    (SMALL.replace("across =", '"a\\nb" ='), "a task's name must be 1 to 40 printable characters"),
 ]
 
 
@@ -191,6 +192,12 @@ def test_arm_env_on_a_small_world_builds_its_table_and_its_own_cache_entry():
     assert scene.env_geoms.sum() == 1 + len(wall_boxes(layout, robot.arm.cell_size))
     assert robot.arm.key != arm_robot("planar2", "joint").arm.key
     assert robot.arm.key != arm_robot("planar2", "joint", layout=world("rooms15")).arm.key
+
+
+def test_continuous_arm_env_takes_a_world():
+    env = gym.make("armtransfer/ContinuousArmRooms-v0", arm="planar3", world="rooms11", task=2)
+    _, info = env.reset(seed=0)
+    assert env.unwrapped.arm.layout.name == "rooms11" and world("rooms11").xy(info["label"]) == (2, 2)
 
 
 def test_dmc_environment_takes_a_world():

@@ -51,8 +51,8 @@ def load_layout(path: str | os.PathLike) -> Layout:
         if p.stat().st_size > MAX_BYTES:
             raise InvalidWorldError(f"{where}: larger than {MAX_BYTES:,} bytes")
         raw = p.read_bytes()
-    except OSError as err:
-        raise InvalidWorldError(f"{where}: cannot be read: {err.strerror or err}") from None
+    except (OSError, ValueError) as err:  # ValueError: a path with a NUL byte
+        raise InvalidWorldError(f"{where}: cannot be read: {getattr(err, 'strerror', None) or err}") from None
     try:
         text = raw.decode("utf-8")
         data = tomllib.loads(text) if p.suffix.lower() == ".toml" else json.loads(text)
@@ -91,6 +91,9 @@ def parse_tasks(tasks: object, where: str) -> tuple[NamedTask, ...]:
         raise InvalidWorldError(f"{where}: tasks must be a table of at least one task, each with a start and a goal")
     out = []
     for name, task in tasks.items():
+        if not (0 < len(name) <= 40 and name.isprintable() and name == name.strip()):
+            raise InvalidWorldError(f"{where}: a task's name must be 1 to 40 printable characters without spaces at "
+                                    f"its ends, got {name[:40]!r}")
         if not isinstance(task, dict) or sorted(task) != ["goal", "start"]:
             raise InvalidWorldError(f"{where}: task {name!r} must have exactly a start and a goal, each [x, y]")
         out.append((str(name), _xy(task["start"], f"{where}: task {name!r}: start"),
