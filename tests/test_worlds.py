@@ -168,6 +168,20 @@ def test_the_api_takes_a_world_file_and_its_task_names(tmp_path):
     assert same.to_json() == r.to_json()
 
 
+def test_a_robot_of_another_world_is_refused(tmp_path):
+    with pytest.raises(InvalidWorldError, match="robot fine moves in the world rooms11, not in rooms"):
+        armtransfer.transfer("coarse", grid_robot("fine", world("rooms11")), world="rooms", trials=1)
+    r = armtransfer.transfer("coarse", grid_robot("fine", world("rooms11")), methods=["none"], trials=1,
+                             controls=False)  # no world given: the robot's
+    assert r.task.start == (0, 0) and r.task.goal == (-4, 4)
+
+
+def test_arms_list_reports_the_tasks_of_the_world(capsys):
+    assert main(["arms", "list", "--world", "rooms11", "--arm", "planar2", "--actions", "joint"]) == 0
+    header, row = capsys.readouterr().out.splitlines()[:2]
+    assert header.split()[-2:] == ["tasks", "cache"] and row.split()[-2] == "3/3"
+
+
 def test_rooms_env_takes_a_world():
     env = gym.make("armtransfer/Rooms-v0", world="rooms15", task="3", robot="coarse")
     check_env(env.unwrapped, skip_render_check=True)

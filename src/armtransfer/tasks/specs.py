@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from armtransfer.errors import UnknownArmError, UnknownRobotError
+from armtransfer.errors import InvalidWorldError, UnknownArmError, UnknownRobotError
 from armtransfer.tasks.grid_robots import GRID_ROBOTS, grid_robot
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.worlds.layout import ROOMS, Layout
@@ -25,7 +25,7 @@ def resolve(spec: str | DiscreteRobot, *, xml_path=None, progress: bool = False,
     (the paper's rooms by default). A robot passes through unchanged when it is in that world."""
     if isinstance(spec, DiscreteRobot):
         if spec.layout is not layout and spec.layout != layout:
-            raise UnknownRobotError(f"robot {spec.name} moves in the world {spec.layout.name or 'unnamed'}, not in "
+            raise InvalidWorldError(f"robot {spec.name} moves in the world {spec.layout.name or 'unnamed'}, not in "
                                     f"{layout.name or 'unnamed'}: build it with the world's layout")
         return spec
     if not isinstance(spec, str):
