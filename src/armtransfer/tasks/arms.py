@@ -395,6 +395,8 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float | None = None, l
              "cell": cell_size, "yaw": yaw, "layout": _layout_data(layout), "stride": _mount.STRIDE,
              "seeds": [_mount.SEEDS, _mount.RESTARTS, RETRIES], "gaps": _mount.GAPS,
              "grid": _mount.PLANAR_GRID, "lifts": _mount.LIFTS}
+    if layout != ROOMS:  # the choice ranks poses by the world's task cells (the rooms' key is as it was)
+        parts["tasks"] = [[name, list(start), list(goal)] for name, start, goal in layout.tasks]
     key = _cache.cache_key(parts)
     entry = _cache.cache_dir() / f"mount-{key[:16]}.json"
     if cache:
