@@ -208,6 +208,17 @@ def test_arm_env_on_a_small_world_builds_its_table_and_its_own_cache_entry():
     assert robot.arm.key != arm_robot("planar2", "joint", layout=world("rooms15")).arm.key
 
 
+def test_arm_env_takes_an_arm_file_on_a_world():
+    from armtransfer.models import ARMS
+
+    env = gym.make("armtransfer/ArmRooms-v0", xml_path=str(ARMS["planar2"].xml_path), actions="cartesian",
+                   base_pos=(-0.03, 0.03, 0.0), world="rooms11", task=3)
+    robot = env.unwrapped.robot
+    assert robot.layout.name == "rooms11" and robot.arm.kind == "custom"
+    _, info = env.reset(seed=0)
+    assert robot.layout.xy(info["label"]) == (4, 4)
+
+
 def test_continuous_arm_env_takes_a_world():
     env = gym.make("armtransfer/ContinuousArmRooms-v0", arm="planar3", world="rooms11", task=2)
     _, info = env.reset(seed=0)

@@ -217,11 +217,11 @@ def rooms_arm(arm: str | None, actions: str, options: dict[str, Any], layout: An
     file ``xml_path=`` with its options, on the world ``layout`` (the paper's rooms when None);
     the robot's keywords (:data:`ARM_OPTIONS`) are taken out of ``options``, the rest left for
     the task."""
-    if layout is not None:
-        options = dict(options, layout=layout)
     from armtransfer.tasks.arms import arm_robot, parse_robot_spec
 
-    robot_kwargs = {k: options.pop(k) for k in (*ARM_OPTIONS, "layout") if k in options}
+    robot_kwargs = {k: options.pop(k) for k in ARM_OPTIONS if k in options}
+    if layout is not None:
+        robot_kwargs["layout"] = layout
     if robot_kwargs.get("xml_path") is None:  # a built-in arm, planar2 by default
         if arm is not None and not isinstance(arm, str):
             raise InvalidParameterError(f"arm must be an arm's name, got {arm!r}")
