@@ -42,7 +42,8 @@ def load_layout(path: str | os.PathLike) -> Layout:
     """The world of a layout file (``.toml`` or ``.json``), checked; a one-line
     :class:`InvalidWorldError` naming the file and the fault otherwise."""
     p = Path(path)
-    where = f"world file {str(p)!r}"
+    shown = str(p) if len(str(p)) <= 120 else f"{str(p)[:50]}...{str(p)[-50:]}"
+    where = f"world file {shown!r}"
     if p.suffix.lower() not in (".toml", ".json"):
         raise InvalidWorldError(f"{where}: a layout file ends in .toml or .json")
     try:
