@@ -191,7 +191,7 @@ UR5E_HOME = (-1.5708, -1.5708, 1.5708, -1.5708, -1.5708, 0.0)
 """The UR5e's ready pose (upper arm up, forearm level, tool down) in the standard DH zero."""
 
 
-def ur5e_style(directory, *, scale: float = 1.0, gripper: bool = False) -> Path:
+def ur5e_style(directory, *, scale: float = 1.0, gripper: bool | str = False) -> Path:
     """A 6-joint UR5e-style arm in ``directory/universal_robots_ur5e/ur5e.xml``.
 
     UR5e standard DH geometry; classes ``ur5e``, ``ur5e/size3``, ``ur5e/size3_limited``,
@@ -207,7 +207,9 @@ def ur5e_style(directory, *, scale: float = 1.0, gripper: bool = False) -> Path:
     gripper on the flange (``ur5e_gripper.xml``, model ``ur5e_gripper``): a palm body
     ``gripper_base``, fingers ``left_pad``/``right_pad`` on slide joints each driven by its
     own ``position`` actuator, and a TCP site ``pinch`` between the fingers that the
-    fingertips reach ``GRIPPER_PAST`` past (see ``_gripper``).
+    fingertips reach ``GRIPPER_PAST`` past (see ``_gripper``). ``gripper="wide"``: the same
+    with fingers as wide as a Robotiq-style pad over their whole length
+    (``ur5e_wide_gripper.xml``, model ``ur5e_wide_gripper``): too wide for a 1 cm door.
     """
     k = float(scale)
     model = "ur5e" if k == 1.0 else "small_ur"
@@ -247,8 +249,8 @@ def ur5e_style(directory, *, scale: float = 1.0, gripper: bool = False) -> Path:
     pad = indent + "  " * n
     body_xml.append(f'{pad}  <site name="attachment_site" pos="0 0 {_f(flange)}"/>')
     if gripper:
-        model = "ur5e_gripper"
-        body_xml += _gripper(pad + "  ", flange)
+        model = "ur5e_wide_gripper" if gripper == "wide" else "ur5e_gripper"
+        body_xml += _gripper(pad + "  ", flange, wide=gripper == "wide")
     for i in range(n, 0, -1):
         body_xml.append(f"{indent + '  ' * i}</body>")
     actuators = []
@@ -344,7 +346,11 @@ GRIPPER_DEFAULTS = """
     </default>"""
 
 
-def _gripper(pad: str, flange: float) -> list[str]:
+WIDE_PAD = 0.011
+"""Half the width (m) of the wide gripper's fingers: 22 mm across, a Robotiq-style pad."""
+
+
+def _gripper(pad: str, flange: float, wide: bool = False) -> list[str]:
     """A parallel gripper on a flange ``flange`` along z from the last body's origin: a palm,
     two fingers on slides (closed at 0), narrow for their last ``GRIPPER_TIP`` (a closed
     gripper is 7 mm by 6 mm there), and the TCP site ``pinch`` ``GRIPPER_PAST`` short of the
@@ -360,9 +366,10 @@ def _gripper(pad: str, flange: float) -> list[str]:
                 f'{pad}    <inertial mass="0.03" pos="0 {_f(sign * 0.006)} 0.03" diaginertia="1e-5 1e-5 2e-6"/>',
                 f'{pad}    <joint name="{side}_finger_joint" class="gripper/finger"'
                 f'{"" if sign > 0 else chr(32) + "axis=" + chr(34) + "0 -1 0" + chr(34)}/>',
-                f'{pad}    <geom class="gripper/finger" size="0.008 0.004 {_f(upper / 2)}" '
+                f'{pad}    <geom class="gripper/finger" size="{_f(WIDE_PAD if wide else 0.008)} 0.004 {_f(upper / 2)}" '
                 f'pos="0 {_f(sign * 0.006)} {_f(upper / 2)}"/>',
-                f'{pad}    <geom class="gripper/finger" size="0.003 0.0015 {_f(GRIPPER_TIP / 2)}" '
+                f'{pad}    <geom class="gripper/finger" size="{_f(WIDE_PAD if wide else 0.003)} 0.0015 '
+                f'{_f(GRIPPER_TIP / 2)}" '
                 f'pos="0 {_f(sign * 0.002)} {_f(upper + GRIPPER_TIP / 2)}"/>',
                 f"{pad}  </body>"]
     return out + [f"{pad}</body>"]
@@ -723,7 +730,11 @@ PEN_SITE = 0.001
 """The pen's site is this far above the base frame's z = 0 (m): its round end 2 mm below it."""
 
 
-def planar5_straight(directory, pen: bool = False) -> Path:
+WIDE_PEN_RADIUS = 0.006
+"""The wide pen's radius (m): 12 mm across, wider than a 1 cm door."""
+
+
+def planar5_straight(directory, pen: bool = False, pen_radius: float = PEN_RADIUS, scale: float = 1.0) -> Path:
     """A planar 5-joint arm (every joint axis vertical): ``directory/planar5/planar5.xml``.
 
     Links ``link1..link5`` (0.09, 0.075, 0.06, 0.045, 0.03 m; 0.30 m in all) stacked
@@ -738,18 +749,24 @@ def planar5_straight(directory, pen: bool = False) -> Path:
     capsule of radius ``PEN_RADIUS`` whose axis ends at the site ``pen_tip`` ``PEN_SITE`` above
     the base frame's z = 0: its round end reaches ``PEN_RADIUS`` past the site, into the table
     with the base frame on the tabletop (and with the site 2 mm above it).
+
+    ``pen_radius`` and ``scale`` (the links' lengths) other than the defaults write
+    ``planar5_wide_pen.xml`` (model ``planar5_wide_pen``): the wide pen is 12 mm across.
     """
+    wide = pen and (pen_radius != PEN_RADIUS or scale != 1.0)
+    model_name = "planar5_wide_pen" if wide else ("planar5_pen" if pen else "planar5")
+    links = tuple(scale * v for v in PLANAR5_LINKS)
     folder = Path(directory) / "planar5"
     meshes = _Meshes(folder / "meshes", "obj")
-    n = len(PLANAR5_LINKS)
+    n = len(links)
     xml = ['    <body name="base" childclass="planar5">',
            f'      <geom class="planar5/collision" type="cylinder" size="0.03 0.02" '
            f'pos="0 0 {_f(PLANAR5_HEIGHT + 0.035)}"/>']
     pad = "    "
     z = PLANAR5_HEIGHT
-    for i, length in enumerate(PLANAR5_LINKS, start=1):
+    for i, length in enumerate(links, start=1):
         pad += "  "
-        pos = f"0 0 {_f(PLANAR5_HEIGHT)}" if i == 1 else f"{_f(PLANAR5_LINKS[i - 2])} 0 {_f(-PLANAR5_DROP)}"
+        pos = f"0 0 {_f(PLANAR5_HEIGHT)}" if i == 1 else f"{_f(links[i - 2])} 0 {_f(-PLANAR5_DROP)}"
         if i > 1:
             z -= PLANAR5_DROP
         mesh = meshes.add(f"link{i}", *box_mesh((0, 0, 0), (length, 0, 0), 0.011))
@@ -763,10 +780,10 @@ def planar5_straight(directory, pen: bool = False) -> Path:
             xml.append(f'{pad}  <geom class="planar5/collision" type="cylinder" size="0.016 0.02" '
                        f'pos="0 0 {_f(PLANAR5_DROP / 2)}"/>')
     stylus = z - (PEN_SITE if pen else PLANAR5_TIP_CLEARANCE)
-    tool = (f'{pad}    <geom class="planar5/collision" size="{_f(PEN_RADIUS)}" fromto="0 0 0 0 0 {_f(stylus)}"/>',
+    tool = (f'{pad}    <geom class="planar5/collision" size="{_f(pen_radius)}" fromto="0 0 0 0 0 {_f(stylus)}"/>',
             f'{pad}    <site name="pen_tip"/>') if pen else (
             f'{pad}    <geom class="planar5/collision" type="cylinder" size="0.0015" fromto="0 0 0 0 0 {_f(stylus)}"/>',)
-    xml += [f'{pad}  <body name="{"pen" if pen else "stylus"}" pos="{_f(PLANAR5_LINKS[-1])} 0 {_f(-stylus)}">',
+    xml += [f'{pad}  <body name="{"pen" if pen else "stylus"}" pos="{_f(links[-1])} 0 {_f(-stylus)}">',
             f'{pad}    <inertial pos="0 0 {_f(stylus / 2)}" mass="0.01" diaginertia="2e-5 2e-5 1e-7"/>',
             *tool, f"{pad}  </body>"]
     for _ in range(n):
@@ -775,7 +792,7 @@ def planar5_straight(directory, pen: bool = False) -> Path:
     xml.append("    </body>")
     actuators = [f'    <position name="servo{i}" joint="j{i}" class="planar5" '
                  f'ctrlrange="{_f(-lim)} {_f(lim)}"/>' for i, lim in enumerate(PLANAR5_LIMITS, start=1)]
-    text = f"""<mujoco model="{"planar5_pen" if pen else "planar5"}">
+    text = f"""<mujoco model="{model_name}">
   <compiler angle="radian" meshdir="meshes" autolimits="true"/>
   <option integrator="implicitfast"/>
   <default>
@@ -801,7 +818,7 @@ def planar5_straight(directory, pen: bool = False) -> Path:
   </actuator>
 </mujoco>
 """
-    return _write(folder, "planar5_pen" if pen else "planar5", text)
+    return _write(folder, model_name, text)
 
 
 SMALL_UR_SCALE = 0.5
@@ -821,8 +838,10 @@ SUGGESTED = {
     # the tool points these files offer, with no mount: the fingers or the pen reach past them
     "panda_tcp": dict(tip_site="tcp"),
     "ur5e_gripper": dict(tip_site="pinch"),
+    "ur5e_wide_gripper": dict(tip_site="pinch"),
     "small_ur": dict(tip_site="attachment_site", tip_offset=(0.0, 0.0, 0.06)),
     "planar5_pen": dict(tip_site="pen_tip"),
+    "planar5_wide_pen": dict(tip_site="pen_tip"),
 }
 """A tip and a mount that work for each arm (cartesian, tool pointing down; planar5 also
 joint). Measured with the project's compiler on copies of these files with the classes'
@@ -834,7 +853,9 @@ cartesian 77%, 3/4, and joint with a 0.35 rad step 92%, 4/4 (494,461 states, 51 
 ALL = {"ur5e": ur5e_style, "panda": panda_style, "panda_nohand": lambda d: panda_style(d, hand=False),
        "so100": so100_style, "planar5": planar5_straight,
        "panda_tcp": lambda d: panda_style(d, tcp=True), "ur5e_gripper": lambda d: ur5e_style(d, gripper=True),
-       "small_ur": lambda d: ur5e_style(d, scale=SMALL_UR_SCALE), "planar5_pen": lambda d: planar5_straight(d, pen=True)}
+       "ur5e_wide_gripper": lambda d: ur5e_style(d, gripper="wide"),
+       "small_ur": lambda d: ur5e_style(d, scale=SMALL_UR_SCALE), "planar5_pen": lambda d: planar5_straight(d, pen=True),
+       "planar5_wide_pen": lambda d: planar5_straight(d, pen=True, pen_radius=WIDE_PEN_RADIUS, scale=2.0)}
 """Every fixture by a short name."""
 
 

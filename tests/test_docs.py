@@ -8,6 +8,14 @@ relative paths (`scripts/...`, `examples/sweeps/...`) work and every output (`--
 (the package is installed already). A block whose line before the fence is `<!-- slow -->` runs
 only under `-m slow`; the block after `<!-- test-command -->` is what CI runs (`.ci/run`) and is
 checked word for word instead of run.
+
+What a block prints, where a page shows it, is checked too: a ```text block marked
+`<!-- output -->`, directly after the bash or python block, is that block's standard output
+(`expected_output`). The comparison (`output_matches`) is line by line, exact but for three
+things: trailing spaces and blank lines at the end are ignored; a line `...` stands for any
+number of lines; and a wall-clock time, a number followed by a unit of time (`12 s`, `3.5 ms`,
+`2 min`, `1 h`), stands for any time (`TIME`). Every other number is compared as written, so
+a run that prints a different number fails (`test_every_number_shown_is_compared`).
 """
 
 from __future__ import annotations
@@ -92,7 +100,8 @@ def _param(b: Block):
     return pytest.param(b, id=b.id, marks=[pytest.mark.slow] if "slow" in b.markers else [])
 
 
-def _run(argv: list[str], block: Block, cwd: Path) -> None:
+def _run(argv: list[str], block: Block, cwd: Path) -> str:
+    """Run ``argv`` for ``block`` in ``cwd`` (with the repository's folders linked); its stdout."""
     for name in LINKED:
         if (ROOT / name).is_dir():
             (cwd / name).symlink_to(ROOT / name)
@@ -105,19 +114,112 @@ def _run(argv: list[str], block: Block, cwd: Path) -> None:
     assert done.returncode == 0, (
         f"{block.id} exited with {done.returncode}\n--- block\n{block.text}--- stdout\n{done.stdout[-3000:]}"
         f"--- stderr\n{done.stderr[-3000:]}")
+    return done.stdout
+
+
+TIME = re.compile(r"(?<![\w.,])\d+(?:[.,]\d+)*(?:\.\d+)?\s?(?:s|ms|min|h)\b")
+"""A wall-clock time as a run prints it: any such number compares equal to any other."""
+ANY_LINES = "..."
+"""An output line that stands for any number of lines."""
+
+
+def _normal(text: str) -> list[str]:
+    lines = [TIME.sub("<time>", line.rstrip()) for line in text.splitlines()]
+    while lines and not lines[-1]:
+        lines.pop()
+    return lines
+
+
+def output_matches(expected: str, printed: str) -> bool:
+    """Whether ``printed`` is what ``expected`` shows, by the rules of the module's docstring."""
+    parts = [r"(?:[^\n]*\n)*?" if line == ANY_LINES else re.escape(line) + r"\n" for line in _normal(expected)]
+    return re.fullmatch("".join(parts), "".join(line + "\n" for line in _normal(printed))) is not None
+
+
+def expected_output(block: Block) -> str | None:
+    """The text of the `<!-- output -->` block right after ``block`` on its page, if any."""
+    found = blocks(ROOT / block.page)
+    at = next(i for i, b in enumerate(found) if b.line == block.line)
+    after = found[at + 1] if at + 1 < len(found) else None
+    if after is None or "output" not in after.markers:
+        return None
+    lines = (ROOT / block.page).read_text(encoding="utf-8").splitlines()
+    between = lines[block.line + block.text.count("\n") + 1:after.line - 1]  # after the closing fence
+    if any(line.strip() and not line.strip().startswith("<!--") for line in between):
+        return None  # prose between the two: the output block belongs to no block
+    return after.text
+
+
+def _check_output(block: Block, printed: str) -> None:
+    expected = expected_output(block)
+    if expected is not None and not output_matches(expected, printed):
+        import difflib
+
+        diff = "\n".join(difflib.unified_diff(_normal(expected), _normal(printed), "the page shows", "the run printed",
+                                              lineterm=""))
+        pytest.fail(f"{block.id} printed other than its output block shows:\n{diff}")
 
 
 @pytest.mark.parametrize("block", [_param(b) for b in _all("bash")])
 def test_bash_block_runs(block: Block, tmp_path: Path) -> None:
     script = without_pip(block.text)
     assert script.strip(), f"{block.id} is only pip install"
-    _run(["bash", "-euo", "pipefail", "-c", script], block, tmp_path)
+    _check_output(block, _run(["bash", "-euo", "pipefail", "-c", script], block, tmp_path))
 
 
 @pytest.mark.parametrize("block", [_param(b) for b in _all("python")])
 def test_python_block_runs(block: Block, tmp_path: Path) -> None:
     (tmp_path / "snippet.py").write_text(block.text)
-    _run([sys.executable, "snippet.py"], block, tmp_path)
+    _check_output(block, _run([sys.executable, "snippet.py"], block, tmp_path))
+
+
+def _output_blocks() -> list[Block]:
+    return [b for page in PAGES for b in blocks(page) if "output" in b.markers]
+
+
+def test_every_output_block_follows_a_block_that_runs() -> None:
+    run = {b.id for b in [*_all("bash"), *_all("python")]}
+    orphans = []
+    for page in PAGES:
+        found = blocks(page)
+        for i, b in enumerate(found):
+            if "output" in b.markers:
+                before = found[i - 1] if i else None
+                if b.lang != "text" or before is None or before.id not in run or expected_output(before) != b.text:
+                    orphans.append(b.id)
+    assert not orphans, f"output blocks that are not ```text right after a block the tests run: {orphans}"
+
+
+def _numbers(text: str) -> list[re.Match]:
+    """The numbers of an output block that are not wall-clock times."""
+    times = [m.span() for m in TIME.finditer(text)]
+    return [m for m in re.finditer(r"\d+", text) if not any(a <= m.start() < b for a, b in times)]
+
+
+@pytest.mark.parametrize("block", _output_blocks(), ids=lambda b: b.id)
+def test_every_number_shown_is_compared(block: Block) -> None:
+    """The checker itself: the page's output compared with itself matches, and with any one of
+    its numbers changed (as a changed result would print it) no longer does."""
+    text = block.text
+    assert output_matches(text, text)
+    numbers = _numbers(text)
+    for m in numbers:
+        digit = str((int(text[m.end() - 1]) + 1) % 10)
+        edited = text[:m.end() - 1] + digit + text[m.end():]
+        assert not output_matches(edited, text), f"{block.id}: {m.group(0)} at {m.start()} is not compared"
+
+
+def test_the_output_checker_on_a_run(tmp_path: Path) -> None:
+    """A block's real output passes, a changed number fails, and only times are normalised."""
+    block = Block("docs/example.md", 1, "bash", "printf 'distance 20\\nwrote runs/x in 3.2 s\\n  \\n'\n", frozenset())
+    printed = _run(["bash", "-c", block.text], block, tmp_path)
+    assert output_matches("distance 20\nwrote runs/x in 12 s\n", printed)
+    assert not output_matches("distance 21\nwrote runs/x in 12 s\n", printed)
+    assert not output_matches("distance 20\nwrote runs/y in 12 s\n", printed)
+    assert not output_matches("distance 20\n", printed)
+    assert output_matches("distance 20\n...\n", printed) and output_matches("...\nwrote runs/x in 1 h\n", printed)
+    assert not output_matches("distance 20 steps\nwrote runs/x in 3.2 s\n", "distance 20 s\nwrote runs/x in 3.2 s\n")
+    assert TIME.sub("T", "62,651 steps/s, 20 seeds, 1,192 s, 0.5 ms, 14 min") == "62,651 steps/s, 20 seeds, T, T, T"
 
 
 def test_readme_set_up_commands_are_the_contract() -> None:
@@ -186,3 +288,64 @@ def test_every_module_named_exists(page: Path) -> None:
                 break
             obj = getattr(obj, name)
     assert not wrong, f"{page.relative_to(ROOT)} names modules or attributes that do not exist: {wrong}"
+
+
+def _linked_pages(page: Path) -> set[Path]:
+    """The Markdown pages of the repository a page links to."""
+    found = set()
+    for target in LINK.findall(page.read_text(encoding="utf-8")):
+        if re.match(r"[a-z]+:", target):
+            continue
+        path = (page.parent / target).resolve()
+        if path.suffix == ".md" and path.is_file() and path.is_relative_to(ROOT):
+            found.add(path)
+    return found
+
+
+def reachable_from_readme() -> set[Path]:
+    """Every page a reader gets to from README.md by following links, README.md included."""
+    seen, todo = set(), [ROOT / "README.md"]
+    while todo:
+        page = todo.pop()
+        if page not in seen:
+            seen.add(page)
+            todo.extend(_linked_pages(page) - seen)
+    return seen
+
+
+def test_every_docs_page_is_reachable_from_the_readme() -> None:
+    pages = set((ROOT / "docs").rglob("*.md"))
+    orphans = sorted(str(p.relative_to(ROOT)) for p in pages - reachable_from_readme())
+    assert not orphans, f"docs pages no link leads to from README.md: {orphans}"
+
+
+def test_reachability_follows_links_only(tmp_path: Path) -> None:
+    """The checker itself: a page linked from nowhere is not reached."""
+    reached = reachable_from_readme()
+    assert ROOT / "docs" / "api.md" in reached and ROOT / "BENCHMARKS.md" in reached
+    assert _linked_pages(ROOT / "docs" / "setup.md") <= reached
+    orphan = tmp_path / "orphan.md"
+    orphan.write_text("# Linked from nowhere\n\n[the README](README.md)\n")
+    assert orphan.resolve() not in reached
+
+
+ISSUE_NUMBER = re.compile(r"\bissues?\s*#?\d+|(?<![\w&/])#\d+\b|\bthe issue's\b", re.IGNORECASE)
+"""What a reader of the docs cannot look up: the tracker's numbers, and "the issue's" target."""
+
+
+def _reader_pages() -> list[Path]:
+    return [ROOT / "README.md", ROOT / "BENCHMARKS.md", *sorted((ROOT / "docs").rglob("*.md"))]
+
+
+@pytest.mark.parametrize("page", _reader_pages(), ids=lambda p: str(p.relative_to(ROOT)))
+def test_no_page_names_an_issue(page: Path) -> None:
+    found = [(n, m.group(0)) for n, line in enumerate(page.read_text(encoding="utf-8").splitlines(), 1)
+             for m in ISSUE_NUMBER.finditer(line)]
+    assert not found, f"{page.relative_to(ROOT)} names issues a reader cannot look up (line, text): {found}"
+
+
+def test_issue_pattern_catches_the_forms_seen() -> None:
+    for text in ("on the scene (issue 11).", "see #36", "Issue #4 says", "The issue's target"):
+        assert ISSUE_NUMBER.search(text), text
+    for text in ("a known issue", "results.md#menagerie-arms", "colour &#8212;", "step 36"):
+        assert not ISSUE_NUMBER.search(text), text

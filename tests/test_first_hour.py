@@ -77,7 +77,7 @@ def test_to_frame_has_one_row_per_trial_of_every_method_and_control(ten_trials):
     assert len(runs) == 3 + 2 * 2  # none, pseudo, dense, and the two shaped methods under both controls
     assert len(df) == 10 * len(runs)
     for run in runs:
-        rows = df[(df.method == run.method) & (df.control.isna() if run.control is None else df.control == run.control)]
+        rows = df[(df.method == run.method) & (df.control == (run.control or "none"))]
         assert list(rows.trial) == list(range(10))
         steps = [None if pd.isna(x) else int(x) for x in rows.exploration_steps]
         assert steps == run.column("exploration_steps")
@@ -90,6 +90,19 @@ def test_to_frame_has_one_row_per_trial_of_every_method_and_control(ten_trials):
         assert column in df.columns, column
     assert set(df.source) == {"coarse"} and set(df.max_total_steps) == {300_000}
     assert (df.step_cap == 300_000).all()
+
+
+def test_a_default_groupby_keeps_the_main_runs(ten_trials):
+    """The runs on the given trajectory are labelled, not NaN, so pandas' default groupby (which
+    drops missing keys) still counts them beside the controls."""
+    df = ten_trials.to_frame()
+    assert df.control.notna().all()
+    assert set(df.control) == {"none", "shuffled", "random"}
+    counts = df.groupby(["method", "control"]).size()
+    assert counts.sum() == len(df)
+    for method in ("none", "pseudo", "dense"):
+        assert counts[(method, "none")] == 10
+    assert counts[("pseudo", "shuffled")] == 10 and ("none", "shuffled") not in counts.index
 
 
 def test_to_frame_without_pandas_names_the_extra(ten_trials, monkeypatch):

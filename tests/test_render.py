@@ -220,3 +220,64 @@ def test_bad_size_or_fps_is_render_error(replays, tmp_path, kwargs):
     with pytest.raises(RenderError):
         render_rollouts([RolloutPanel(replays["planar2:cartesian"])], tmp_path / "v.mp4", **kwargs)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.rendering
+def test_panels_are_captioned_and_the_shorter_holds_its_end_with_reached(robots, replays, tmp_path):
+    """Each panel names its arm and method and counts its steps; the shorter replay's frames
+    after its end are its last frame, captioned "reached the goal", repeated exactly."""
+    import imageio.v3 as iio
+
+    from armtransfer.ik import font
+    from armtransfer.ik.render import caption, panel_steps, rollout_frames
+
+    r = robots["planar2:cartesian"]
+    states, _ = _path(r, goal=(2, 0))
+    short = replay(r, states, segment_seconds=0.06, settle_seconds=0.1)
+    long = replays["ur5e_like:cartesian"]
+    fps, width, height = 20, 160, 120
+    panels = [RolloutPanel(short, label=["planar2:cartesian", "source"]),
+              RolloutPanel(long, label=["ur5e_like:cartesian", "target: pseudo"])]
+    ends = [len(p.replay.frame_indices(fps)) for p in panels]
+    assert ends[0] < ends[1] - 3  # the first panel ends frames before the second
+    renderers = [PanelRenderer(p, width, height) for p in panels]
+    try:
+        frames = list(rollout_frames(panels, renderers, fps))
+        plain = [np.array(rd.render(p.replay.qpos[p.replay.frame_indices(fps)[0]]))
+                 for p, rd in zip(panels, renderers)]
+        short_end = np.array(renderers[0].render(short.qpos[-1]))
+    finally:
+        for rd in renderers:
+            rd.close()
+    assert len(frames) == ends[1] and frames[0].shape == (height, 2 * width, 3)
+
+    # the caption is drawn over the first frame, top left, and nowhere else
+    box_h, box_w = font.text_size(["planar2:cartesian", "source", "step 0/9"])
+    first = frames[0][:, :width]
+    changed = np.any(first != plain[0], axis=-1)
+    assert changed[:box_h, :box_w].mean() > 0.5
+    assert not changed[box_h:].any() and not changed[:, box_w:].any()
+    assert np.array_equal(first, caption(plain[0].copy(), panels[0], 0, ended=False))
+
+    # the step counter follows the path: 0 at the start, every move once its ramp has ended
+    steps = panel_steps(short, short.frame_indices(fps))
+    assert steps[0] == 0 and steps[-1] == len(states) - 1 and np.all(np.diff(steps) >= 0)
+
+    # after its end the shorter panel is its last pose, captioned as reached, frame after frame
+    assert short.reached_goal
+    held = caption(short_end.copy(), panels[0], len(states) - 1, ended=True)
+    for k in range(ends[0] - 1, len(frames)):
+        assert np.array_equal(frames[k][:, :width], held), k
+    running = caption(short_end.copy(), panels[0], len(states) - 1, ended=False)
+    reached_box = np.any(held != running, axis=-1)
+    assert reached_box[height // 2:].sum() > 100 and not reached_box[:height // 2].any()
+    # while the second panel keeps moving
+    assert not np.array_equal(frames[ends[0]][:, width:], frames[-1][:, width:])
+
+    # the written video shows the captions too (H.264 is lossy: compared on average)
+    out = tmp_path / "captioned.mp4"
+    stats = render_rollouts(panels, out, width=width, height=height, fps=fps)
+    video = iio.imread(out, index=None).astype(int)
+    assert stats.frames == len(frames) == len(video)
+    box = (slice(0, box_h), slice(0, box_w))
+    assert np.abs(video[0][box] - frames[0][box]).mean() < 12 < np.abs(video[0][box] - plain[0][box]).mean()

@@ -18,7 +18,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import armtransfer.checks as checks
-from armtransfer.errors import InvalidParameterError, InvalidTaskError
+from armtransfer.errors import InvalidCellError, InvalidParameterError, InvalidTaskError
 from armtransfer.learning import farming, potentials
 from armtransfer.experiments import experiment
 from armtransfer.learning import methods as registry
@@ -150,13 +150,17 @@ def transfer(
     src = resolve(source, xml_path=arm_xml, layout=layout, **options)
     tgt = resolve(target, xml_path=arm_xml, layout=layout, **options)
     for robot in (src, tgt):
-        robot.start_state(start_cell)
-        robot.start_state(goal_cell, what="goal")
+        try:
+            robot.start_state(start_cell)
+            robot.start_state(goal_cell, what="goal")
+        except InvalidCellError as err:
+            raise InvalidCellError(_with_walls_cause(str(err), robot)) from None
     paths: dict[str, list[tuple[int, int]]] = {}
     for robot in (tgt, src):  # the source must solve the task too, to hand over its path
         found = robot.shortest_path(robot.start_state(start_cell), goal_cell)
         if found is None:
-            raise InvalidTaskError(f"robot {robot.name} cannot reach the goal {the_task.goal} from {the_task.start}")
+            raise InvalidTaskError(_with_walls_cause(
+                f"robot {robot.name} cannot reach the goal {the_task.goal} from {the_task.start}", robot))
         paths[robot.name] = found
     path = paths[tgt.name]
 
@@ -323,7 +327,17 @@ def _bad_k(K: str):
     raise InvalidParameterError(f"K must be a non-negative number or 'auto', got {K!r}")
 
 
-ARM_OPTIONS = ("tip_site", "tip_body", "tip_offset", "arm_name", "base_pos", "base_yaw", "cell_size", "joint_step",
+def _with_walls_cause(message: str, robot: DiscreteRobot) -> str:
+    """``message``, and why, when an arm misses cells because its geometry meets the walls."""
+    from armtransfer.tasks.arms import walls_cause
+
+    if robot.arm is None:
+        return message
+    cause = walls_cause(robot)
+    return f"{message}: it reaches {robot.arm.reach:.1%} of the free cells; {cause}" if cause else message
+
+
+ARM_OPTIONS = ("tip_site", "tip_body", "tip_offset", "tool", "arm_name", "base_pos", "base_yaw", "cell_size", "joint_step",
                "tip_down", "cache")
 """The keys of ``arm_options``: how an arm file is mounted and where its tool point is."""
 

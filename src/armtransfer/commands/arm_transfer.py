@@ -238,7 +238,8 @@ def arm_json(robot: DiscreteRobot) -> dict:
 
 def _paths(out_json: dict, source: DiscreteRobot, target: DiscreteRobot) -> dict:
     """The source's transferred path and the target's converged greedy path (first
-    converged trial of the first transfer method), as states and cells."""
+    converged trial of the first transfer method, named as ``target_method``; the target's
+    shortest path when none converged), as states and cells."""
     layout = target.layout
     start = layout.cell(*out_json["task"]["start"])
     goal = layout.cell(*out_json["task"]["goal"])
@@ -249,12 +250,12 @@ def _paths(out_json: dict, source: DiscreteRobot, target: DiscreteRobot) -> dict
         source_states = trajectories.states_along(source, traj)
     else:
         source_states = [source.start_state(start)]
-    target_states = None
+    target_states, target_method = None, "shortest path"
     for method, r in out_json["results"].items():
         if method != "none":
             for states in r.get("greedy_path_states", []):
                 if states:
-                    target_states = states
+                    target_states, target_method = states, method
                     break
         if target_states:
             break
@@ -267,6 +268,7 @@ def _paths(out_json: dict, source: DiscreteRobot, target: DiscreteRobot) -> dict
         "goal": goal,
         "source_states": source_states,
         "target_states": target_states,
+        "target_method": target_method,
         "target_xy": [list(layout.xy(int(target.label[s]))) for s in target_states],
     }
 
@@ -283,6 +285,8 @@ def _video(result: dict, args, path: Path, scenes: dict | None = None) -> dict:
             path, trajectory_cells=paths["trajectory_cells"], goal_cell=paths["goal"],
             width=size[0], height=size[1], fps=fps,
             scenes=[(scenes or {}).get(id(result[k])) for k in ("source", "target")], without=_without(args),
+            labels=[[result["source"].name, "source: hands its path"],
+                    [result["target"].name, f"target: {paths['target_method']}"]],
         )
 
 

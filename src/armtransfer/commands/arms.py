@@ -13,7 +13,7 @@ HELP = ("Transfer a trajectory from one MuJoCo arm to another; write results, ta
 EXAMPLE = "armtransfer arms --fast --out runs/demo"
 
 
-ARM_FILE_OPTIONS = {"arm_xml", "tip_site", "tip_body", "tip_offset", "arm_name", "base_pos", "base_yaw", "cell_size"}
+ARM_FILE_OPTIONS = {"arm_xml", "tip_site", "tip_body", "tip_offset", "tool", "arm_name", "base_pos", "base_yaw", "cell_size"}
 LIST_ONLY = {"arm", "actions"}
 LIST_OPTIONS = LIST_ONLY | ARM_FILE_OPTIONS | {"no_cache", "world"}
 GENERATE_ONLY = {"family", "dof"}
@@ -92,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
                   **{k: v for k, v in options.items() if k != "arm_name"})
         for a in custom:
             jobs.append(dict(arm=None, actions=a, xml_path=args.arm_xml, **options))
-    from armtransfer.tasks.arms import tasks_solvable
+    from armtransfer.tasks.arms import tasks_solvable, walls_cause
 
     def build(job: dict):
         job = dict(job)
@@ -114,6 +114,8 @@ def run(args: argparse.Namespace) -> int:
         print()
     for r in custom:
         print(f"{r.name}: {mount_line(r.arm)}")
+        if cause := walls_cause(r):
+            print(f"{r.name}: reaches {r.arm.reach:.1%} of the free cells: {cause}")
     return 0
 
 

@@ -280,6 +280,10 @@ def add_arm_file_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--tip-offset", metavar="X,Y,Z", default=None,
                         help="the tool point is this far (m) from the tip site or body, in its own frame; "
                              "the tool's axis, kept pointing down, runs along it (e.g. 0,0,0.12)")
+    parser.add_argument("--tool", metavar="stylus[:LENGTH[:RADIUS]]", default=None,
+                        help="a pen held at the tool point of --arm-xml along its axis, LENGTH and RADIUS in "
+                             "metres (default 0.05 and 0.0015): a gripper then rides above the walls, and the "
+                             "cell is read at the pen's end (a spatial arm, its tool kept pointing down)")
     parser.add_argument("--arm-name", metavar="NAME", default=None,
                         help="the name of --arm-xml in tables, plots, JSON and the cache (default: its "
                              "MJCF model attribute)")
@@ -309,7 +313,8 @@ def check_arm_flags(args: argparse.Namespace) -> None:
     if getattr(args, "cell_size", None) is not None and not (math.isfinite(args.cell_size) and args.cell_size > 0):
         raise ArmModelError(f"--cell-size must be a positive number of metres, got {args.cell_size!r}")
     flags = (("--base-pos", "base_pos"), ("--base-yaw", "base_yaw"), ("--tip-site", "tip_site"),
-             ("--tip-body", "tip_body"), ("--tip-offset", "tip_offset"), ("--arm-name", "arm_name"))
+             ("--tip-body", "tip_body"), ("--tip-offset", "tip_offset"), ("--tool", "tool"),
+             ("--arm-name", "arm_name"))
     if not getattr(args, "arm_xml", None):
         given = [flag for flag, attr in flags if getattr(args, attr, None) is not None]
         if given:
@@ -322,7 +327,7 @@ def check_arm_flags(args: argparse.Namespace) -> None:
 
 def arm_file_options(args: argparse.Namespace) -> dict:
     """The bring-your-own arm's options as ``arm_robot`` keywords, checked."""
-    from armtransfer.ik.tool import parse_offset
+    from armtransfer.ik.tool import parse_held, parse_offset
 
     if args.tip_site is not None and args.tip_body is not None:
         raise ArmModelError("give --tip-site or --tip-body, not both")
@@ -330,4 +335,5 @@ def arm_file_options(args: argparse.Namespace) -> dict:
         raise ArmModelError("--arm-name must not be empty")
     return dict(tip_site=args.tip_site, tip_body=args.tip_body,
                 tip_offset=parse_offset(args.tip_offset) if args.tip_offset is not None else None,
+                tool=parse_held(args.tool).spec() if getattr(args, "tool", None) is not None else None,
                 arm_name=args.arm_name, base_pos=parse_base_pos(args.base_pos), base_yaw=args.base_yaw)

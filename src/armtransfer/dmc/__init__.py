@@ -53,7 +53,7 @@ def load(arm: str | None = None, actions: str = "joint", task: int | None = 1, *
     to ``goal`` cells, as ``dm_control.suite.load`` gives one of the suite's.
 
     ``arm`` is a built-in arm (planar2 by default) or, with ``xml_path=``, an arm file with
-    ``tip_site=``/``tip_body=``, ``tip_offset=``, ``arm_name=``, ``base_pos=``/``base_yaw=``
+    ``tip_site=``/``tip_body=``, ``tip_offset=``, ``tool=``, ``arm_name=``, ``base_pos=``/``base_yaw=``
     (:data:`armtransfer.tasks.envs.ARM_OPTIONS`), compiled or loaded from the cache as the
     Gymnasium environment's. ``random`` is the wind's ``numpy.random.Generator`` or its seed.
     An episode is cut after ``step_limit`` steps (None: never). ``trajectory`` (a

@@ -107,7 +107,7 @@ class TransferResult:
 
     def to_frame(self) -> "pd.DataFrame":
         """A tidy pandas DataFrame: one row per trial of every method and control (``control``
-        names it, None for the real trajectory), every per-trial metric a column (exploration,
+        names it, ``"none"`` for the real trajectory), every per-trial metric a column (exploration,
         total and greedy steps, convergence, episodes, the K used, Taylor and Stone's transfer
         metrics, the mapped share for ``mapping``), then the run's settings (task, robots,
         seed, wind, trajectory length, every learner setting). A trial that never reached the

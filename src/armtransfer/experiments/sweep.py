@@ -26,6 +26,7 @@ their own and then used by name in ``pairs``, as ``NAME`` or ``NAME:ACTIONS``::
     xml = "mujoco_menagerie/universal_robots_ur5e/ur5e.xml"   # relative to the sweep file
     tip_site = "attachment_site"         # or tip_body = "hand"
     tip_offset = [0, 0, 0.12]            # metres, in the site's or body's frame
+    tool = "stylus:0.05"                 # optional: a pen held at the tool point
     # base_pos = [0, -0.4, 0]; base_yaw = 1.5708   (default: chosen automatically)
 
 A sweep runs in one world, ``world = "rooms11"`` (a built-in name, ``generated:SEED[:SIDE]`` or
@@ -125,7 +126,8 @@ def size(spec: dict) -> int:
     return n
 
 
-ARM_KEYS: dict[str, type | tuple[type, ...]] = {"xml": str, "tip_site": str, "tip_body": str, "tip_offset": list, "base_pos": list,
+ARM_KEYS: dict[str, type | tuple[type, ...]] = {"xml": str, "tip_site": str, "tip_body": str, "tip_offset": list, "tool": str,
+            "base_pos": list,
             "base_yaw": (int, float)}
 """The keys of an ``[arms.NAME]`` table and their types."""
 
@@ -154,6 +156,13 @@ def _arms(raw: object, where: str, base: Path | None) -> dict:
             if key in body and not (len(body[key]) == 3 and all(
                     isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in body[key])):
                 raise SweepFileError(f"{w}: {key} must be three finite numbers [X, Y, Z] (metres)")
+        if "tool" in body:
+            from armtransfer.ik.tool import parse_held
+
+            try:
+                parse_held(body["tool"])
+            except ArmTransferError as err:
+                raise SweepFileError(f"{w}: tool: {err}") from None
         if "base_yaw" in body and not math.isfinite(body["base_yaw"]):
             raise SweepFileError(f"{w}: base_yaw must be a finite number of radians")
         arm = dict(body)

@@ -12,8 +12,12 @@ Each panel is one ``Replay`` (``armtransfer.ik.replay``) rendered with its own m
 and the arm wherever it is mounted; the tool tip's path is drawn on the table as a line.
 Markers are drawn as MuJoCo user geoms added to the renderer's scene (they are not part
 of the model, so they never collide): the transferred trajectory's cells as orange
-tiles, the goal cell as a green disc. Panels are concatenated left to right; a shorter
-replay holds its last frame. Frames are streamed to the encoder, one at a time: MP4
+tiles, the goal cell as a green disc. Each panel is captioned (``armtransfer.ik.font``, a
+bitmap font drawn with numpy) with its lines, e.g. the arm and the method that moved it, and
+the step of the path it is on; panels are concatenated left to right. A replay that ends
+before the others holds its last frame, captioned "reached the goal" (or "ended off the
+goal"), until the longest one ends, which gets the same caption on its last frame. Frames are
+streamed to the encoder, one at a time: MP4
 (H.264 through imageio's ffmpeg plugin, the binary from ``imageio-ffmpeg``) or GIF
 (Pillow). The video is written to a temporary file beside the destination and renamed
 over it only when complete, so a failed or interrupted render leaves nothing behind.
@@ -39,13 +43,13 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Self, Sequence
+from typing import TYPE_CHECKING, Iterator, Self, Sequence
 
 import mujoco  # after armtransfer.ik named the backend
 import numpy as np
 
 from armtransfer.errors import ArmTransferError
-from armtransfer.ik import offscreen
+from armtransfer.ik import font, offscreen
 from armtransfer.ik.replay import Replay, replay
 from armtransfer.ik.workspace import WALL_HEIGHT
 from armtransfer.io import OutputError, check_writable
@@ -108,6 +112,12 @@ class RolloutPanel:
     """A blue tile under the first planned cell."""
     show_tip_path: bool = True
     """A line on the table where the tool tip went during the replay."""
+    label: Sequence[str] = ()
+    """Caption lines in the top-left corner, e.g. the arm and the method that moved it."""
+    show_step: bool = True
+    """A caption line ``step k/n``: the moves of the path done so far; and, from the replay's
+    end on, whether it ended on the goal (bottom-left). False draws no caption at all but
+    ``label``."""
 
 
 @dataclass
@@ -329,6 +339,59 @@ def _markers(panel: RolloutPanel) -> list[Marker]:
     return out
 
 
+REACHED_RGB = (120, 255, 120)
+MISSED_RGB = (255, 150, 90)
+
+
+def caption_scale(width: int) -> int:
+    """The font's scale for a panel ``width`` pixels wide: 2 from 300 px on, else 1."""
+    return 2 if width >= 300 else 1
+
+
+def panel_steps(rp: Replay, indices: np.ndarray) -> np.ndarray:
+    """Moves of the path done at each of the replay's samples ``indices`` (0 at the start,
+    ``len(path) - 1`` once the last waypoint's ramp has ended)."""
+    return np.searchsorted(rp.waypoint_index[1:], indices, side="right")
+
+
+def caption(image: np.ndarray, panel: RolloutPanel, step: int, ended: bool) -> np.ndarray:
+    """``image`` (a frame of ``panel``, changed in place and returned) with its caption: the
+    panel's label lines and ``step k/n`` top left; once ``ended``, whether the replay ended on
+    the goal, bottom left."""
+    rp = panel.replay
+    scale = caption_scale(image.shape[1])
+    lines = list(panel.label)
+    if panel.show_step:
+        lines.append(f"step {step}/{len(rp.path_states) - 1}")
+    font.draw_lines(image, lines, scale=scale)
+    if panel.show_step and ended:
+        reached = rp.reached_goal
+        font.draw_lines(image, ["reached the goal" if reached else "ended off the goal"], corner="bottom-left",
+                        scale=scale, color=REACHED_RGB if reached else MISSED_RGB)
+    return image
+
+
+def rollout_frames(panels: Sequence[RolloutPanel], renderers: Sequence[PanelRenderer],
+                   fps: float) -> Iterator[np.ndarray]:
+    """The video's frames, one per 1 / ``fps`` s of simulation: the panels side by side, each
+    captioned; a replay that has ended repeats its last captioned frame (drawn once)."""
+    indices = [p.replay.frame_indices(fps) for p in panels]
+    steps = [panel_steps(p.replay, idx) for p, idx in zip(panels, indices)]
+    held: dict[int, np.ndarray] = {}
+    for k in range(max(len(idx) for idx in indices)):
+        images = []
+        for i, (p, r, idx) in enumerate(zip(panels, renderers, indices)):
+            if i not in held:
+                j = min(k, len(idx) - 1)
+                image = caption(np.array(r.render(p.replay.qpos[idx[j]])), p, int(steps[i][j]), j == len(idx) - 1)
+                if j == len(idx) - 1:
+                    held[i] = image
+            else:
+                image = held[i]
+            images.append(image)
+        yield images[0] if len(images) == 1 else np.concatenate(images, axis=1)
+
+
 def _pad_even(frame: np.ndarray) -> np.ndarray:
     """H.264 in yuv420p needs even sizes: repeat the last row/column when odd."""
     h, w = frame.shape[:2]
@@ -407,17 +470,18 @@ def render_rollouts(panels: Sequence[RolloutPanel] | RolloutPanel, path: str | o
     renderers: list[PanelRenderer] = []
     writer = None
     try:
-        frames_q = [p.replay.frames_qpos(fps) for p in panels]
-        n_frames = max(len(q) for q in frames_q)
         for p in panels:
             renderers.append(PanelRenderer(p, width, height, shadows=shadows, samples=samples, without=without))
         writer = _Writer(tmp, fmt, fps, quality)
-        for k in range(n_frames):
+        frames = rollout_frames(panels, renderers, fps)
+        while True:
             t0 = time.perf_counter()
-            images = [r.render(q[min(k, len(q) - 1)]) for r, q in zip(renderers, frames_q)]
-            frame = images[0] if len(images) == 1 else np.concatenate(images, axis=1)
+            frame = next(frames, None)
+            if frame is None:
+                break
             t1 = time.perf_counter()
             writer.append(frame)
+            n_frames += 1
             render_s += t1 - t0
             encode_s += time.perf_counter() - t1
         t1 = time.perf_counter()
@@ -456,12 +520,13 @@ def rollout_video(rollouts: Sequence[tuple[object, Sequence[int]]],
                   goal_cell: int | None = None, width: int = 320, height: int = 240,
                   fps: float = 30.0, format: str | None = None, shadows: bool = False,
                   replay_options: dict | None = None, scenes: Sequence | None = None,
-                  without: str = WITHOUT) -> dict:
+                  labels: Sequence[Sequence[str]] | None = None, without: str = WITHOUT) -> dict:
     """Replay each (robot, path states) in MuJoCo and render them side by side to ``path``.
 
     ``trajectory_cells`` (the transferred trajectory) and ``goal_cell`` are marked in every
     panel. ``scenes``, one per rollout (None: rebuilt), are the robots' own scenes, e.g. those
-    ``check_replayable`` returned. Returns a JSON-able report: the video's stats and, per
+    ``check_replayable`` returned. ``labels``, one list of caption lines per rollout, name
+    each panel (default: the robot's name). Returns a JSON-able report: the video's stats and, per
     panel, the replay's ``max_deviation_cells``, ``reached_goal`` and friends
     (``Replay.report()``). A machine where OpenGL cannot draw is found out before the
     replays: an ``OffscreenError`` names what to install and ends with ``without``.
@@ -472,13 +537,16 @@ def rollout_video(rollouts: Sequence[tuple[object, Sequence[int]]],
     scenes = list(scenes) if scenes is not None else [None] * len(rollouts)
     if len(scenes) != len(rollouts):
         raise RenderError(f"{len(scenes)} scenes for {len(rollouts)} rollouts")
+    if labels is not None and len(labels) != len(rollouts):
+        raise RenderError(f"{len(labels)} labels for {len(rollouts)} rollouts")
     replays = [replay(robot, states, goal_cell=goal_cell, scene=scene, **(replay_options or {}))
                for (robot, states), scene in zip(rollouts, scenes)]
-    panels = [RolloutPanel(rp, trajectory_cells, goal_cell) for rp in replays]
+    labels = [[rp.robot] for rp in replays] if labels is None else labels
+    panels = [RolloutPanel(rp, trajectory_cells, goal_cell, label=list(lines)) for rp, lines in zip(replays, labels)]
     stats = render_rollouts(panels, path, width=width, height=height, fps=fps, format=format,
                             shadows=shadows, without=without)
     return {**stats.report(), "replays": [rp.report() for rp in replays]}
 
 
-__all__ = ["PanelRenderer", "RenderError", "RenderStats", "RolloutPanel", "render_rollouts",
-           "rollout_video", "table_camera", "video_format"]
+__all__ = ["PanelRenderer", "RenderError", "RenderStats", "RolloutPanel", "caption", "render_rollouts",
+           "rollout_frames", "rollout_video", "table_camera", "video_format"]

@@ -414,9 +414,15 @@ def _actuators(spec: mujoco.MjSpec, model: mujoco.MjModel, chain: list[int]) -> 
     return [j for j in chain if j not in keep]
 
 
+STYLUS = "stylus_held"
+"""Name of the geom of a held :class:`~armtransfer.ik.tool.Stylus` (the pen)."""
+
+
 def _tool_site(spec: mujoco.MjSpec, model: mujoco.MjModel, tool: Tool, tip_body: int) -> str:
-    """The site the scene uses as the tool tip (added when the tool has an offset or is a body)."""
-    if tool.site is not None and not tool.has_offset:
+    """The site the scene uses as the tool tip (added when the tool has an offset, is a body or
+    holds a stylus; a held stylus is a capsule from the tool point along the tool axis, and the
+    site is at its end)."""
+    if tool.site is not None and not tool.has_offset and tool.held is None:
         return tool.site
     if tool.site is not None:
         sid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, tool.site)
@@ -437,7 +443,18 @@ def _tool_site(spec: mujoco.MjSpec, model: mujoco.MjModel, tool: Tool, tip_body:
     body = spec.body(body_name) if body_name else None
     if body is None:
         raise ArmModelError("the tool's body needs a name in the arm MJCF")
-    body.add_site(name=name, pos=frame_pos + _rotate(frame_quat, offset), quat=quat, size=[0.004, 0, 0],
+    point = frame_pos + _rotate(frame_quat, offset)
+    if tool.held is not None:
+        end = point + _rotate(quat, np.array([0.0, 0.0, tool.held.length]))
+        pen = STYLUS
+        geoms = {_name(model, mujoco.mjtObj.mjOBJ_GEOM, i) for i in range(model.ngeom)}
+        while pen in geoms:
+            pen += "_"
+        body.add_geom(name=pen, type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[tool.held.radius, 0.0, 0.0],
+                      fromto=[*map(float, point), *map(float, end)], rgba=[0.15, 0.15, 0.18, 1.0],
+                      contype=1, conaffinity=1, group=0)
+        point = end
+    body.add_site(name=name, pos=point, quat=quat, size=[0.004, 0, 0],
                   rgba=[0.9, 0.2, 0.2, 1.0], group=4)
     return name
 
@@ -528,6 +545,10 @@ def build_scene(xml_path: Path, tool: Tool | str = "tip", mount_pos=(0.0, 0.0, 0
     data.qpos[:] = home
     mujoco.mj_kinematics(scene, data)
     planar = bool(np.all(np.abs(np.abs(data.xaxis[:, 2]) - 1.0) < 1e-6))
+    if planar and tool.held is not None:
+        raise ArmModelError(f"arm MJCF {where} moves in a plane at a fixed height, so a held {tool.held.spec()} would "
+                            "put its tip off the table; a held tool needs a spatial arm (its tool kept pointing "
+                            "down): for a planar arm's own pen, give --cell-size for wider doors")
     tip_id = mujoco.mj_name2id(scene, mujoco.mjtObj.mjOBJ_SITE, PREFIX + tip_name)
     table_geoms = np.flatnonzero(env)
     hits_table = np.zeros(scene.ngeom, dtype=bool)
@@ -574,6 +595,16 @@ class ContactChecker:
         self.can_self_collide = bool(pairs.any())
         """Whether any two of the arm's geoms on different bodies, one of them moving, may
         collide by their contype/conaffinity (the built-in arms' may not)."""
+
+    @property
+    def walls(self) -> np.ndarray:
+        """Boolean over geoms: the workspace's walls."""
+        return self._walls
+
+    def contacts(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Every contact MuJoCo finds at q, as two arrays of geom ids (kinematics and collision
+        are run on :attr:`data`)."""
+        return self._contacts(q)
 
     def _contacts(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         d = self.data

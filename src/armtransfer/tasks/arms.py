@@ -26,7 +26,7 @@ import armtransfer.checks as checks
 from armtransfer.ik import cache as _cache
 from armtransfer.ik.actions import ACTION_MODELS, action_model
 from armtransfer.ik.description import ArmDescription
-from armtransfer.ik.tool import Tool
+from armtransfer.ik.tool import Tool, parse_held
 from armtransfer.errors import ArmModelError, UnknownArmError
 from armtransfer.models import ARMS
 from armtransfer.worlds.layout import ROOMS, Layout
@@ -96,15 +96,17 @@ def tasks_solvable(robot: DiscreteRobot, tasks=None) -> int:
     return solved
 
 
-def make_tool(tip_site: str | None = None, tip_body: str | None = None, tip_offset=None) -> Tool:
+def make_tool(tip_site: str | None = None, tip_body: str | None = None, tip_offset=None, tool=None) -> Tool:
     """The tool point of a bring-your-own arm: ``tip_site`` or ``tip_body`` (not both; the site
-    ``tip`` when neither is given), with an optional offset in its frame (metres)."""
+    ``tip`` when neither is given), with an optional offset in its frame (metres), and the tool
+    the hand holds there, ``tool`` (``"stylus[:LENGTH[:RADIUS]]"`` or a ``Stylus``), if any."""
     if tip_site is not None and tip_body is not None:
         raise ArmModelError("give the tool point as a tip site or a tip body, not both")
     offset = tuple(tip_offset) if tip_offset is not None else (0.0, 0.0, 0.0)
+    held = parse_held(tool) if tool is not None else None
     if tip_body is not None:
-        return Tool(site=None, body=tip_body, offset=offset)
-    return Tool(site=tip_site or "tip", offset=offset)
+        return Tool(site=None, body=tip_body, offset=offset, held=held)
+    return Tool(site=tip_site or "tip", offset=offset, held=held)
 
 
 def file_arm_name(path: Path) -> str:
@@ -125,7 +127,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
               tip_body: str | None = None, tip_offset=None, arm_name: str | None = None,
               base_pos: tuple[float, float, float] | None = None, base_yaw: float | None = None,
               joint_step: float | None = None, tip_down: bool | None = None, layout: Layout = ROOMS,
-              cache: bool = True, progress: bool = False) -> DiscreteRobot:
+              cache: bool = True, progress: bool = False, tool=None) -> DiscreteRobot:
     """Compile (or load from the cache) the discrete robot of an arm and action model.
 
     Built-in arms are named by ``arm``. A bring-your-own arm is the MJCF file ``xml_path``
@@ -134,10 +136,13 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
     (default: the file's ``model`` attribute). Its base pose ``base_pos``/``base_yaw`` is in
     the table frame (tabletop z = 0, cell (x, y) centred at (x * cell_size, y * cell_size));
     without ``base_pos`` it is chosen automatically (see :func:`automatic_mount`). A spatial
-    bring-your-own arm keeps its tool pointing down unless ``tip_down=False``. The cell size is
-    the world's (``ik.workspace.world_cell``: 1 cm on the rooms) unless given.
+    bring-your-own arm keeps its tool pointing down unless ``tip_down=False``. ``tool`` puts a
+    pen in the hand, ``"stylus[:LENGTH[:RADIUS]]"`` (metres; see ``ik.tool.Stylus``), for any arm
+    whose tool is kept pointing down; the cell is read at the pen's end. The cell size is the
+    world's (``ik.workspace.world_cell``: 1 cm on the rooms) unless given.
     """
     model = action_model(actions)
+    stylus = parse_held(tool) if tool is not None else None
     cell_size, base_pos, base_yaw = _checked_pose(cell_size, base_pos, base_yaw, layout)
     if joint_step is not None:
         joint_step = checks.real(joint_step, "the joint step (radians)", 0.0, math.pi, lo_open=True,
@@ -161,7 +166,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
             xml_bytes = path.read_bytes()
         except OSError as err:
             raise ArmModelError(f"cannot read arm MJCF {str(path)!r}: {err.strerror or err}") from None
-        tool = make_tool(tip_site, tip_body, tip_offset)
+        tool = make_tool(tip_site, tip_body, tip_offset, stylus)
         name = arm_name or arm or file_arm_name(path)
         kind, source = "custom", "given"
         generated = read_sidecar(path) if base_pos is None else None
@@ -182,7 +187,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
             raise UnknownArmError(f"unknown arm {arm!r}; valid arms: {', '.join(ARMS)}")
         check_actions(arm, actions)
         info = ARMS[arm]
-        path, name, tool = info.xml_path, arm, Tool(site=info.tip_site)
+        path, name, tool = info.xml_path, arm, Tool(site=info.tip_site, held=stylus)
         xml_bytes = path.read_bytes()
         mount, source = _builtin_mount(info, cell_size, layout), "built-in"
         if base_pos is not None:
@@ -457,7 +462,8 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float | None = None, l
 def _mount_robot(path: Path, tool: Tool, pose, cell_size: float, layout: Layout, cache: bool) -> DiscreteRobot:
     """The 1-cell cartesian robot of the arm file at ``pose``: how the automatic mount ranks it."""
     return arm_robot(None, "cartesian", cell_size=cell_size, xml_path=path, tip_site=tool.site, tip_body=tool.body,
-                     tip_offset=tool.offset, base_pos=pose.pos, base_yaw=pose.yaw, layout=layout, cache=cache)
+                     tip_offset=tool.offset, base_pos=pose.pos, base_yaw=pose.yaw, layout=layout, cache=cache,
+                     tool=tool.held)
 
 
 def _cached_pose(entry: Path, key: str) -> tuple[tuple[tuple[float, float, float], float], tuple[int, float]] | None:
@@ -548,18 +554,34 @@ def _assets_sha(path: Path) -> str:
 
 def arm_scene(arm: str | None = None, *, cell_size: float | None = None, xml_path=None,
               tip_site: str | None = None, tip_body: str | None = None, tip_offset=None,
-              base_pos=None, base_yaw: float | None = None, layout: Layout = ROOMS):
+              base_pos=None, base_yaw: float | None = None, layout: Layout = ROOMS, tool=None):
     """The MuJoCo scene (``ik.scene.ArmScene``) a robot of this arm is compiled in (a
     bring-your-own arm without ``base_pos`` at the origin)."""
     cell_size, base_pos, base_yaw = _checked_pose(cell_size, base_pos, base_yaw, layout)
     if xml_path is not None:
-        return _scene(Path(xml_path), make_tool(tip_site, tip_body, tip_offset), base_pos or (0.0, 0.0, 0.0),
+        return _scene(Path(xml_path), make_tool(tip_site, tip_body, tip_offset, tool), base_pos or (0.0, 0.0, 0.0),
                       base_yaw or 0.0, cell_size, layout)
     if arm not in ARMS:
         raise UnknownArmError(f"unknown arm {arm!r}; valid arms: {', '.join(ARMS)}")
     info = ARMS[arm]
-    return _scene(info.xml_path, Tool(site=info.tip_site), _builtin_mount(info, cell_size, layout), info.mount_yaw,
+    return _scene(info.xml_path, Tool(site=info.tip_site, held=parse_held(tool) if tool is not None else None),
+                  _builtin_mount(info, cell_size, layout), info.mount_yaw,
                   cell_size, layout)
+
+
+def walls_cause(robot: DiscreteRobot) -> str:
+    """Why an arm robot reaches less than ``ik.walls.REACH_OK`` of the free cells, when its
+    geometry meets the walls: the geometry, its width against a door's, and the remedy (see
+    ``ik.walls``); "" when it reaches enough, is no arm, or the walls are not the cause."""
+    from armtransfer.ik import walls as _walls
+
+    arm = robot.arm
+    if arm is None or arm.reach >= _walls.REACH_OK:
+        return ""
+    scene = _scene(arm.xml_path, arm.tool, arm.mount, arm.yaw, arm.cell_size, arm.layout)
+    reached = np.zeros(arm.layout.n_cells, dtype=bool)
+    reached[np.unique(robot.label)] = True
+    return _walls.wall_cause(scene, not scene.planar, reached)
 
 
 def _scene(path, tool: Tool, mount, yaw, cell, layout):
@@ -583,5 +605,5 @@ def _compile(scene, model, tip_down, step, progress) -> dict:
     return arrays
 
 
-__all__ = ["arm_robot", "arm_scene", "automatic_mount", "make_tool", "compile_order", "mount_search", "parse_robot_spec", "robot", "robot_specs",
+__all__ = ["walls_cause", "arm_robot", "arm_scene", "automatic_mount", "make_tool", "compile_order", "mount_search", "parse_robot_spec", "robot", "robot_specs",
            "tasks_solvable"]

@@ -207,7 +207,7 @@ def check_options(kwargs: dict, extra: tuple[str, ...] = ()) -> None:
             f"unknown environment option {unknown[0]!r}; valid options: {', '.join(TASK_OPTIONS + extra)}")
 
 
-ARM_OPTIONS = ("cell_size", "xml_path", "tip_site", "tip_body", "tip_offset", "arm_name", "base_pos", "base_yaw",
+ARM_OPTIONS = ("cell_size", "xml_path", "tip_site", "tip_body", "tip_offset", "tool", "arm_name", "base_pos", "base_yaw",
                "joint_step", "cache")
 """The keywords of an arm environment that build its robot (the rest set up the task)."""
 
@@ -237,8 +237,9 @@ def make_arm_rooms_env(arm: str | None = None, actions: str = "joint", task: int
     """Entry point of ``armtransfer/ArmRooms-v0``: an arm robot (compiled or loaded from the
     cache) on a task of ``world`` (Table I's on the paper's rooms, the default) or a custom
     task; the table is built from the world. Bring-your-own arms: ``xml_path=`` with
-    ``tip_site=`` or ``tip_body=``, ``tip_offset=``, ``arm_name=``, ``base_pos=``/``base_yaw=``
-    (automatic without)."""
+    ``tip_site=`` or ``tip_body=``, ``tip_offset=``, ``tool=`` (a held pen,
+    ``"stylus[:LENGTH[:RADIUS]]"``), ``arm_name=``, ``base_pos=``/``base_yaw=`` (automatic
+    without)."""
     check_options(kwargs, ARM_OPTIONS)
     the_task = rooms_task(task, start, goal, world)  # a bad world or task fails before any compiling
     return RobotRoomsEnv(rooms_arm(arm, actions, kwargs, the_task.layout), the_task, **kwargs)

@@ -1,7 +1,8 @@
 """Tidy tables of trials for pandas (and seaborn, rliable, ... that read tidy frames).
 
 One row per trial of a method (and of a control: a method given a shuffled or random
-trajectory), every per-trial metric a column, the run's settings as columns too, so that
+trajectory), every per-trial metric a column, ``control`` a label on every row (``"none"`` for
+the trajectory the run was given, so a default ``groupby`` keeps those rows), the run's settings as columns too, so that
 ``df.groupby(["target", "method"]).exploration_steps.describe()`` or a plot reads it as it is.
 
 A trial that never reached the goal is kept, never dropped: its ``reached`` is False and its
@@ -27,6 +28,9 @@ COUNTS = ("exploration_steps", "total_steps", "greedy_steps", "episodes", "step_
 LEAD = ("method", "control", "trial", "reached", "exploration_steps", "converged", "total_steps", "greedy_steps",
         "episodes")
 """The columns a frame starts with, in this order; the other metrics and the settings follow."""
+NO_CONTROL = "none"
+"""The ``control`` of a run on the trajectory it was given (not a control's): a label, not a
+missing value, which pandas' ``groupby`` and plots would drop."""
 
 
 class MissingExtraError(ArmTransferError):
@@ -58,7 +62,8 @@ def settings_columns(settings: dict) -> dict:
 
 def trial_rows(method: str, control: str | None, per_trial: dict[str, Sequence], settings: dict) -> list[dict]:
     """One row per trial: ``per_trial`` maps each metric to its list over the trials (a
-    scalar is the same for every trial); ``settings`` are the run's columns."""
+    scalar is the same for every trial); ``settings`` are the run's columns. ``control`` None
+    (the given trajectory) is labelled :data:`NO_CONTROL`."""
     lists = {k: v for k, v in per_trial.items() if isinstance(v, (list, tuple))}
     n = len(per_trial["exploration_steps"])
     if any(len(v) != n for v in lists.values()):
@@ -67,7 +72,8 @@ def trial_rows(method: str, control: str | None, per_trial: dict[str, Sequence],
     flat = settings_columns(settings)
     rows = []
     for trial in range(n):
-        row: dict[str, object] = {"method": method, "control": control, "trial": trial}
+        row: dict[str, object] = {"method": method, "control": NO_CONTROL if control is None else control,
+                                  "trial": trial}
         for name, value in per_trial.items():
             row[name] = value[trial] if name in lists else value
         row["reached"] = row["exploration_steps"] is not None
