@@ -29,8 +29,9 @@ from armtransfer.learning.mapping import load_for as load_mapping
 from armtransfer.experiments.continuous import ContinuousResult
 from armtransfer.experiments.results import MappingInfo, TransferResult
 from armtransfer.learning.trajectory import Trajectory
-from armtransfer.tasks.catalog import Task, as_xy, custom_task, table_task
-from armtransfer.worlds.layout import ROOMS
+from armtransfer.tasks.catalog import Task, as_xy, custom_task, table_task, world_task
+from armtransfer.worlds.layout import ROOMS, Layout
+from armtransfer.worlds.resolve import world as resolve_world
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.tasks.specs import resolve
 
@@ -70,6 +71,7 @@ def transfer(
     arm_options: dict | None = None,
     progress: Callable[[], None] | None = None,
     state: str = "discrete",
+    world: str | Path | Layout | None = None,
     **learner_options,
 ) -> TransferResult | ContinuousResult:
     """Transfer a trajectory from ``source`` to ``target`` and learn with each method.
@@ -84,6 +86,11 @@ def transfer(
     with ``save_mapping`` the file is updated from this run's converged trials.
     ``learner_options`` are :class:`LearnerConfig` fields (``alpha``, ``epsilon``, ...).
     ``progress`` is called after every trial.
+
+    ``world`` is where the robots move: ``"rooms"`` (the paper's, the default), ``"rooms11"``,
+    ``"rooms15"``, ``"generated:SEED[:SIDE]"``, a layout file or a ``Layout``
+    (:mod:`armtransfer.worlds`); ``task`` is then one of its task names. Robots given as
+    ``DiscreteRobot`` objects bring their own world when ``world`` is None.
 
     ``state="continuous"``: the target is a planar arm (``"planar3:joint"``, an arm file
     ``"PATH.xml"``, or ``"custom"`` with ``arm_xml=``) whose state is its joint configuration,
@@ -120,6 +127,7 @@ def transfer(
     if arm_xml is not None:
         arm_xml = checks.path(arm_xml, "arm_xml")
     options = _arm_options(arm_options)
+    layout = _world(world, source, target)
     specs = list(_as_sequence(trajectory, "trajectory")) if trajectory is not None else ["learned"]
     uses_mapping = any(registry.get(m).macros for m in method_names)
     if mapping is not None and not uses_mapping:
@@ -129,7 +137,7 @@ def transfer(
     if save_mapping and not isinstance(mapping, (str, Path)):
         raise InvalidParameterError("save_mapping needs the mapping's file path")
 
-    the_task = _task(task, start, goal, specs)
+    the_task = _task(task, start, goal, specs, layout)
     start_cell, goal_cell = the_task.cells()
     if state == "continuous":
         if wind:
@@ -139,8 +147,8 @@ def transfer(
                                         "continuous one: " + ", ".join(_cell_methods()))
         return _transfer_continuous(source, target, the_task, method_names, specs, trials, seed, K, config,
                                     arm_xml, options, progress)
-    src = resolve(source, xml_path=arm_xml, **options)
-    tgt = resolve(target, xml_path=arm_xml, **options)
+    src = resolve(source, xml_path=arm_xml, layout=layout, **options)
+    tgt = resolve(target, xml_path=arm_xml, layout=layout, **options)
     for robot in (src, tgt):
         try:
             robot.start_state(start_cell)
@@ -231,12 +239,13 @@ def _transfer_continuous(source, target, the_task: Task, method_names: list[str]
     if target.partition(":")[0] == "custom":
         if arm_xml is None:
             raise InvalidParameterError("target 'custom' needs arm_xml")
-        arm = continuous_arm(None, xml_path=arm_xml, **options)
+        arm = continuous_arm(None, xml_path=arm_xml, layout=the_task.layout, **options)
     else:
-        arm = continuous_arm(target, **{k: v for k, v in options.items() if k in ("joint_step", "cell_size")})
+        arm = continuous_arm(target, layout=the_task.layout,
+                             **{k: v for k, v in options.items() if k in ("joint_step", "cell_size")})
     start_cell, goal_cell = the_task.cells(arm.layout)
     arm.place(start_cell)  # the task's start must be reachable before the source learns anything
-    src = resolve(source, xml_path=arm_xml, **options)
+    src = resolve(source, xml_path=arm_xml, layout=the_task.layout, **options)
     for cell, what in ((start_cell, "start"), (goal_cell, "goal")):
         src.start_state(cell, what=what)
     shaped = any(registry.get(m).shaped for m in method_names)
@@ -254,10 +263,11 @@ def resolve_trajectories(specs: Sequence[TrajectorySpec], source: DiscreteRobot,
     """Each spec: a :data:`TRAJECTORY_KINDS` kind made from the source robot, a trajectory JSON
     file for this task, or a :class:`Trajectory`."""
     start, goal = task.cells()
+    layout = task.layout
     out: list[Trajectory] = []
     for spec in specs:
         if isinstance(spec, Trajectory):
-            trajectories.check_task(spec, start, goal)
+            trajectories.check_task(spec, start, goal, layout)
             trajectories.check_source(spec, source)
             out.append(spec)
         elif spec in ("optimal", "learned"):
@@ -266,8 +276,8 @@ def resolve_trajectories(specs: Sequence[TrajectorySpec], source: DiscreteRobot,
             real = experiment.source_trajectory("optimal", source, start, goal, config, seed)
             out.extend(experiment.control_trajectories(spec, source, [real], seed))
         elif isinstance(spec, (str, Path)):
-            traj = trajectories.load(spec)
-            trajectories.check_task(traj, start, goal)
+            traj = trajectories.load(spec, layout)
+            trajectories.check_task(traj, start, goal, layout)
             trajectories.check_source(traj, source)
             out.append(traj)
         else:
@@ -276,22 +286,34 @@ def resolve_trajectories(specs: Sequence[TrajectorySpec], source: DiscreteRobot,
     return out
 
 
-def _task(task, start, goal, specs) -> Task:
+def _world(world, source, target) -> Layout:
+    """The world of a transfer: ``world`` resolved, or the world robots given as objects bring."""
+    if world is None:
+        given = [r.layout for r in (source, target) if isinstance(r, DiscreteRobot)]
+        return given[0] if given else ROOMS
+    return resolve_world(world)
+
+
+def _task(task, start, goal, specs, layout: Layout = ROOMS) -> Task:
     if start is not None or goal is not None:
         if task is not None:
             raise InvalidTaskError("give either a task or start/goal cells, not both")
         if start is None or goal is None:
             raise InvalidTaskError("start and goal go together")
-        return custom_task(as_xy(start, "start"), as_xy(goal, "goal"))
+        return custom_task(as_xy(start, "start"), as_xy(goal, "goal"), layout)
     if task is None:
         files = [s for s in specs if isinstance(s, (str, Path)) and s not in TRAJECTORY_KINDS]
         if files:
-            traj = trajectories.load(files[0])
-            return Task("trajectory file", ROOMS.xy(traj.start), ROOMS.xy(traj.goal))
-        task = 1
-    if isinstance(task, bool) or not isinstance(task, numbers.Integral):
-        raise InvalidTaskError(f"a task is a Table I task number, got {task!r}")
-    return table_task(int(task))
+            traj = trajectories.load(files[0], layout)
+            return Task("trajectory file", layout.xy(traj.start), layout.xy(traj.goal), layout=layout)
+        if not layout.tasks:  # a bare Layout: Table I's first task, as before worlds had tasks
+            return table_task(1)
+        return world_task(layout, None)
+    if isinstance(task, bool) or not isinstance(task, (numbers.Integral, str)):
+        raise InvalidTaskError(f"a task is a Table I task number or a task name of the world, got {task!r}")
+    if not layout.tasks:
+        return table_task(int(task)) if isinstance(task, numbers.Integral) else table_task(task)
+    return world_task(layout, task)
 
 
 def _as_sequence(value, what: str) -> Sequence:

@@ -15,6 +15,10 @@ class InvalidCellError(ArmTransferError):
     """A cell is off the grid or inside a wall."""
 
 
+class InvalidWorldError(ArmTransferError):
+    """A world is unknown or its layout is malformed (ragged grid, no path from start to goal)."""
+
+
 class InvalidTaskError(ArmTransferError):
     """A task is unknown or malformed (e.g. start equals goal)."""
 

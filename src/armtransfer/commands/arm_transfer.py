@@ -31,7 +31,6 @@ from armtransfer.commands.rooms import print_results, results_table
 from armtransfer.errors import InvalidParameterError
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.trajectory import Trajectory
-from armtransfer.worlds.layout import ROOMS
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.experiments import experiment
 from armtransfer.experiments.reports import figures
@@ -119,10 +118,17 @@ def run(args: argparse.Namespace) -> int:
         from armtransfer.ik import offscreen
 
         offscreen.require(_without(args))
+    layout = common.world_of(args)  # the world and its task, checked before compiling
+    if args.task is not None:
+        from armtransfer.tasks.catalog import world_task
+
+        world_task(layout, args.task)
     with common.phase("compiling arms"):  # before anything is written: a bad arm writes nothing
         options = arm_options(args)
-        source = resolve(args.source, xml_path=args.arm_xml, progress=common.interactive(), **options)
-        target = resolve(args.target, xml_path=args.arm_xml, progress=common.interactive(), **options)
+        source = resolve(args.source, xml_path=args.arm_xml, progress=common.interactive(), layout=layout,
+                         **options)
+        target = resolve(args.target, xml_path=args.arm_xml, progress=common.interactive(), layout=layout,
+                         **options)
         scenes: dict = {}  # the checked scenes, rendered from: each is built once
         if renders:  # a replay that cannot be made fails now, not after learning
             from armtransfer.ik.replay import check_replayable
@@ -196,8 +202,9 @@ def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target
     figures.learning_curves(curves, f"{source.name} -> {target.name}: steps per episode", tmp / "learning_curves.png",
                             greedy=greedy)
     paths = _paths(out_json, source, target)
-    traj_xy = [list(ROOMS.xy(c)) for c in paths["trajectory_cells"]] + [list(out_json["task"]["goal"])]
-    figures.mapping_paths(ROOMS.wall_mask, ROOMS.lo, traj_xy, paths["target_xy"] or traj_xy, [],
+    layout = target.layout
+    traj_xy = [list(layout.xy(c)) for c in paths["trajectory_cells"]] + [list(out_json["task"]["goal"])]
+    figures.mapping_paths(layout.wall_mask, layout.lo, traj_xy, paths["target_xy"] or traj_xy, [],
                           f"{source.name} (dashed) -> {target.name} (solid)", tmp / "map.png")
     video, no_video = None, None
     if not args.no_video:
@@ -233,10 +240,11 @@ def _paths(out_json: dict, source: DiscreteRobot, target: DiscreteRobot) -> dict
     """The source's transferred path and the target's converged greedy path (first
     converged trial of the first transfer method, named as ``target_method``; the target's
     shortest path when none converged), as states and cells."""
-    start = ROOMS.cell(*out_json["task"]["start"])
-    goal = ROOMS.cell(*out_json["task"]["goal"])
+    layout = target.layout
+    start = layout.cell(*out_json["task"]["start"])
+    goal = layout.cell(*out_json["task"]["goal"])
     steps = out_json["trajectory"]["steps"] if out_json["trajectory"] else []
-    traj_cells = [ROOMS.cell(*s["cell"]) for s in steps]
+    traj_cells = [layout.cell(*s["cell"]) for s in steps]
     if steps:
         traj = Trajectory(tuple(traj_cells), tuple(s["action"] for s in steps), goal, source=source.name)
         source_states = trajectories.states_along(source, traj)
@@ -261,7 +269,7 @@ def _paths(out_json: dict, source: DiscreteRobot, target: DiscreteRobot) -> dict
         "source_states": source_states,
         "target_states": target_states,
         "target_method": target_method,
-        "target_xy": [list(ROOMS.xy(int(target.label[s]))) for s in target_states],
+        "target_xy": [list(layout.xy(int(target.label[s]))) for s in target_states],
     }
 
 
@@ -286,7 +294,8 @@ def _table_md(out_json: dict) -> str:
     t = out_json["task"]
     return (
         f"# {out_json['source']} -> {out_json['target']}\n\n"
-        f"{t['name']}: {tuple(t['start'])} -> {tuple(t['goal'])}; target's optimal distance "
+        + (f"world {out_json['world']}, " if out_json.get("world") else "")
+        + f"{t['name']}: {tuple(t['start'])} -> {tuple(t['goal'])}; target's optimal distance "
         f"{out_json['distance']}; {out_json['trials']} trials, seed {out_json['seed']}"
         + (f", wind {out_json['wind']}" if out_json["wind"] else "")
         + "\n\n" + results_table(out_json) + "\n"

@@ -15,7 +15,7 @@ EXAMPLE = "armtransfer arms --fast --out runs/demo"
 
 ARM_FILE_OPTIONS = {"arm_xml", "tip_site", "tip_body", "tip_offset", "tool", "arm_name", "base_pos", "base_yaw", "cell_size"}
 LIST_ONLY = {"arm", "actions"}
-LIST_OPTIONS = LIST_ONLY | ARM_FILE_OPTIONS | {"no_cache"}
+LIST_OPTIONS = LIST_ONLY | ARM_FILE_OPTIONS | {"no_cache", "world"}
 GENERATE_ONLY = {"family", "dof"}
 GENERATE_OPTIONS = GENERATE_ONLY | {"seed", "out"}
 
@@ -33,7 +33,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="only these built-in arms, comma-separated (e.g. planar2,ur5e_like)")
     parser.add_argument("--actions", default=None,
                         help="only these action models, comma-separated (e.g. joint,cartesian)")
-    parser.add_argument("--cell-size", type=float, default=0.01, help="cell size in metres")
+    parser.add_argument("--cell-size", type=float, default=None,
+                        help="cell size in metres (default 0.01 on rooms; on a world of another size, the size "
+                             "that keeps the table 0.51 m wide)")
     parser.add_argument("--no-cache", action="store_true", help="compile without the cache")
     from armtransfer.commands import arm_transfer
 
@@ -56,7 +58,9 @@ def run(args: argparse.Namespace) -> int:
     common.refuse_other_options(args, LIST_OPTIONS, "'arms list'")
     common.check_arm_flags(args)
     from armtransfer.tasks.arms import arm_robot, robot_specs
-    from armtransfer.tasks.catalog import TABLE_I
+    from armtransfer.worlds.resolve import is_default
+
+    layout = common.world_of(args)
 
     wanted = None
     if args.actions:
@@ -84,7 +88,7 @@ def run(args: argparse.Namespace) -> int:
         from armtransfer.tasks.arms import arm_scene
 
         options = common.arm_file_options(args)
-        arm_scene(xml_path=args.arm_xml, cell_size=args.cell_size,
+        arm_scene(xml_path=args.arm_xml, cell_size=args.cell_size, layout=layout,
                   **{k: v for k, v in options.items() if k != "arm_name"})
         for a in custom:
             jobs.append(dict(arm=None, actions=a, xml_path=args.arm_xml, **options))
@@ -93,17 +97,18 @@ def run(args: argparse.Namespace) -> int:
     def build(job: dict):
         job = dict(job)
         return arm_robot(job.pop("arm"), job.pop("actions"), cell_size=args.cell_size, cache=not args.no_cache,
-                         progress=common.interactive(), **job)
+                         progress=common.interactive(), layout=layout, **job)
 
     # the bring-your-own arm first: a file that cannot be compiled fails before the long listing
     built = {i: build(job) for i, job in enumerate(jobs) if job.get("xml_path")}
     robots = [built[i] if i in built else build(job) for i, job in enumerate(jobs)]
-    header = f"{'robot':<24} {'dof':>3} {'actions':>7} {'states':>7} {'reach':>6} {'tableI':>6} {'cache':>6}"
+    tasks = "tableI" if is_default(layout) else "tasks"
+    header = f"{'robot':<24} {'dof':>3} {'actions':>7} {'states':>7} {'reach':>6} {tasks:>6} {'cache':>6}"
     print(header)
     for r in robots:
         solved = tasks_solvable(r)
         print(f"{r.name:<24} {r.arm.dof:>3} {r.n_actions:>7} {r.n_states:>7} "
-              f"{r.arm.reach:>6.1%} {solved:>4}/{len(TABLE_I)} {r.arm.cache:>6}")
+              f"{r.arm.reach:>6.1%} {solved:>4}/{len(layout.tasks)} {r.arm.cache:>6}")
     custom = [r for r in robots if r.arm.kind == "custom"]
     if custom:
         print()

@@ -34,6 +34,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--method", nargs="+", default=None, metavar="METHOD",
                    help="run only these methods, each beside its baselines (default: the suite's methods and "
                         "every method of an installed plugin); a method's records are the same bytes either way")
+    common.add_world_argument(p)
 
 
 def results_bytes(suite: suites.Suite, seed: int, ran: list[str], missing: list[str], records: list[dict],
@@ -45,6 +46,7 @@ def results_bytes(suite: suites.Suite, seed: int, ran: list[str], missing: list[
 
 
 def run(args: argparse.Namespace) -> int:
+    common.refuse_world(args, "benchmark", "its suites are fixed, with their tasks set in the rooms world")
     suite = suites.get(args.suite)
     out = Path(args.out) if args.out else Path("runs") / _dt.datetime.now().strftime(
         f"benchmark-{suite.name}-%Y%m%d-%H%M%S")

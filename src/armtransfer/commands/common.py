@@ -79,8 +79,36 @@ def add_method_arguments(p: argparse.ArgumentParser, default: list[str] | None =
                         f"(default {mappings.DEFAULT_MAX_SPAN})")
 
 
+def add_world_argument(p: argparse.ArgumentParser) -> None:
+    from armtransfer.worlds.resolve import DEFAULT_WORLD, VALID
+
+    p.add_argument("--world", default=None, metavar="NAME|PATH",
+                   help=f"the world the robots move in (default {DEFAULT_WORLD}, the paper's 51 x 51 rooms): "
+                        f"{VALID} (docs/worlds.md)")
+
+
+def world_of(args: argparse.Namespace):
+    """The world --world names (the paper's rooms without it), checked: a one-line error for
+    an unknown name or a bad layout file."""
+    from armtransfer.worlds.resolve import world
+
+    return world(getattr(args, "world", None))
+
+
+def refuse_world(args: argparse.Namespace, command: str, why: str) -> None:
+    """``command`` runs on the paper's rooms only: any other world is a one-line error saying
+    ``why`` (a world that does not load names its own fault first)."""
+    from armtransfer.worlds.resolve import DEFAULT_WORLD, is_default
+
+    if getattr(args, "world", None) is not None and not is_default(world_of(args)):
+        raise InvalidParameterError(f"--world {str(args.world)[:100]} does not apply to {command}: {why}; "
+                                    f"valid worlds: {DEFAULT_WORLD}")
+
+
 def add_task_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--task", type=int, default=None, help="Table I task 1-4 (default 1)")
+    add_world_argument(p)
+    p.add_argument("--task", default=None, metavar="NAME",
+                   help="a task of the world: Table I task 1-4 on rooms (default: the world's first task)")
     p.add_argument("--start", default=None, metavar="X,Y", help="start cell (with --goal)")
     p.add_argument("--goal", default=None, metavar="X,Y", help="goal cell (with --start)")
 
@@ -143,8 +171,13 @@ def transfer_kwargs(args: argparse.Namespace) -> dict:
     if args.mapping is not None and "mapping" not in args.method:
         raise InvalidParameterError("--mapping goes with --method mapping")
     refuse_unused_method_options(args)
+    world = world_of(args)
+    if args.task is not None:
+        from armtransfer.tasks.catalog import world_task
+
+        world_task(world, args.task)  # an unknown task is named before anything else is done
     return dict(
-        task=args.task, start=start, goal=goal, methods=args.method, trials=args.trials, seed=args.seed,
+        world=world, task=args.task, start=start, goal=goal, methods=args.method, trials=args.trials, seed=args.seed,
         wind=args.wind, K=args.K, beta=args.beta, trajectory=args.trajectory, controls=not args.no_controls,
         mapping=args.mapping, save_mapping=args.mapping is not None, max_span=args.max_span,
         **config_options(args),
@@ -277,7 +310,7 @@ def parse_base_pos(text: str | None):
 def check_arm_flags(args: argparse.Namespace) -> None:
     """The arm flags of ``arms``: a finite positive cell size, and the bring-your-own arm's
     options only with --arm-xml (they would be silently ignored otherwise)."""
-    if hasattr(args, "cell_size") and not (math.isfinite(args.cell_size) and args.cell_size > 0):
+    if getattr(args, "cell_size", None) is not None and not (math.isfinite(args.cell_size) and args.cell_size > 0):
         raise ArmModelError(f"--cell-size must be a positive number of metres, got {args.cell_size!r}")
     flags = (("--base-pos", "base_pos"), ("--base-yaw", "base_yaw"), ("--tip-site", "tip_site"),
              ("--tip-body", "tip_body"), ("--tip-offset", "tip_offset"), ("--tool", "tool"),

@@ -21,25 +21,48 @@ HELP = "Measure which robots help which: every ordered source -> target pair of 
 EXAMPLE = "armtransfer matrix --robots coarse,fine --tasks 1 --trials 5 --out runs/matrix"
 
 
-def _task_list(text: str) -> list[int]:
-    """'1-4', '1,3' or '2' -> task numbers."""
-    from armtransfer.tasks.catalog import TABLE_I
-
-    out: list[int] = []
-    try:
-        for part in text.split(","):
-            lo, _, hi = part.strip().partition("-")
-            first, last = int(lo), int(hi or lo)
-            for t in (first, last):  # checked before the range is listed: '1-9999999999' lists nothing
-                if t not in TABLE_I:
-                    raise argparse.ArgumentTypeError(
-                        f"unknown task {t} in {text!r}; valid tasks: {', '.join(map(str, TABLE_I))}")
-            out.extend(range(first, last + 1))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"tasks are numbers or ranges like 1-4 or 1,3, got {text!r}") from None
-    if not out:
+def _task_list(text: str) -> list[str]:
+    """'1-4', '1,3', '2' or task names -> the parts, each a task or a range of numbered tasks
+    (checked against the world in :func:`world_tasks`)."""
+    parts = [part.strip() for part in text.split(",")]
+    if not any(parts):
         raise argparse.ArgumentTypeError(f"no tasks in {text!r}")
-    return out
+    if not all(parts):
+        raise argparse.ArgumentTypeError(f"tasks are names, numbers or ranges like 1-4 or 1,3, got {text!r}")
+    return parts
+
+
+def world_tasks(parts: list[str] | None, layout) -> list:
+    """The tasks of ``--tasks`` in the world (every task of it when None): numbers on the rooms
+    (its Table I tasks), names elsewhere; a one-line error naming an unknown one."""
+    from armtransfer.errors import InvalidTaskError
+    from armtransfer.worlds.resolve import is_default
+
+    names = [t[0] for t in layout.tasks]
+    rooms = is_default(layout)
+    if parts is None:
+        return [int(n) for n in names] if rooms else names
+    text = ",".join(parts)
+
+    def known(name: str) -> str:
+        if name not in names:
+            where = "" if rooms else f" of world {layout.name}"
+            raise InvalidTaskError(f"unknown task {name[:40]} in {text[:80]!r}{where}; valid tasks: {', '.join(names)}")
+        return name
+
+    out: list[str] = []
+    for part in parts:
+        lo, dash, hi = part.partition("-")
+        if dash and lo.isdigit() and hi.isdigit():
+            first, last = known(str(int(lo))), known(str(int(hi)))  # both ends first: '1-9999999999' lists nothing
+            out.extend(known(str(t)) for t in range(int(first), int(last) + 1))
+        elif part.isdigit():
+            out.append(known(str(int(part))))
+        elif rooms:
+            raise InvalidTaskError(f"tasks are numbers or ranges like 1-4 or 1,3, got {text[:80]!r}")
+        else:
+            out.append(known(part))
+    return [int(t) for t in out] if rooms else out
 
 
 def _robot_list(text: str) -> list[str]:
@@ -53,8 +76,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--robots", type=_robot_list, required=True, metavar="SPEC,SPEC,...",
                    help="robot specs: coarse, fine, ARM:ACTIONS (see `armtransfer arms list`), and the arm "
                         "of --arm-xml as custom:ACTIONS or NAME:ACTIONS")
-    p.add_argument("--tasks", type=_task_list, default=[1, 2, 3, 4], metavar="1-4",
-                   help="Table I tasks (default 1-4)")
+    common.add_world_argument(p)
+    p.add_argument("--tasks", type=_task_list, default=None, metavar="1-4",
+                   help="tasks of the world: Table I tasks on rooms, names or ranges of numbers (default: all, "
+                        "1-4 on rooms)")
     p.add_argument("--methods", nargs="+", default=["none", "pseudo", "dense"], metavar="METHOD",
                    help="methods; 'none' is always run as the baseline (default: none pseudo dense)")
     p.add_argument("--trials", type=common.positive_int, default=10, help="trials per run (default 10)")
@@ -73,9 +98,11 @@ def run(args: argparse.Namespace) -> int:
     for m in args.methods:
         methods.get(m)
     common.refuse_unused_method_options(args, "--methods")
+    layout = common.world_of(args)
+    tasks = world_tasks(args.tasks, layout)
     robots, arms = arm_file_robots(args)
-    sweep = matrix.matrix_sweep(robots, args.tasks, args.methods, args.trials, args.seeds, args.trajectory,
-                                arms=arms)
+    sweep = matrix.matrix_sweep(robots, tasks, args.methods, args.trials, args.seeds, args.trajectory,
+                                arms=arms, world=args.world)
     code = run_sweep(sweep, args)
     text = write_summary(ResultStore.open_existing(args.out), Path(args.out))
     print(text)

@@ -30,6 +30,7 @@ NAMES = {"fig3": "fig3_layout.png", "fig4": "fig4_coarse_to_fine.png", "fig5": "
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    common.add_world_argument(p)
     p.add_argument("--out", default=None,
                    help="output directory, absent or empty; written whole or not at all "
                         "(default runs/reproduce-<timestamp>)")
@@ -96,6 +97,7 @@ def _write(res: dict, tmp: Path) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    common.refuse_world(args, "reproduce", "the paper's Tables I-V and figures are set in its rooms world")
     out = Path(args.out) if args.out else Path("runs") / _dt.datetime.now().strftime("reproduce-%Y%m%d-%H%M%S")
     check_output_dir(out)  # before the long run, not after
     config = LearnerConfig(max_total_steps=args.max_total_steps)

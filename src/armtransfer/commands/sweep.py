@@ -77,14 +77,15 @@ def check_runs(runs: list[dict]) -> dict:
 
     refuse_run_time((run["method"] for run in runs), "a sweep's runs")
     arms = {name: arm for run in runs for name, arm in run.get("arms", {}).items()}
-    robots = {spec: resolve(spec, arms=arms) for spec in robot_specs(runs)}
+    layout = sweeps.sweep_world(runs[0])  # one world a sweep
+    robots = {spec: resolve(spec, arms=arms, layout=layout) for spec in robot_specs(runs)}
     seen = set()
     for run in runs:
         key = (run["source"], run["target"], tuple(run["start"]), tuple(run["goal"]))
         if key in seen:
             continue
         seen.add(key)
-        task = custom_task(tuple(run["start"]), tuple(run["goal"]))
+        task = custom_task(tuple(run["start"]), tuple(run["goal"]), layout)
         start, goal = task.cells()
         for spec in (run["source"], run["target"]):
             robots[spec].start_state(start)
@@ -107,7 +108,7 @@ def _check_farming_bounds(runs: list[dict], robots: dict) -> None:
             continue
         key = (run["source"], tuple(run["start"]), tuple(run["goal"]))
         if key not in shortest:
-            start, goal = custom_task(tuple(run["start"]), tuple(run["goal"])).cells()
+            start, goal = custom_task(tuple(run["start"]), tuple(run["goal"]), robots[run["source"]].layout).cells()
             shortest[key] = trajectory.shortest(robots[run["source"]], start, goal).n
         n = max(shortest[key], 1)
         step = LearnerConfig.from_options({k: run[k] for k in LearnerConfig.options() if k in run}).step_reward

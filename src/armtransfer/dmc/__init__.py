@@ -48,7 +48,7 @@ def load(arm: str | None = None, actions: str = "joint", task: int | None = 1, *
          step_reward: float = -1.0, goal_reward: float = 0.0, random=None, step_limit: int | None = STEP_LIMIT,
          trajectory: TrajectoryLike | Sequence[TrajectoryLike] | None = None, method: str = "pseudo",
          K: float | str = "auto", gamma: float = LearnerConfig().gamma, beta: float | None = None,
-         environment_kwargs: dict[str, Any] | None = None, **arm_options: Any) -> dm_env.Environment:
+         environment_kwargs: dict[str, Any] | None = None, world: Any = None, **arm_options: Any) -> dm_env.Environment:
     """The dm_control environment of an arm robot on a Table I task (``task``) or from ``start``
     to ``goal`` cells, as ``dm_control.suite.load`` gives one of the suite's.
 
@@ -60,7 +60,9 @@ def load(arm: str | None = None, actions: str = "joint", task: int | None = 1, *
     :class:`armtransfer.learning.trajectory.Trajectory`, a trajectory JSON file, or a list of
     them) adds ``method``'s shaping with ``K``, ``gamma`` and ``beta`` to the rewards.
     ``environment_kwargs`` go to ``dm_control.rl.control.Environment`` (``n_sub_steps``,
-    ``control_timestep``, ``flat_observation``).
+    ``control_timestep``, ``flat_observation``). ``world`` is the world the table is built from
+    (``"rooms11"``, ``"generated:3"``, a layout file; the paper's rooms by default), and
+    ``task`` one of its tasks.
     """
     unknown = sorted(set(arm_options) - set(ARM_OPTIONS))
     if unknown:
@@ -75,8 +77,8 @@ def load(arm: str | None = None, actions: str = "joint", task: int | None = 1, *
         raise InvalidParameterError("the transfer shaping reads the observation's state: not with flat_observation")
     if step_limit is not None and (isinstance(step_limit, bool) or not isinstance(step_limit, int) or step_limit < 1):
         raise InvalidParameterError(f"step_limit must be a positive integer or None, got {step_limit!r}")
-    the_task = rooms_task(task, start, goal)  # a bad task fails before any compiling
-    robot = rooms_arm(arm, actions, dict(arm_options))
+    the_task = rooms_task(task, start, goal, world)  # a bad world or task fails before any compiling
+    robot = rooms_arm(arm, actions, dict(arm_options), the_task.layout)
     rooms = RoomsTask(robot, the_task, wind=wind, step_reward=step_reward, goal_reward=goal_reward, random=random)
     from armtransfer.ik.replay import robot_scene
 

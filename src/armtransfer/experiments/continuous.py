@@ -101,10 +101,13 @@ class ContinuousResult:
         from armtransfer.experiments.experiment import summarize
 
         summary = summarize(list(self.methods.values()), baseline="none" if "none" in self.methods else "")
+        from armtransfer.worlds.resolve import is_default, world_name
+
         t = self.task
+        world = {} if is_default(t.layout) else {"world": world_name(t.layout)}  # the rooms' JSON is as it was
         return {"state": "continuous", "task": {"name": t.name, "start": list(t.start), "goal": list(t.goal)},
-                "source": self.source, "target": self.target,
-                "trajectories": [tr.to_json() for tr in self.trajectories], "seed": self.seed, "trials": self.trials,
+                **world, "source": self.source, "target": self.target,
+                "trajectories": [tr.to_json(t.layout) for tr in self.trajectories], "seed": self.seed, "trials": self.trials,
                 "config": self.config.to_dict(),
                 "approximation": self.approximation.to_json(),
                 "results": {m: summary[r.label] for m, r in self.methods.items()}}

@@ -33,9 +33,9 @@ def robot_specs(runs: list[dict]) -> list[str]:
 def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
     """(result, seconds) of one run."""
     t0 = time.perf_counter()
-    task = custom_task(tuple(run["start"]), tuple(run["goal"]))
-    start, goal = task.cells()
     source, target = robots[run["source"]], robots[run["target"]]
+    task = custom_task(tuple(run["start"]), tuple(run["goal"]), target.layout)  # the robots' world
+    start, goal = task.cells()
     config = learner_config(run)
     traj = None
     if methods.get(run["method"]).shaped and methods.get(run["method"]).uses_trajectory:

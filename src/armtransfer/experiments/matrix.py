@@ -50,11 +50,12 @@ def family(spec: str) -> str:
     return "custom"
 
 
-def matrix_spec(robots: Sequence[str], tasks: Sequence[int], methods: Sequence[str], trials: int,
+def matrix_spec(robots: Sequence[str], tasks: Sequence[int | str], methods: Sequence[str], trials: int,
                 seeds: Sequence[int] = (0,), trajectory: str = "learned", name: str = "matrix",
-                arms: dict | None = None) -> dict:
+                arms: dict | None = None, world: str | None = None) -> dict:
     """The sweep of every ordered pair of ``robots`` (each robot to itself too); ``arms`` names
-    bring-your-own arms as a sweep file's ``[arms.NAME]`` tables do (``NAME[:ACTIONS]`` robots)."""
+    bring-your-own arms as a sweep file's ``[arms.NAME]`` tables do (``NAME[:ACTIONS]`` robots);
+    ``world`` is the sweep's world (the paper's rooms when None)."""
     robots = list(robots)
     if len(robots) < 2:
         raise InvalidParameterError("a matrix needs at least two robots")
@@ -67,13 +68,15 @@ def matrix_spec(robots: Sequence[str], tasks: Sequence[int], methods: Sequence[s
                      "methods": methods, "seeds": list(seeds), "trials": trials, "trajectory": trajectory}}
     if arms:
         raw["arms"] = arms
+    if world is not None:
+        raw["sweep"]["world"] = world
     return sweeps.normalise(raw, where="matrix")
 
 
-def matrix_sweep(robots: Sequence[str], tasks: Sequence[int], methods: Sequence[str], trials: int,
+def matrix_sweep(robots: Sequence[str], tasks: Sequence[int | str], methods: Sequence[str], trials: int,
                  seeds: Sequence[int] = (0,), trajectory: str = "learned", name: str = "matrix",
-                 arms: dict | None = None) -> sweeps.Sweep:
-    spec = matrix_spec(robots, tasks, methods, trials, seeds, trajectory, name, arms)
+                 arms: dict | None = None, world: str | None = None) -> sweeps.Sweep:
+    spec = matrix_spec(robots, tasks, methods, trials, seeds, trajectory, name, arms, world)
     return sweeps.Sweep(spec["name"], spec, tuple(sweeps.expand(spec)))
 
 

@@ -23,6 +23,7 @@ from armtransfer.learning.mapping import ActionMapping
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.catalog import Task
 from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.worlds.resolve import is_default, world_name
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -127,13 +128,16 @@ class TransferResult:
     def to_json(self) -> dict:
         summary = self._summary()
         t = self.task
+        layout = self.target.layout
+        world = {} if is_default(layout) else {"world": world_name(layout)}  # the rooms' JSON is as it was
         return {
             "task": {"name": t.name, "start": list(t.start), "goal": list(t.goal)},
+            **world,
             "distance": self.distance,
             "source": self.source.name,
             "target": self.target.name,
-            "trajectory": None if not self.trajectories else self.trajectories[0].to_json(),
-            "trajectories": [tr.to_json() for tr in self.trajectories],
+            "trajectory": None if not self.trajectories else self.trajectories[0].to_json(layout),
+            "trajectories": [tr.to_json(layout) for tr in self.trajectories],
             "trajectory_length": None if not self.trajectories else len(self.trajectories[0]),
             "seed": self.seed,
             "trials": self.trials,

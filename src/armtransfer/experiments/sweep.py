@@ -29,6 +29,11 @@ their own and then used by name in ``pairs``, as ``NAME`` or ``NAME:ACTIONS``::
     tool = "stylus:0.05"                 # optional: a pen held at the tool point
     # base_pos = [0, -0.4, 0]; base_yaw = 1.5708   (default: chosen automatically)
 
+A sweep runs in one world, ``world = "rooms11"`` (a built-in name, ``generated:SEED[:SIDE]`` or
+a layout file, relative to the sweep file; default the paper's ``rooms``); ``tasks`` are then
+the world's task names. Every run carries the world's content (grid and tasks), so its key
+changes when the world does; the rooms' runs carry none and keep their keys.
+
 One *run* is one combination: ``trials`` trials of one method, seeded by its seed. Its
 content key is a hash of its full, normalised configuration, so the same run is never done
 twice (``none`` ignores K, so its runs are shared by every K).
@@ -44,7 +49,10 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from armtransfer.tasks.catalog import TABLE_I, parse_xy
+from armtransfer.tasks.catalog import TABLE_I, parse_xy, world_task
+from armtransfer.worlds.files import layout_data
+from armtransfer.worlds.resolve import is_default, layout_of_data
+from armtransfer.worlds.resolve import world as resolve_world
 from armtransfer.errors import ArmTransferError
 from armtransfer.io import read_input
 from armtransfer.tasks.arms import ARM_NAME, ARM_NAME_FORM
@@ -197,9 +205,9 @@ def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, ba
                              "[arms.NAME] tables")
     arms = _arms(raw.get("arms", {}), where, base)
     body = raw["sweep"]
-    valid = sorted([*_AXES, *_SCALARS])
+    valid = sorted([*_AXES, *_SCALARS, "world"])
     for key in body:
-        if key not in _AXES and key not in _SCALARS:
+        if key not in _AXES and key not in _SCALARS and key != "world":
             raise SweepFileError(f"{where}: unknown key {key!r}; valid keys: {', '.join(valid)}")
     spec: dict = {}
     for key, default in _SCALARS.items():
@@ -214,8 +222,15 @@ def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, ba
     _check_number(f"{w}: max_episodes", spec["max_episodes"], 1, 1_000_000, integer=True)
     if spec["trajectory"] not in ("optimal", "learned"):
         raise SweepFileError(f"{w}: trajectory must be 'optimal' or 'learned', got {spec['trajectory']!r}")
+    layout = _world(body.get("world"), w, base)
+    if layout is not None:
+        spec["world"] = layout_data(layout)
+    names = [t[0] for t in layout.tasks] if layout is not None else None
     for t in spec["tasks"]:
-        if isinstance(t, bool) or t not in TABLE_I:
+        if names is not None:
+            if isinstance(t, bool) or not isinstance(t, (int, str)) or str(t) not in names:
+                raise SweepFileError(f"{w}: unknown task {t!r} in world {layout.name}; valid tasks: {', '.join(names)}")
+        elif isinstance(t, bool) or t not in TABLE_I:
             raise SweepFileError(f"{w}: unknown task {t!r}; valid tasks: {', '.join(map(str, TABLE_I))}")
     pairs = []
     for sg in spec["start_goal"]:
@@ -265,9 +280,15 @@ def check_stored(spec: object, where: str) -> dict:
     keys = {*_SCALARS, *_AXES, "arms"}
     for key in sorted(keys - set(spec)):
         raise SweepFileError(f"{where}: field 'spec' has no {key!r}")
-    for key in sorted(set(spec) - keys, key=str):
-        raise SweepFileError(f"{where}: field 'spec' has an unknown key {key!r}; valid keys: {', '.join(sorted(keys))}")
-    body = {k: v for k, v in spec.items() if k != "arms"}
+    for key in sorted(set(spec) - keys - {"world"}, key=str):
+        raise SweepFileError(f"{where}: field 'spec' has an unknown key {key!r}; valid keys: "
+                             f"{', '.join(sorted(keys | {'world'}))}")
+    if spec.get("world") is not None:  # stored as the layout's data; a sweep file names it
+        try:
+            layout_of_data(spec["world"], f"{where}: field 'spec': world")
+        except ArmTransferError as err:
+            raise SweepFileError(str(err)) from None
+    body = {k: v for k, v in spec.items() if k not in ("arms", "world")}
     if isinstance(spec["start_goal"], list):  # stored as cells; a sweep file writes "X,Y"
         body["start_goal"] = [[f"{c[0]},{c[1]}" if isinstance(c, list) and len(c) == 2 else c for c in sg]
                               if isinstance(sg, list) else sg for sg in spec["start_goal"]]
@@ -276,11 +297,37 @@ def check_stored(spec: object, where: str) -> dict:
         if again[key] != spec[key] or json.dumps(again[key]) != json.dumps(spec[key]):
             raise SweepFileError(f"{where}: field 'spec': {key} is not as a sweep writes it ({spec[key]!r:.80})")
     return spec
+def _world(given: object, where: str, base: Path | None):
+    """The sweep's world (``world = ...``), or None for the paper's rooms (its runs name none)."""
+    if given is None:
+        return None
+    if not isinstance(given, str) or not given.strip():
+        raise SweepFileError(f"{where}: world must be a world's name or a layout file, got {given!r}")
+    if base is not None and given.lower().endswith((".toml", ".json")) and not os.path.isabs(given):
+        given = str(base / given)
+    try:
+        layout = resolve_world(given)
+    except ArmTransferError as err:
+        raise SweepFileError(f"{where}: world: {err}") from None
+    return None if is_default(layout) else layout
+
+
+def sweep_world(spec_or_run: dict):
+    """The world of a normalised spec or one of its runs (the paper's rooms when it names none)."""
+    from armtransfer.worlds.layout import ROOMS
+
+    data = spec_or_run.get("world")
+    return ROOMS if data is None else layout_of_data(data, "the sweep's world")
 
 
 def expand(spec: dict) -> list[dict]:
     """Every run of the sweep, in a fixed order, each a flat configuration."""
-    tasks = [{"task": t, "start": list(TABLE_I[t].start), "goal": list(TABLE_I[t].goal)} for t in spec["tasks"]]
+    if spec.get("world") is None:
+        tasks = [{"task": t, "start": list(TABLE_I[t].start), "goal": list(TABLE_I[t].goal)} for t in spec["tasks"]]
+    else:
+        layout = sweep_world(spec)
+        found = [world_task(layout, t) for t in spec["tasks"]]
+        tasks = [{"task": t, "start": list(f.start), "goal": list(f.goal)} for t, f in zip(spec["tasks"], found)]
     tasks += [{"task": None, "start": s, "goal": g} for s, g in spec["start_goal"]]
     runs: dict[str, dict] = {}
     for task, pair, method, seed, K, eps, lam, alpha, gamma, wind in itertools.product(
@@ -289,6 +336,7 @@ def expand(spec: dict) -> list[dict]:
     ):
         run = {
             "format": RUN_FORMAT,
+            **({"world": spec["world"]} if spec.get("world") is not None else {}),
             **task,
             "source": pair[0],
             "target": pair[1],

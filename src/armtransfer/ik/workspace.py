@@ -25,6 +25,15 @@ if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never impor
 DEFAULT_CELL = 0.01
 """One cell = 1 cm by default."""
 WALL_HEIGHT = 0.02
+TABLE_SIDE = 0.51
+"""The table's side at the default cell size on the paper's 51 x 51 rooms (metres)."""
+
+
+def world_cell(layout: Layout) -> float:
+    """The default cell size on ``layout``: 1 cm on a 51-cell world (the paper's rooms), and on
+    any other the size that keeps the table :data:`TABLE_SIDE` wide, so that an arm built for
+    the rooms' table reaches a small world's table as it reaches that one."""
+    return DEFAULT_CELL if layout.width == 51 else TABLE_SIDE / layout.width
 TABLE_THICKNESS = 0.02
 
 

@@ -33,7 +33,7 @@ from armtransfer.io import check_input, read_input
 from armtransfer.models import ARMS
 from armtransfer.worlds.layout import ROOMS, Layout
 from armtransfer.tasks.robot import DiscreteRobot
-from armtransfer.ik.workspace import DEFAULT_CELL, WALL_HEIGHT
+from armtransfer.ik.workspace import DEFAULT_CELL, WALL_HEIGHT, world_cell
 
 SIDECAR_FORMAT = "armtransfer-generated-arm/1"
 """The JSON ``armtransfer arms generate`` writes beside an arm: its mount and tool."""
@@ -81,13 +81,13 @@ def _layout_data(layout: Layout) -> dict:
 
 
 def tasks_solvable(robot: DiscreteRobot, tasks=None) -> int:
-    """How many of ``tasks`` (Table I by default) the robot can solve: both cells reached and
-    the goal reachable from the start."""
+    """How many of ``tasks`` (its world's tasks by default: Table I on the rooms) the robot can
+    solve: both cells reached and the goal reachable from the start."""
     from armtransfer.errors import InvalidCellError
-    from armtransfer.tasks.catalog import TABLE_I
+    from armtransfer.tasks.catalog import world_tasks
 
     solved = 0
-    for task in (tasks if tasks is not None else TABLE_I.values()):
+    for task in (tasks if tasks is not None else world_tasks(robot.layout)):
         try:
             s, g = task.cells(robot.layout)
             start = robot.start_state(s)
@@ -154,7 +154,7 @@ def file_arm_name(path: Path) -> str:
     return path.stem
 
 
-def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
+def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
               xml_path: str | Path | None = None, tip_site: str | None = None,
               tip_body: str | None = None, tip_offset=None, arm_name: str | None = None,
               base_pos: tuple[float, float, float] | None = None, base_yaw: float | None = None,
@@ -170,11 +170,12 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
     without ``base_pos`` it is chosen automatically (see :func:`automatic_mount`). A spatial
     bring-your-own arm keeps its tool pointing down unless ``tip_down=False``. ``tool`` puts a
     pen in the hand, ``"stylus[:LENGTH[:RADIUS]]"`` (metres; see ``ik.tool.Stylus``), for any arm
-    whose tool is kept pointing down; the cell is read at the pen's end.
+    whose tool is kept pointing down; the cell is read at the pen's end. The cell size is the
+    world's (``ik.workspace.world_cell``: 1 cm on the rooms) unless given.
     """
     model = action_model(actions)
     stylus = parse_held(tool) if tool is not None else None
-    cell_size, base_pos, base_yaw = _checked_pose(cell_size, base_pos, base_yaw)
+    cell_size, base_pos, base_yaw = _checked_pose(cell_size, base_pos, base_yaw, layout)
     if joint_step is not None:
         joint_step = checks.real(joint_step, "the joint step (radians)", 0.0, math.pi, lo_open=True,
                                  error=ArmModelError)
@@ -219,7 +220,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float = DEFAULT_CELL,
         info = ARMS[arm]
         path, name, tool = info.xml_path, arm, Tool(site=info.tip_site, held=stylus)
         xml_bytes = path.read_bytes()
-        mount, source = _builtin_mount(info, cell_size), "built-in"
+        mount, source = _builtin_mount(info, cell_size, layout), "built-in"
         if base_pos is not None:
             mount, source = cast(tuple[float, float, float], tuple(float(v) for v in base_pos)), "given"
         yaw = info.mount_yaw if base_pos is None else float(base_yaw or 0.0)
@@ -306,8 +307,11 @@ def _arrays_check(layout: Layout):
     return check
 
 
-def _checked_pose(cell_size, base_pos, base_yaw) -> tuple:
-    """The cell size, base position and yaw checked: finite, in metres up to ``checks.MAX_METRES``."""
+def _checked_pose(cell_size, base_pos, base_yaw, layout: Layout) -> tuple:
+    """The cell size (the world's when None), base position and yaw checked: finite, in metres
+    up to ``checks.MAX_METRES``."""
+    if cell_size is None:
+        cell_size = world_cell(layout)
     cell_size = checks.real(cell_size, "the cell size (metres)", 0.0, checks.MAX_METRES, lo_open=True,
                             error=ArmModelError)
     if base_yaw is not None:
@@ -317,10 +321,13 @@ def _checked_pose(cell_size, base_pos, base_yaw) -> tuple:
     return cell_size, base_pos, base_yaw
 
 
-def _builtin_mount(info, cell_size: float) -> tuple[float, float, float]:
+def _builtin_mount(info, cell_size: float, layout: Layout) -> tuple[float, float, float]:
     mount = info.mount_pos
-    if info.kind == "planar":  # hang over the same cell whatever the cell size
+    if info.kind == "planar" and layout.width == ROOMS.width:  # hang over the same cell whatever the cell size
         mount = (mount[0] * cell_size / DEFAULT_CELL, mount[1] * cell_size / DEFAULT_CELL, mount[2])
+    elif info.kind == "planar":  # another world: over the same point of a table scaled as the rooms' is
+        scale = cell_size / world_cell(layout)
+        mount = (mount[0] * scale, mount[1] * scale, mount[2])
     return mount
 
 
@@ -331,7 +338,7 @@ def _chain_of(arrays: dict) -> tuple[tuple[str, ...], tuple[tuple[str, float], .
     return chain, held
 
 
-def mount_search(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, layout: Layout = ROOMS,
+def mount_search(path: Path, tool: Tool, *, cell_size: float | None = None, layout: Layout = ROOMS,
                  yaw: float | None = None) -> list[tuple[int, float, "object"]]:
     """Every base pose the automatic mount tries, best first, as (Table I cells reached,
     estimated share of free cells, ``ik.mount.Pose``).
@@ -347,10 +354,11 @@ def mount_search(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, lay
     that cannot succeed ends soon.
     """
     from armtransfer.ik import mount as _mount
-    from armtransfer.tasks.catalog import TABLE_I
+    from armtransfer.tasks.catalog import world_tasks
 
+    cell_size = world_cell(layout) if cell_size is None else cell_size
     origin = _scene(path, tool, (0.0, 0.0, 0.0), 0.0, cell_size, layout)
-    must = sorted({c for t in TABLE_I.values() for c in t.cells(layout)})
+    must = sorted({c for t in world_tasks(layout) for c in t.cells(layout)})
     scored: list = []
 
     def score(batch: list) -> None:
@@ -402,7 +410,7 @@ def compile_order(scored: list, n: int = COMPILES) -> list:
     return first + [t for t in by_share if t not in first and t[1] > floor][:n]
 
 
-def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, layout: Layout = ROOMS,
+def automatic_mount(path: Path, tool: Tool, *, cell_size: float | None = None, layout: Layout = ROOMS,
                     yaw: float | None = None, cache: bool = True, progress: bool = False):
     """A base pose for an arm that came without one (``ik.mount.Pose``).
 
@@ -417,11 +425,14 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float = DEFAULT_CELL, 
     from armtransfer.errors import UnreachableTableError
     from armtransfer.ik import mount as _mount
 
+    cell_size = world_cell(layout) if cell_size is None else cell_size
     parts = {"version": 11, "what": "mount", "compiles": COMPILES, "covers": COVERS,
              "arm_xml": _sha(path.read_bytes()), "assets": _assets_sha(path), "tool": tool.key(),
              "cell": cell_size, "yaw": yaw, "layout": _layout_data(layout), "stride": _mount.STRIDE,
              "seeds": [_mount.SEEDS, _mount.RESTARTS, RETRIES], "gaps": _mount.GAPS,
              "grid": _mount.PLANAR_GRID, "lifts": _mount.LIFTS}
+    if layout != ROOMS:  # the choice ranks poses by the world's task cells (the rooms' key is as it was)
+        parts["tasks"] = [[name, list(start), list(goal)] for name, start, goal in layout.tasks]
     key = _cache.cache_key(parts)
     entry = _cache.cache_dir() / f"mount-{key[:16]}.json"
     if cache:
@@ -492,7 +503,6 @@ def _cached_pose(entry: Path, key: str) -> tuple[tuple[tuple[float, float, float
     another key, numbers of the wrong kind or out of range): it is then chosen again."""
     from armtransfer.errors import ArmTransferError
     from armtransfer.io import parse_json_bytes
-    from armtransfer.tasks.catalog import TABLE_I
 
     raw = _cache.read_regular(entry)
     try:
@@ -501,7 +511,7 @@ def _cached_pose(entry: Path, key: str) -> tuple[tuple[tuple[float, float, float
             return None
         pos = checks.point(data.get("pos"), "pos", limit=checks.MAX_METRES)
         yaw = checks.real(data.get("yaw"), "yaw")
-        rank = checks.whole(data.get("solvable"), "solvable", 0, len(TABLE_I)), checks.real(data.get("reach"), "reach", 0, 1)
+        rank = checks.whole(data.get("solvable"), "solvable", 0, checks.MAX_COUNT), checks.real(data.get("reach"), "reach", 0, 1)
         return ((pos[0], pos[1], pos[2]), yaw), rank
     except (ValueError, ArmTransferError):
         return None
@@ -576,12 +586,12 @@ def _assets_sha(path: Path) -> str:
     return h.hexdigest()
 
 
-def arm_scene(arm: str | None = None, *, cell_size: float = DEFAULT_CELL, xml_path=None,
+def arm_scene(arm: str | None = None, *, cell_size: float | None = None, xml_path=None,
               tip_site: str | None = None, tip_body: str | None = None, tip_offset=None,
               base_pos=None, base_yaw: float | None = None, layout: Layout = ROOMS, tool=None):
     """The MuJoCo scene (``ik.scene.ArmScene``) a robot of this arm is compiled in (a
     bring-your-own arm without ``base_pos`` at the origin)."""
-    cell_size, base_pos, base_yaw = _checked_pose(cell_size, base_pos, base_yaw)
+    cell_size, base_pos, base_yaw = _checked_pose(cell_size, base_pos, base_yaw, layout)
     if xml_path is not None:
         return _scene(Path(xml_path), make_tool(tip_site, tip_body, tip_offset, tool), base_pos or (0.0, 0.0, 0.0),
                       base_yaw or 0.0, cell_size, layout)
@@ -589,7 +599,7 @@ def arm_scene(arm: str | None = None, *, cell_size: float = DEFAULT_CELL, xml_pa
         raise UnknownArmError(f"unknown arm {arm!r}; valid arms: {', '.join(ARMS)}")
     info = ARMS[arm]
     return _scene(info.xml_path, Tool(site=info.tip_site, held=parse_held(tool) if tool is not None else None),
-                  _builtin_mount(info, cell_size), info.mount_yaw,
+                  _builtin_mount(info, cell_size, layout), info.mount_yaw,
                   cell_size, layout)
 
 

@@ -1,9 +1,9 @@
-"""Start/goal tasks: the paper's Table I, and tasks given by coordinates."""
+"""Start/goal tasks: the paper's Table I, a world's named tasks, and tasks given by coordinates."""
 
 from __future__ import annotations
 
 import numbers
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from armtransfer.errors import InvalidTaskError
 from armtransfer.worlds.layout import ROOMS, Layout
@@ -16,9 +16,13 @@ class Task:
     goal: tuple[int, int]
     paper_distance: int | None = None
     """The optimal 1-cell distance Table I gives, where the task is one of the paper's."""
+    layout: Layout = field(default=ROOMS, compare=False, repr=False)
+    """The world the task is in (the paper's rooms unless it says otherwise)."""
 
-    def cells(self, layout: Layout = ROOMS) -> tuple[int, int]:
-        """(start cell id, goal cell id); both must be free and differ."""
+    def cells(self, layout: Layout | None = None) -> tuple[int, int]:
+        """(start cell id, goal cell id) in ``layout`` (the task's own world when None); both
+        must be free and differ."""
+        layout = self.layout if layout is None else layout
         s = layout.free_cell(*self.start, what="start")
         g = layout.free_cell(*self.goal, what="goal")
         if s == g:
@@ -37,7 +41,7 @@ TABLE_I = {
 TABLE_I_ROOMS = {1: (1, 2), 2: (1, 2), 3: (1, 3), 4: (1, 3)}
 
 
-def table_task(number: int) -> Task:
+def table_task(number: int | str) -> Task:
     if number not in TABLE_I:
         raise InvalidTaskError(
             f"unknown task {number}; valid tasks: {', '.join(str(k) for k in TABLE_I)}"
@@ -66,7 +70,34 @@ def as_xy(value: object, what: str) -> tuple[int, int]:
     return int(xy[0]), int(xy[1])
 
 
+def world_task(layout: Layout, task: object = None) -> Task:
+    """The task named ``task`` (a name, or a number for the paper's rooms) of the world
+    ``layout``; its first task when None. Table I's tasks keep their paper distances."""
+    if not layout.tasks:
+        raise InvalidTaskError(f"world {layout.name or 'unnamed'} has no named task; give a start and a goal")
+    if task is None:
+        name = layout.tasks[0][0]
+    elif isinstance(task, bool) or not isinstance(task, (str, numbers.Integral)):
+        raise InvalidTaskError(f"a task is one of the world's task names, got {task!r}")
+    else:
+        name = str(task)
+    if layout is ROOMS or layout == ROOMS:
+        if name.isdigit() and name.isascii() and len(name) < 40:
+            return table_task(int(name))  # the one-line error listing Table I's tasks when unknown
+        raise InvalidTaskError(f"unknown task {name[:40]!r}; valid tasks: {', '.join(str(k) for k in TABLE_I)}")
+    found = layout.task(name)
+    if found is None:
+        raise InvalidTaskError(f"unknown task {name[:40]!r} in world {layout.name}; valid tasks: "
+                               f"{', '.join(t[0] for t in layout.tasks)}")
+    return Task(f"task {found[0]}", found[1], found[2], layout=layout)
+
+
+def world_tasks(layout: Layout) -> list[Task]:
+    """Every named task of the world ``layout``, in order (Table I's on the rooms)."""
+    return [world_task(layout, t[0]) for t in layout.tasks]
+
+
 def custom_task(start: tuple[int, int], goal: tuple[int, int], layout: Layout = ROOMS) -> Task:
-    task = Task(f"({start[0]},{start[1]})->({goal[0]},{goal[1]})", start, goal)
+    task = Task(f"({start[0]},{start[1]})->({goal[0]},{goal[1]})", start, goal, layout=layout)
     task.cells(layout)  # validate now, so errors come before any work
     return task

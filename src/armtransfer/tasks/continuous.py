@@ -16,7 +16,6 @@ import numpy as np
 
 import armtransfer.checks as checks
 from armtransfer.errors import ArmModelError, UnknownArmError
-from armtransfer.ik.workspace import DEFAULT_CELL
 from armtransfer.models import ARMS
 from armtransfer.worlds.layout import ROOMS, Layout
 
@@ -56,10 +55,11 @@ def parse_spec(spec: str) -> tuple[str | None, str | None]:
 
 def continuous_arm(spec: str | None = None, *, xml_path=None, tip_site: str | None = None,
                    tip_body: str | None = None, tip_offset=None, base_pos=None, base_yaw: float | None = None,
-                   joint_step: float | None = None, cell_size: float = DEFAULT_CELL, layout: Layout = ROOMS):
+                   joint_step: float | None = None, cell_size: float | None = None, layout: Layout = ROOMS):
     """The continuous arm of a built-in planar arm (``spec``, e.g. ``"planar3:joint"``) or of a
     planar arm file (``spec`` ``"PATH.xml"`` or ``xml_path=``) with its tool point and mount
-    (a generated arm's from its sidecar; without ``base_pos`` the automatic mount)."""
+    (a generated arm's from its sidecar; without ``base_pos`` the automatic mount), on the
+    world ``layout`` (its cell size ``ik.workspace.world_cell`` unless given)."""
     from armtransfer.ik.continuous import ContinuousArm
     from armtransfer.tasks.arms import arm_scene, automatic_mount, make_tool, read_sidecar
 

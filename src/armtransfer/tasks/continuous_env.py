@@ -90,18 +90,18 @@ class ContinuousArmRoomsEnv(gym.Env):
         return None
 
 
-def make_continuous_arm_rooms_env(arm: str | None = "planar3", task: int | None = 1,
+def make_continuous_arm_rooms_env(arm: str | None = "planar3", task: int | str | None = 1,
                                   start: tuple[int, int] | None = None, goal: tuple[int, int] | None = None,
-                                  **kwargs: Any) -> ContinuousArmRoomsEnv:
+                                  world: Any = None, **kwargs: Any) -> ContinuousArmRoomsEnv:
     """Entry point of ``armtransfer/ContinuousArmRooms-v0``: a built-in planar arm (``arm``, e.g.
     ``"planar3"`` or ``"planar3:joint"``) or a planar arm file (``xml_path=``) on a Table I or
-    custom task."""
+    custom task; ``world=`` as the other environments'."""
     from armtransfer.tasks.continuous import continuous_arm
 
     check_options(kwargs, ARM_OPTIONS)
-    the_task = rooms_task(task, start, goal)
+    the_task = rooms_task(task, start, goal, world)
     arm_kwargs = {k: kwargs.pop(k) for k in ARM_OPTIONS if k in kwargs}
     if kwargs.pop("wind", 0.0) != 0.0:
         raise InvalidParameterError("the continuous arm has no wind; valid wind: 0")
     spec = None if arm_kwargs.get("xml_path") is not None else arm
-    return ContinuousArmRoomsEnv(continuous_arm(spec, **arm_kwargs), the_task, **kwargs)
+    return ContinuousArmRoomsEnv(continuous_arm(spec, layout=the_task.layout, **arm_kwargs), the_task, **kwargs)

@@ -2,7 +2,8 @@
 
 ``import armtransfer`` registers ``armtransfer/Rooms-v0`` (a grid robot) and
 ``armtransfer/ArmRooms-v0`` (an arm robot); then ``gymnasium.make("armtransfer/Rooms-v0",
-task=1, robot="fine")``. The observation is the robot's own state index, the action an index into its action model; each step costs
+task=1, robot="fine")``. ``world=`` names the world (``"rooms11"``, ``"generated:3"``, a layout
+file; the paper's rooms by default) and ``task`` one of its tasks. The observation is the robot's own state index, the action an index into its action model; each step costs
 ``step_reward`` and reaching the goal cell pays ``goal_reward`` and terminates. With
 ``wind=p`` the robot is pushed one cell towards +x with probability p after its move.
 """
@@ -18,7 +19,7 @@ from gymnasium import spaces
 
 import armtransfer.checks as checks
 from armtransfer.errors import InvalidParameterError, InvalidTaskError
-from armtransfer.tasks.catalog import Task, as_xy, custom_task, table_task
+from armtransfer.tasks.catalog import Task, as_xy, custom_task, table_task, world_task
 from armtransfer.registration import register_envs  # noqa: F401  (kept importable from here)
 from armtransfer.tasks.robot import DiscreteRobot
 
@@ -160,30 +161,39 @@ def task_states(robot: DiscreteRobot, task: Task) -> tuple[int, int]:
     return start, goal_cell
 
 
-def rooms_task(task: int | None = 1, start: tuple[int, int] | None = None,
-               goal: tuple[int, int] | None = None) -> Task:
-    """A Table I task, or the custom task from ``start`` to ``goal`` (cells (x, y) or 'X,Y')."""
+def rooms_task(task: int | str | None = 1, start: tuple[int, int] | None = None,
+               goal: tuple[int, int] | None = None, world: Any = None) -> Task:
+    """A task of the world (``worlds.resolve.world``; Table I's on the paper's rooms, the
+    default), or the custom task from ``start`` to ``goal`` (cells (x, y) or 'X,Y')."""
+    from armtransfer.worlds.resolve import is_default, world as resolve_world
+
+    layout = resolve_world(world)
     if start is None and goal is None:
-        if isinstance(task, bool) or not isinstance(task, numbers.Integral):
-            raise InvalidTaskError(f"a task is a Table I task number (1-4), got {task!r}")
-        return table_task(int(task))
+        if is_default(layout):
+            if isinstance(task, bool) or not isinstance(task, numbers.Integral):
+                raise InvalidTaskError(f"a task is a Table I task number (1-4), got {task!r}")
+            return table_task(int(task))
+        return world_task(layout, task)
     if start is None or goal is None:
         raise InvalidTaskError("start and goal go together")
-    return custom_task(as_xy(start, "start"), as_xy(goal, "goal"))
+    return custom_task(as_xy(start, "start"), as_xy(goal, "goal"), layout)
 
 
 def make_rooms_env(
-    task: int | None = 1,
+    task: int | str | None = 1,
     robot: str = "fine",
     start: tuple[int, int] | None = None,
     goal: tuple[int, int] | None = None,
+    world: Any = None,
     **kwargs: Any,
 ) -> RobotRoomsEnv:
-    """Entry point of ``armtransfer/Rooms-v0``: a grid robot on a Table I or custom task."""
+    """Entry point of ``armtransfer/Rooms-v0``: a grid robot on a task of ``world`` (Table I's on
+    the paper's rooms, the default) or a custom task."""
     from armtransfer.tasks.grid_robots import grid_robot
 
     check_options(kwargs)
-    return RobotRoomsEnv(grid_robot(robot), rooms_task(task, start, goal), **kwargs)
+    the_task = rooms_task(task, start, goal, world)
+    return RobotRoomsEnv(grid_robot(robot, the_task.layout), the_task, **kwargs)
 
 
 TASK_OPTIONS = ("wind", "step_reward", "goal_reward", "render_mode")
@@ -215,13 +225,16 @@ ARM_OPTIONS = ("cell_size", "xml_path", "tip_site", "tip_body", "tip_offset", "t
 """The keywords of an arm environment that build its robot (the rest set up the task)."""
 
 
-def rooms_arm(arm: str | None, actions: str, options: dict[str, Any]) -> DiscreteRobot:
+def rooms_arm(arm: str | None, actions: str, options: dict[str, Any], layout: Any = None) -> DiscreteRobot:
     """The arm robot of an arm environment: a built-in ``arm`` (planar2 by default), or the arm
-    file ``xml_path=`` with its options; the robot's keywords (:data:`ARM_OPTIONS`) are taken
-    out of ``options``, the rest left for the task."""
+    file ``xml_path=`` with its options, on the world ``layout`` (the paper's rooms when None);
+    the robot's keywords (:data:`ARM_OPTIONS`) are taken out of ``options``, the rest left for
+    the task."""
     from armtransfer.tasks.arms import arm_robot, parse_robot_spec
 
     robot_kwargs = {k: options.pop(k) for k in ARM_OPTIONS if k in options}
+    if layout is not None:
+        robot_kwargs["layout"] = layout
     if robot_kwargs.get("xml_path") is None:  # a built-in arm, planar2 by default
         if arm is not None and not isinstance(arm, str):
             raise InvalidParameterError(f"arm must be an arm's name, got {arm!r}")
@@ -231,13 +244,15 @@ def rooms_arm(arm: str | None, actions: str, options: dict[str, Any]) -> Discret
     return arm_robot(arm, actions, **robot_kwargs)
 
 
-def make_arm_rooms_env(arm: str | None = None, actions: str = "joint", task: int | None = 1,
+def make_arm_rooms_env(arm: str | None = None, actions: str = "joint", task: int | str | None = 1,
                        start: tuple[int, int] | None = None,
-                       goal: tuple[int, int] | None = None, **kwargs: Any) -> RobotRoomsEnv:
+                       goal: tuple[int, int] | None = None, world: Any = None, **kwargs: Any) -> RobotRoomsEnv:
     """Entry point of ``armtransfer/ArmRooms-v0``: an arm robot (compiled or loaded from the
-    cache) on a Table I or custom task. Bring-your-own arms: ``xml_path=`` with ``tip_site=`` or
-    ``tip_body=``, ``tip_offset=``, ``tool=`` (a held pen, ``"stylus[:LENGTH[:RADIUS]]"``), ``arm_name=``,
-    ``base_pos=``/``base_yaw=`` (automatic without)."""
+    cache) on a task of ``world`` (Table I's on the paper's rooms, the default) or a custom
+    task; the table is built from the world. Bring-your-own arms: ``xml_path=`` with
+    ``tip_site=`` or ``tip_body=``, ``tip_offset=``, ``tool=`` (a held pen,
+    ``"stylus[:LENGTH[:RADIUS]]"``), ``arm_name=``, ``base_pos=``/``base_yaw=`` (automatic
+    without)."""
     check_options(kwargs, ARM_OPTIONS)
-    the_task = rooms_task(task, start, goal)  # a bad task fails before any compiling
-    return RobotRoomsEnv(rooms_arm(arm, actions, kwargs), the_task, **kwargs)
+    the_task = rooms_task(task, start, goal, world)  # a bad world or task fails before any compiling
+    return RobotRoomsEnv(rooms_arm(arm, actions, kwargs, the_task.layout), the_task, **kwargs)

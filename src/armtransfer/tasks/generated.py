@@ -32,7 +32,7 @@ from armtransfer.ik.workspace import DEFAULT_CELL
 from armtransfer.models.generate import ArmDraw, check_family, draw_arm, planar_tip_cells, with_home
 from armtransfer.tasks.arms import SIDECAR_FORMAT, read_sidecar
 from armtransfer.tasks.catalog import TABLE_I
-from armtransfer.worlds.layout import ROOMS
+from armtransfer.worlds.layout import ROOMS, Layout
 
 MAX_DRAWS = 12
 
@@ -163,11 +163,12 @@ def readme(draw: ArmDraw, seed: int, index: int, rejected: list[str], reach: flo
             f"## Rejected draws\n\n{why}\n")
 
 
-def resolve_generated(spec: str, progress: bool = False):
+def resolve_generated(spec: str, progress: bool = False, layout: Layout = ROOMS):
     """The robot of ``gen:FAMILY:DOF:SEED[:ACTIONS]``: the arm generated with those settings,
-    kept in the cache directory (``$ARMTRANSFER_CACHE/generated``) after the first use."""
+    kept in the cache directory (``$ARMTRANSFER_CACHE/generated``) after the first use, on the
+    world ``layout`` (it is drawn for the rooms' table, which other worlds keep by default)."""
     xml, generated, actions = generated_file(spec, progress)
-    return robot_of(xml, generated, actions, progress=progress)
+    return robot_of(xml, generated, actions, progress=progress, layout=layout)
 
 
 def generated_file(spec: str, progress: bool = False) -> tuple[Path, dict, str]:

@@ -6,27 +6,32 @@ from __future__ import annotations
 
 from typing import Any
 
-from armtransfer.errors import UnknownArmError, UnknownRobotError
+from armtransfer.errors import InvalidWorldError, UnknownArmError, UnknownRobotError
 from armtransfer.tasks.grid_robots import GRID_ROBOTS, grid_robot
 from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.worlds.layout import ROOMS, Layout
 
 CUSTOM = "custom"
 """The spec of a bring-your-own arm: ``custom`` or ``custom:ACTIONS`` with its file given."""
 
 
 def resolve(spec: str | DiscreteRobot, *, xml_path=None, progress: bool = False, arms: dict | None = None,
-            **arm_options) -> DiscreteRobot:
+            layout: Layout = ROOMS, **arm_options) -> DiscreteRobot:
     """A robot from its spec: ``fine``/``coarse`` (grid robots), ``planar2:joint`` (a built-in
     arm and action model; the arm's first model when omitted), ``PATH.xml[:ACTIONS]`` (an arm
     file), or ``custom[:ACTIONS]`` (the arm in ``xml_path``); ``arm_options`` such as
     ``tip_site`` and ``base_pos`` go to arm files; ``arms`` names bring-your-own arms (a sweep
-    file's ``[arms.NAME]`` tables: ``NAME[:ACTIONS]``). A robot passes through unchanged."""
+    file's ``[arms.NAME]`` tables: ``NAME[:ACTIONS]``). The robot moves in the world ``layout``
+    (the paper's rooms by default). A robot passes through unchanged when it is in that world."""
     if isinstance(spec, DiscreteRobot):
+        if spec.layout is not layout and spec.layout != layout:
+            raise InvalidWorldError(f"robot {spec.name} moves in the world {spec.layout.name or 'unnamed'}, not in "
+                                    f"{layout.name or 'unnamed'}: build it with the world's layout")
         return spec
     if not isinstance(spec, str):
         raise UnknownRobotError(f"a robot is a spec string or a DiscreteRobot, got {type(spec).__name__}")
     if spec in GRID_ROBOTS:
-        return grid_robot(spec)
+        return grid_robot(spec, layout)
     if arms and spec.partition(":")[0] in arms:
         from armtransfer.tasks.arms import arm_robot
 
@@ -34,18 +39,19 @@ def resolve(spec: str | DiscreteRobot, *, xml_path=None, progress: bool = False,
         arm = arms[name]
         options: dict[str, Any] = {k: (tuple(v) if isinstance(v, list) else v) for k, v in arm.items() if k != "xml"}
         return arm_robot(None, actions or "cartesian", xml_path=arm["xml"], arm_name=name, progress=progress,
-                         **options)
+                         layout=layout, **options)
     from armtransfer.models import ARMS
 
     if ".xml" in spec:  # an arm file: PATH.xml or PATH.xml:ACTIONS
         path, _, actions = spec.rpartition(":") if not spec.endswith(".xml") else (spec, "", "")
         from armtransfer.tasks.arms import arm_robot
 
-        return arm_robot(None, actions or "cartesian", xml_path=path, progress=progress, **arm_options)
+        return arm_robot(None, actions or "cartesian", xml_path=path, progress=progress, layout=layout,
+                         **arm_options)
     if spec.startswith("gen:"):
         from armtransfer.tasks.generated import resolve_generated
 
-        return resolve_generated(spec, progress=progress)
+        return resolve_generated(spec, progress=progress, layout=layout)
     name, _, actions = spec.partition(":")
     given = xml_arm_name(xml_path, arm_options.get("arm_name")) if xml_path is not None else None
     if name == CUSTOM or (name == given and name not in ARMS):
@@ -53,13 +59,14 @@ def resolve(spec: str | DiscreteRobot, *, xml_path=None, progress: bool = False,
             raise UnknownRobotError(f"robot '{CUSTOM}' needs --arm-xml PATH (arm_xml= in the API)")
         from armtransfer.tasks.arms import arm_robot
 
-        return arm_robot(None, actions or "cartesian", xml_path=xml_path, progress=progress, **arm_options)
+        return arm_robot(None, actions or "cartesian", xml_path=xml_path, progress=progress, layout=layout,
+                         **arm_options)
     if name in ARMS:
         from armtransfer.tasks.arms import arm_robot, parse_robot_spec
 
         arm, actions = parse_robot_spec(spec)
         sized = {k: arm_options[k] for k in ("cell_size", "cache") if arm_options.get(k) is not None}
-        return arm_robot(arm, actions, progress=progress, **sized)
+        return arm_robot(arm, actions, progress=progress, layout=layout, **sized)
     file_arm = f"{CUSTOM} or {given} (the arm of --arm-xml)" if given else f"or {CUSTOM} with --arm-xml"
     if actions:
         raise UnknownArmError(f"unknown arm {name!r}; valid arms: {', '.join(ARMS)}, {file_arm}")

@@ -28,6 +28,8 @@ from armtransfer.errors import InvalidCellError
 # A wall is a straight segment of cells; a door is one free cell in it.
 # ((x0, y0), (x1, y1)) with x0 == x1 or y0 == y1, both ends included.
 WallSegment = tuple[tuple[int, int], tuple[int, int]]
+# A named task of a world: (name, start cell, goal cell), cells as (x, y).
+NamedTask = tuple[str, tuple[int, int], tuple[int, int]]
 
 
 @dataclass(frozen=True)
@@ -40,6 +42,14 @@ class Layout:
     doors: tuple[tuple[int, int], ...]
     rooms: dict[int, tuple[int, int, int, int]] = field(default_factory=dict)
     """Room number -> (xmin, xmax, ymin, ymax), inclusive, for naming rooms in reports."""
+    name: str = ""
+    """The world's name (``rooms``, ``rooms11``, ``generated:7``, a layout file's name)."""
+    tasks: tuple[NamedTask, ...] = ()
+    """The world's named tasks, in order; the first is the default task."""
+
+    def task(self, name: str) -> NamedTask | None:
+        """The named task, or None when the world has none of that name."""
+        return next((t for t in self.tasks if t[0] == name), None)
 
     @property
     def width(self) -> int:
@@ -155,5 +165,12 @@ ROOMS = Layout(
         3: (-25, -4, -25, 2),
         4: (-2, 25, -25, -8),
     },
+    name="rooms",
+    tasks=(  # the paper's Table I (tasks.catalog.TABLE_I gives their distances)
+        ("1", (0, 0), (-8, 12)),
+        ("2", (2, -2), (-12, 18)),
+        ("3", (2, 6), (-6, -6)),
+        ("4", (20, 18), (-22, -16)),
+    ),
 )
 """The rooms world every experiment in this project runs in."""

@@ -135,6 +135,7 @@ CONTROLS_NOTE = ("[shuffled] and [random] are controls: the same method given th
 def transfer_heading(out: dict) -> str:
     """The line above a transfer's table: task, robots, distance, trials, seed (and wind)."""
     t = out["task"]
-    return (f"{t['name']}: {tuple(t['start'])} -> {tuple(t['goal'])}, {out['source']} -> {out['target']}, "
+    world = f"world {out['world']}, " if out.get("world") else ""
+    return (f"{world}{t['name']}: {tuple(t['start'])} -> {tuple(t['goal'])}, {out['source']} -> {out['target']}, "
             f"target's optimal distance {out['distance']}, {out['trials']} trials, seed {out['seed']}"
             + (f", wind {out['wind']}" if out["wind"] else ""))
