@@ -192,6 +192,9 @@ class ResultStore:
         from armtransfer.experiments.sweep import expand
         from armtransfer.learning.config import LearnerConfig
 
+        if is_benchmark(self.meta["spec"]):
+            raise StoreError(f"{str(self.root)!r} holds a benchmark, whose trials are in its results.json "
+                             "(armtransfer summarize DIR writes it)")
         frames.pandas()
         rows, done = [], set()
         for rec in self.records():
@@ -222,6 +225,11 @@ class ResultStore:
         return out
 
 
+def is_benchmark(spec: dict) -> bool:
+    """Whether a store's spec is a benchmark's (``armtransfer benchmark``), not a sweep's."""
+    return isinstance(spec, dict) and "benchmark" in spec
+
+
 RESULT_LISTS = ("exploration_steps", "total_steps", "greedy_steps", "converged")
 
 
@@ -234,6 +242,10 @@ def _run_problem(record: object, key: str) -> str | None:
     result = record.get("result")
     if not isinstance(result, dict):
         return "has no result"
+    if str(record["config"].get("format", "")).startswith("armtransfer-benchmark-"):
+        from armtransfer.experiments.benchmark_runs import result_problem
+
+        return result_problem(record["config"], result)
     lengths = set()
     for name in RESULT_LISTS:
         values = result.get(name)
