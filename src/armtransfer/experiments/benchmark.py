@@ -140,12 +140,6 @@ def case_cells(case: suites.Case, source: DiscreteRobot, target: DiscreteRobot, 
     return draw_task(source, target, rng)
 
 
-def plan_size(suite: suites.Suite) -> int:
-    """Trials the suite runs (for a progress bar)."""
-    run, _ = methods_to_run()
-    return sum(len(s.cases) * s.source_seeds * s.trials * len(run) for s in suite.sections)
-
-
 class IncompleteError(ArmTransferError):
     """Not every run of a benchmark is in (yet)."""
 
@@ -215,7 +209,7 @@ def record(pair: Pair, name: str, source_result: dict, trials: list[dict]) -> di
         rec.update(first_exposure=[None] * n, converged=[False] * n, convergence_steps=[None] * n,
                    greedy_steps=[None] * n, episodes=[0] * n, area=[None] * n, curves=[])
         return rec
-    rec.update({name: [t[field] for t in trials] for name, field in (
+    rec.update({key: [t[field] for t in trials] for key, field in (
         ("first_exposure", "first_exposure"), ("converged", "converged"), ("convergence_steps", "convergence_steps"),
         ("greedy_steps", "greedy_steps"), ("episodes", "episodes"), ("area", "area"), ("curves", "curve"))})
     return rec

@@ -6,6 +6,9 @@
     DIR/timings/<key>.json  how long the finished run took (wall clock, kept out of its run
                             file so that the same sweep writes the same run files, byte for byte)
 
+A benchmark's store (``armtransfer benchmark``) is the same: its sweep.json names the suite and
+seed, and its runs are robot 1's learning and single trials (``experiments.benchmark_runs``).
+
 A run file appears only by ``os.replace`` of a complete temporary file, so after a crash
 (even ``kill -9``) every run file present is whole, and a run without one is simply not
 done. Temporary files a crash leaves behind start with '.' and are removed on open.

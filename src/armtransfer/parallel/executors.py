@@ -65,6 +65,8 @@ def run_local(
                     queue.appendleft(run)
             elif answer[0] == DONE:
                 result, secs = cast(tuple, answer[1])  # fn's answer is (result, seconds)
+                while queue and (worker := pool.idle()) is not None:  # it works while the store is written
+                    pool.give(worker, queue.popleft())
                 for more in on_done(run, result, secs) or ():
                     attempts[more["key"]] = 0
                     queue.append(more)
