@@ -29,6 +29,7 @@ from collections.abc import Callable
 from armtransfer.errors import ArmTransferError
 from armtransfer.experiments import experiment
 from armtransfer.experiments.stats import learning_metrics
+from armtransfer.experiments.sweep import content_key
 from armtransfer.learning import methods
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.trajectory import Trajectory
@@ -43,8 +44,6 @@ LEARNER = "sarsa"
 
 
 def _key(run: dict) -> dict:
-    from armtransfer.experiments.sweep import content_key
-
     return dict(run, key=content_key(run))
 
 
