@@ -45,29 +45,40 @@ def whole(benchmark_fast):
 
 
 def test_a_crash_mid_run_resumes_to_the_same_bytes(whole, tmp_path, monkeypatch, capsys):
-    """The driver dies after its 7th run is written (robot 1's paths and trials of the methods
-    that need none), with a half-written temporary file left in the store; the same command
-    again runs only what is missing."""
-    real_write, written = ResultStore.write_run, []
+    """The driver dies after its 7th run is written (robot 1's two paths and trials of the
+    methods that need none; one path's file is then taken away, as if it had been under way),
+    with a half-written temporary file left in the store; the same command again runs each
+    missing run once, and nothing else."""
+    real_write, written, keys = ResultStore.write_run, [], []
 
     def crash_after_seven(self, run, result, elapsed):
         if len(written) == 7:
             raise KeyboardInterrupt  # the driver stops here, its workers with it
         real_write(self, run, result, elapsed)
         written.append(run["format"])
+        keys.append(run["key"])
+
+    def counted(self, run, result, elapsed):
+        real_write(self, run, result, elapsed)
+        keys.append(run["key"])
 
     out = tmp_path / "store"
     monkeypatch.setattr(ResultStore, "write_run", crash_after_seven)
     assert main(["benchmark", "--suite", "fast", "--out", str(out), "--workers", "1"]) == 130
     monkeypatch.undo()
-    assert benchmark_runs.SOURCE_FORMAT in written and benchmark_runs.TRIAL_FORMAT in written
+    assert written.count(benchmark_runs.SOURCE_FORMAT) == 2 and benchmark_runs.TRIAL_FORMAT in written
     assert len(_run_files(out)) == 7 and not (out / "report.md").exists()
+    # as if robot 1's second path had been under way at the kill, while later runs were done
+    late = keys.pop(written.index(benchmark_runs.SOURCE_FORMAT, 1))
+    (out / "runs" / f"{late}.json").unlink()
     (out / "runs" / ".deadbeef.json.tmp").write_text('{"key": "dead')  # what a kill mid-write leaves
     capsys.readouterr()
+    monkeypatch.setattr(ResultStore, "write_run", counted)
     assert main(["benchmark", "--suite", "fast", "--out", str(out), "--workers", "2"]) == 0
     total = len(_run_files(whole))
-    assert f"{total} runs, 7 already done, {total - 7} to run" in capsys.readouterr().out
-    assert _run_files(out) == _run_files(whole)  # nothing lost, nothing twice
+    assert f"{total} runs, 6 already done, {total - 6} to run" in capsys.readouterr().out
+    assert _run_files(out) == _run_files(whole)  # nothing lost
+    assert len(keys) == len(set(keys)) == total  # and every run ran once, over both
     assert not list((out / "runs").glob(".*"))
     for name in REPORT:
         assert (out / name).read_bytes() == (whole / name).read_bytes(), name

@@ -109,7 +109,7 @@ def _run_into(store: ResultStore, plan: benchmark.Plan, robots: dict, args: argp
             pair = waiting.pop(run["key"], None)
             if pair is None:
                 return []
-            released = pair.trial_runs(plan.methods, result)
+            released = pair.waiting_runs(plan.methods, result)
             more = [r for r in released if not store.is_done(r["key"])]
             bar.update(len(released) - len(more))  # a run done before its source's file was set aside
             return more

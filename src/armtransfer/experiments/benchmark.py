@@ -186,6 +186,11 @@ class Pair:
                 for name in names if source_result is not None or not benchmark_runs.needs_trajectory(name)
                 for k in range(self.section.trials)]
 
+    def waiting_runs(self, names: Sequence[str], source_result: dict) -> list[dict]:
+        """The trial runs that wait for the source run: those of the methods that read the
+        trajectory (the others are in :meth:`trial_runs` without it)."""
+        return [run for run in self.trial_runs(names, source_result) if benchmark_runs.needs_trajectory(run["method"])]
+
     def base(self, source_result: dict) -> dict:
         """What every record of this pair holds, before its method's."""
         traj = source_result["trajectory"]
