@@ -86,3 +86,21 @@ def reproduce_fast(tmp_path_factory):
             code = main(["reproduce", "--trials", "2", "--max-total-steps", "2000000", "--out", str(out)])
             done.write_text(json.dumps(code))
     return json.loads(done.read_text()), out
+
+
+@pytest.fixture(scope="session")
+def benchmark_fast(tmp_path_factory):
+    """`armtransfer benchmark --suite fast` run twice with the same seed, on 1 worker (``one``)
+    and on 2 (``two``), shared by the tests that read the stores: (exit codes, root folder)."""
+    from armtransfer.cli import main
+
+    shared = run_dir(tmp_path_factory) / "benchmark-fast"
+    shared.mkdir(parents=True, exist_ok=True)
+    done = shared / "exit-codes.json"
+    with open(shared / "lock", "a") as lock:  # the first worker runs them; the others wait, then read them
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not done.exists():
+            codes = [main(["benchmark", "--suite", "fast", "--out", str(shared / name), "--workers", workers])
+                     for name, workers in (("one", "1"), ("two", "2"))]
+            done.write_text(json.dumps(codes))
+    return json.loads(done.read_text()), shared

@@ -19,23 +19,30 @@ from armtransfer.tasks.grid_robots import grid_robot
 
 
 @pytest.fixture(scope="module")
-def fast_runs(tmp_path_factory):
-    """The fast suite, run twice with the same seed through the command."""
-    root = tmp_path_factory.mktemp("bench")
-    codes = [main(["benchmark", "--suite", "fast", "--out", str(root / name)]) for name in ("a", "b")]
+def fast_runs(benchmark_fast):
+    """The fast suite, run twice with the same seed through the command: on 1 worker (one),
+    then on 2 (two)."""
+    codes, root = benchmark_fast
     return root, codes
+
+
+REPORT = ("report.md", "results.json", "survival_fast.png", "learning_curves_fast.png")
+"""What the fast suite's report is, byte for byte (timings.json holds wall times)."""
 
 
 def test_fast_suite_writes_one_whole_report(fast_runs):
     root, codes = fast_runs
     assert codes == [0, 0]
-    out = root / "a"
+    out = root / "one"
     names = {p.name for p in out.iterdir()}
-    assert names == {"report.md", "results.json", "timings.json", "survival_fast.png", "learning_curves_fast.png"}
-    data = json.loads((out / "results.json").read_text())
+    assert names == {*REPORT, "timings.json", "sweep.json", "runs", "failed", "timings", ".lock"}
     suite = suites.get("fast")
     ran, _ = benchmark.methods_to_run()
-    section = suite.sections[0]
+    section = suite.sections[0]  # a source run per (case, source seed) and a run per trial of every method
+    pairs = len(section.cases) * section.source_seeds
+    assert len(list((out / "runs").glob("*.json"))) == pairs * (1 + section.trials * len(ran))
+    assert not list((out / "failed").iterdir())
+    data = json.loads((out / "results.json").read_text())
     assert len(data["records"]) == len(section.cases) * section.source_seeds * len(ran)
     for rec in data["records"]:
         assert len(rec["first_exposure"]) == section.trials and rec["cap"] == section.max_total_steps
@@ -44,16 +51,30 @@ def test_fast_suite_writes_one_whole_report(fast_runs):
     assert timings["total_seconds"] > 0 and "_seconds" not in (out / "results.json").read_text()
 
 
-def test_same_seed_same_results_bytes(fast_runs):
+def test_same_seed_same_bytes_on_one_or_two_workers(fast_runs):
     root, _ = fast_runs
-    assert (root / "a" / "results.json").read_bytes() == (root / "b" / "results.json").read_bytes()
-    assert (root / "a" / "report.md").read_bytes() == (root / "b" / "report.md").read_bytes()
+    for name in REPORT:
+        assert (root / "one" / name).read_bytes() == (root / "two" / name).read_bytes(), name
+    # the runs too: the same keys, the same results
+    runs = sorted(p.name for p in (root / "one" / "runs").glob("*.json"))
+    assert runs == sorted(p.name for p in (root / "two" / "runs").glob("*.json"))
+    for name in runs:
+        assert (root / "one" / "runs" / name).read_bytes() == (root / "two" / "runs" / name).read_bytes()
+
+
+def test_the_store_gives_what_one_process_gives(fast_runs):
+    """The records of the runs in the store, run on workers, are those of the suite run in this
+    process, trial runs on threads."""
+    root, _ = fast_runs
+    records, timings = benchmark.run_suite(suites.get("fast"), 0, threads=2)
+    assert json.loads((root / "one" / "results.json").read_text())["records"] == records
+    assert timings["total_seconds"] > 0
 
 
 def test_report_names_each_methods_baseline(fast_runs):
     root, _ = fast_runs
-    report = (root / "a" / "report.md").read_text()
-    data = json.loads((root / "a" / "results.json").read_text())
+    report = (root / "one" / "report.md").read_text()
+    data = json.loads((root / "one" / "results.json").read_text())
     named = 0
     for m in data["methods"]:
         bases = list(benchmark.baselines_of(m))

@@ -1,9 +1,14 @@
-"""armtransfer benchmark: run a fixed, versioned suite and write one report.
+"""armtransfer benchmark: run a fixed, versioned suite into a result store and write one report.
 
-The report directory holds report.md, results.json (one record per case, source seed and
-method, then the statistics; the same seed gives the same bytes), timings.json (wall
-times, apart so results.json stays deterministic) and the figures. It is written into a
-hidden temporary directory beside ``--out`` and renamed into place only when complete.
+The suite's runs (robot 1's learning per case and source seed, and every trial of every
+method) go into the store the sweeps use (``--out``), keyed by content: a run that stops, even
+by SIGKILL, loses only the runs under way, and the same command resumes it; ``--workers N``
+runs them on N local processes, ``--executor ray`` on Ray (``--address`` for a cluster). When
+every run is in, the report is written into the same directory: report.md, results.json (one
+record per case, source seed and method, then the statistics; the same seed gives the same
+bytes, however and wherever the runs ran), timings.json (the runs' seconds, apart so
+results.json stays deterministic) and the figures. ``armtransfer summarize DIR`` writes it
+again from the store.
 """
 
 from __future__ import annotations
@@ -11,14 +16,20 @@ from __future__ import annotations
 import argparse
 import datetime as _dt
 import json
+import os
 import time
 from pathlib import Path
 
 from armtransfer.commands import common
+from armtransfer.commands.sweep import add_executor_arguments, check_executor_options
 from armtransfer.experiments import benchmark, suites
+from armtransfer.experiments.benchmark_runs import execute
 from armtransfer.experiments.reports import benchmark_report
 from armtransfer.experiments.stats import benchmark_stats
-from armtransfer.io import check_output_dir, staged_directory, write_json_atomic, write_text_atomic
+from armtransfer.experiments.store import ResultStore, StoreError
+from armtransfer.experiments.sweep import Sweep, content_key
+from armtransfer.io import write_bytes_atomic, write_json_atomic, write_text_atomic
+from armtransfer.parallel.executors import _check_reachable, _import_ray, run_local, run_ray
 
 HELP = "Compare every method with the baselines that share its learner on a fixed suite, over many source seeds."
 EXAMPLE = "armtransfer benchmark --suite fast --out runs/bench-fast"
@@ -28,13 +39,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     listing = "; ".join(f"{s.name}{' (held out)' if s.held_out else ''}: {s.description}" for s in suites.SUITES.values())
     p.add_argument("--suite", required=True, metavar="NAME", help=f"the suite to run. {listing}")
     p.add_argument("--out", default=None,
-                   help="output directory, absent or empty; written whole or not at all "
-                        "(default runs/benchmark-<suite>-<timestamp>)")
+                   help="result store directory: absent, empty, or this suite and seed's store to resume; the "
+                        "report is written into it when every run is in (default runs/benchmark-<suite>-<timestamp>)")
     p.add_argument("--seed", type=common.non_negative_int, default=0, help="random seed, >= 0 (default 0)")
     p.add_argument("--method", nargs="+", default=None, metavar="METHOD",
                    help="run only these methods, each beside its baselines (default: the suite's methods and "
                         "every method of an installed plugin); a method's records are the same bytes either way")
     common.add_world_argument(p)
+    add_executor_arguments(p)
 
 
 def results_bytes(suite: suites.Suite, seed: int, ran: list[str], missing: list[str], records: list[dict],
@@ -48,27 +60,142 @@ def results_bytes(suite: suites.Suite, seed: int, ran: list[str], missing: list[
 def run(args: argparse.Namespace) -> int:
     common.refuse_world(args, "benchmark", "its suites are fixed, with their tasks set in the rooms world")
     suite = suites.get(args.suite)
+    check_executor_options(args)
     out = Path(args.out) if args.out else Path("runs") / _dt.datetime.now().strftime(
         f"benchmark-{suite.name}-%Y%m%d-%H%M%S")
-    check_output_dir(out)  # before the long run, not after
+    if args.executor == "ray":
+        _import_ray()  # say how to install Ray before anything is written
+        if args.address:
+            _check_reachable(args.address)
     wanted = None
     if args.method is not None:
         from armtransfer.learning import methods
 
         wanted = tuple(methods.get(m).name for m in args.method)  # a typo lists the valid names
     ran, missing = benchmark.methods_to_run(wanted)
+    robots = benchmark.Robots({})
+    plan = benchmark.plan(suite, args.seed, robots, ran, missing)
+    from armtransfer.learning.methods import probe_on, refuse_run_time
+
+    # a plugin's fault stops the run here, in one line, before its store is opened
+    probe_on(plan.methods, [robots(p.case.target) for p in plan.pairs])
+    refuse_run_time(plan.methods, "a benchmark's runs")  # every case's task checked before anything is written
     t0 = time.perf_counter()
-    with common.progress_bar(benchmark.plan_size(suite, wanted), f"benchmark {suite.name}") as bar:
-        records, timings = benchmark.run_suite(suite, args.seed, tick=bar.update, wanted=wanted)
-    summary = benchmark_stats.summarize(records)
-    with staged_directory(out) as tmp:  # out appears only complete
-        (tmp / "results.json").write_bytes(results_bytes(suite, args.seed, ran, missing, records, summary))
-        write_json_atomic(tmp / "timings.json", timings)
-        benchmark_report.write_figures(summary, suite, tmp)
-        write_text_atomic(tmp / "report.md", benchmark_report.report_markdown(suite, args.seed, summary, ran, missing))
+    store = ResultStore.open_for(out, Sweep(plan.name, plan.spec(), ()))
+    try:
+        code = _run_into(store, plan, robots.resolved, args)
+    finally:
+        store.unlock()
+    if code:
+        return code
+    summary = write_report(store, plan)
     print(f"wrote {out / 'report.md'} ({time.perf_counter() - t0:.0f} s)")
     for section in suite.sections:
         for name, against in summary[section.name]["pooled"].items():
             for ab in against.values():
                 print(benchmark_report.sentence(name, ab, section.name))
+    return 0
+
+
+def _run_into(store: ResultStore, plan: benchmark.Plan, robots: dict, args: argparse.Namespace) -> int:
+    """Run every run of ``plan`` not in ``store`` yet; a trial run that reads robot 1's path is
+    released when its source run is in. Returns 1 when a run failed, else 0."""
+    todo, waiting, done = [], {}, 0
+    for pair in plan.pairs:
+        src = pair.source_run()
+        found = store.load_run(src["key"])
+        if found is None:
+            todo.append(src)
+            waiting[src["key"]] = pair
+        runs = pair.trial_runs(plan.methods, None if found is None else found["result"])
+        left = [r for r in runs if not store.is_done(r["key"])]
+        todo += left
+        done += (found is not None) + len(runs) - len(left)
+    to_run = plan.size() - done
+    print(f"benchmark {plan.suite.name!r}, seed {plan.seed}: {plan.size()} runs, {done} already done, {to_run} to "
+          f"run ({args.executor})")
+    if not to_run:
+        return 0
+    todo.sort(key=lambda r: r["key"] not in waiting)  # source runs first: trial runs wait for them
+    failed: list[str] = []
+    with common.progress_bar(to_run, f"benchmark {plan.suite.name}") as bar:
+        def on_done(run: dict, result: dict, secs: float) -> list[dict]:
+            store.write_run(run, result, secs)
+            bar.update()
+            pair = waiting.pop(run["key"], None)
+            if pair is None:
+                return []
+            released = pair.waiting_runs(plan.methods, result)
+            more = [r for r in released if not store.is_done(r["key"])]
+            bar.update(len(released) - len(more))  # a run done before its source's file was set aside
+            return more
+
+        def on_failed(run: dict, error: str, attempts: int) -> None:
+            store.write_failure(run, error, attempts)
+            failed.append(f"{run['key']}: {error}")
+            bar.update(1 + (plan.waiting(waiting[run["key"]]) if run["key"] in waiting else 0))
+
+        if args.executor == "ray":
+            run_ray(todo, robots, args.workers, args.address, on_done, on_failed, retries=args.retries, fn=execute)
+        else:
+            run_local(todo, robots, args.workers or os.cpu_count() or 1, on_done, on_failed, retries=args.retries,
+                      fn=execute)
+    if failed:
+        print(f"{len(failed)} runs failed, so no report yet; run the same command again to retry them")
+        for line in failed[:10]:
+            print(f"  failed {line}")
+        return 1
+    return 0
+
+
+def write_report(store: ResultStore, plan: benchmark.Plan) -> dict:
+    """The report of a store whose runs are all in, written into it (report.md last: it is
+    there only when the rest is); returns the statistics. :class:`~armtransfer.experiments.
+    benchmark.IncompleteError` when a run is missing."""
+    def result(run: dict) -> dict | None:
+        rec = store.load_run(run["key"])
+        return None if rec is None else rec["result"]
+
+    def seconds(run: dict) -> float | None:
+        try:
+            return float(json.loads((store.timings_dir / f"{run['key']}.json").read_text())["elapsed_seconds"])
+        except (OSError, ValueError, KeyError, TypeError):
+            return None
+
+    records = plan.records(result)
+    summary = benchmark_stats.summarize(records)
+    out = store.root
+    write_bytes_atomic(out / "results.json", results_bytes(plan.suite, plan.seed, list(plan.methods),
+                                                          list(plan.missing), records, summary))
+    write_json_atomic(out / "timings.json", plan.timings(result, seconds))
+    benchmark_report.write_figures(summary, plan.suite, out)
+    write_text_atomic(out / "report.md", benchmark_report.report_markdown(
+        plan.suite, plan.seed, summary, list(plan.methods), list(plan.missing)))
+    return summary
+
+
+def plan_of(store: ResultStore) -> benchmark.Plan:
+    """The plan of a benchmark store, made again by this build; a store of a suite this build
+    defines otherwise (another version) or does not have is a one-line error."""
+    spec = store.meta["spec"]["benchmark"]
+    try:
+        suite = suites.get(spec["suite"]["name"])
+    except Exception:  # noqa: BLE001 - any malformed spec is the same one-line refusal
+        raise StoreError(f"{str(store.root)!r} holds a benchmark of a suite this build does not have") from None
+    plan = benchmark.plan(suite, spec["seed"], ran=spec["methods"], missing=spec["not_in_registry"])
+    if content_key(plan.spec()) != store.meta.get("key"):
+        raise StoreError(f"{str(store.root)!r} holds a benchmark of suite {suite.name!r} as another build defined "
+                         "it (its version, methods or learner settings differ); rebuild it with that build")
+    return plan
+
+
+def summarize(store: ResultStore) -> int:
+    """``armtransfer summarize DIR`` of a benchmark store: its report again, when every run is in."""
+    plan = plan_of(store)
+    try:
+        write_report(store, plan)
+    except benchmark.IncompleteError as err:
+        raise StoreError(f"{str(store.root)!r}: {err}; finish it with armtransfer benchmark --suite "
+                         f"{plan.suite.name} --seed {plan.seed} --out {str(store.root)}") from None
+    print(f"wrote {store.root / 'report.md'}")
     return 0

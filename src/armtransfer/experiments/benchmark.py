@@ -7,6 +7,12 @@ random effect of the benchmark, not one fixed path. Then every method of
 ``trials`` trials on robot 2 from the same random streams (common random numbers), so a
 method and its baseline are paired trial by trial and seed by seed.
 
+A suite is planned (:func:`plan`) into runs of the result store
+(``armtransfer.experiments.benchmark_runs``): one source run per (case, source seed) and one
+run per trial of every method, which any executor may run in any order; the records are
+then assembled from the runs' results in the plan's order (:meth:`Plan.records`), so they do
+not depend on where or when each run ran. :func:`run_suite` runs them all in this process.
+
 A source that does not converge, or a method that refuses the case, is recorded (counted
 as a failure in the statistics), never dropped. Every random draw comes from
 ``SeedSequence([seed, section, case, source seed, ...])``, so the same seed gives the same
@@ -15,19 +21,17 @@ records, bit for bit, whatever else the suite holds; wall times are kept apart f
 
 from __future__ import annotations
 
-import time
 import zlib
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from typing import cast
 
 import numpy as np
 
-from armtransfer.errors import ArmTransferError, InvalidTaskError, PluginError
-from armtransfer.experiments import experiment, suites
-from armtransfer.experiments.stats import learning_metrics
+from armtransfer.errors import ArmTransferError, InvalidTaskError
+from armtransfer.experiments import benchmark_runs, experiment, suites
 from armtransfer.learning import methods
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.catalog import table_task
 from armtransfer.tasks.robot import DiscreteRobot
 
@@ -140,97 +144,192 @@ def case_cells(case: suites.Case, source: DiscreteRobot, target: DiscreteRobot, 
     return draw_task(source, target, rng)
 
 
-def plan_size(suite: suites.Suite, wanted: tuple[str, ...] | None = None) -> int:
-    """Trials the suite runs with the methods ``wanted`` (:func:`methods_to_run`; for a progress bar)."""
-    run, _ = methods_to_run(wanted)
-    return sum(len(s.cases) * s.source_seeds * s.trials * len(run) for s in suite.sections)
+class IncompleteError(ArmTransferError):
+    """Not every run of a benchmark is in (yet)."""
+
+    def __init__(self, message: str, missing: int) -> None:
+        super().__init__(message)
+        self.missing = missing
 
 
-def run_suite(suite: suites.Suite, seed: int = 0, tick: Callable[[], None] | None = None,
-              threads: int | None = None, wanted: tuple[str, ...] | None = None) -> tuple[list[dict], dict]:
-    """Every run of ``suite`` with the methods ``wanted`` and their baselines (:func:`methods_to_run`):
-    (records, one per (section, case, source seed, method), and the wall times of the run, kept
-    apart so that the records depend on ``seed`` alone)."""
-    run, _ = methods_to_run(wanted)
-    robots = Robots({})
-    records: list[dict] = []
-    timings: dict = {"runs": []}
-    t_all = time.perf_counter()
+Lookup = Callable[[dict], "dict | None"]
+"""A finished run's result by its run (None: not finished)."""
+
+
+@dataclass(frozen=True)
+class Pair:
+    """One (section, case, source seed): robot 1 learns its task once, and every method's trials
+    follow on robot 2."""
+
+    section: suites.Section
+    index: int
+    """The case's place in its section."""
+    case: suites.Case
+    source_seed: int
+    seed: int
+    """:func:`run_seed`: robot 1's learning and every trial of robot 2."""
+    start: tuple[int, int]
+    goal: tuple[int, int]
+    optimal: int
+    """Robot 2's shortest path, in its own steps."""
+
+    @property
+    def config(self) -> LearnerConfig:
+        """Robot 2's learner: the defaults, with the section's step cap."""
+        return replace(SOURCE_CONFIG, max_total_steps=self.section.max_total_steps)
+
+    def source_run(self) -> dict:
+        return benchmark_runs.source_run(self.case.source, self.case.target, list(self.start), list(self.goal),
+                                         self.seed, SOURCE_CONFIG)
+
+    def trial_runs(self, names: Sequence[str], source_result: dict | None) -> list[dict]:
+        """Every trial run of the methods ``names``, in (method, trial) order; without the source
+        run's result, only those of the methods that read no trajectory."""
+        return [benchmark_runs.trial_run(name, k, self.case.source, self.case.target, list(self.start),
+                                         list(self.goal), self.case.wind, self.seed, self.config, source_result)
+                for name in names if source_result is not None or not benchmark_runs.needs_trajectory(name)
+                for k in range(self.section.trials)]
+
+    def waiting_runs(self, names: Sequence[str], source_result: dict) -> list[dict]:
+        """The trial runs that wait for the source run: those of the methods that read the
+        trajectory (the others are in :meth:`trial_runs` without it)."""
+        return [run for run in self.trial_runs(names, source_result) if benchmark_runs.needs_trajectory(run["method"])]
+
+    def base(self, source_result: dict) -> dict:
+        """What every record of this pair holds, before its method's."""
+        traj = source_result["trajectory"]
+        return {"section": self.section.name, "case": self.index, "label": self.case.label,
+                "source": self.case.source, "target": self.case.target, "task": self.case.task,
+                "start": list(self.start), "goal": list(self.goal), "wind": self.case.wind,
+                "source_seed": self.source_seed, "seed": self.seed,
+                "source_steps": None if traj is None else len(traj["cells"]),
+                "source_failure": source_result["failure"], "optimal": self.optimal,
+                "cap": self.section.max_total_steps, "budget": suites.BUDGET_FACTOR * self.optimal}
+
+
+def record(pair: Pair, name: str, source_result: dict, trials: list[dict]) -> dict:
+    """One record: method ``name``'s trials on ``pair`` (none when it could not run: then
+    ``error`` says why, the first trial's in trial order, and every trial counts as a failure)."""
+    rec = dict(pair.base(source_result), method=name, baselines=list(baselines_of(name)), error=None)
+    n = len(trials)
+    errors = [t["error"] for t in trials if t["error"] is not None]
+    if errors:
+        rec["error"] = errors[0]
+        rec.update(first_exposure=[None] * n, converged=[False] * n, convergence_steps=[None] * n,
+                   greedy_steps=[None] * n, episodes=[0] * n, area=[None] * n, curves=[])
+        return rec
+    rec.update({key: [t[field] for t in trials] for key, field in (
+        ("first_exposure", "first_exposure"), ("converged", "converged"), ("convergence_steps", "convergence_steps"),
+        ("greedy_steps", "greedy_steps"), ("episodes", "episodes"), ("area", "area"), ("curves", "curve"))})
+    return rec
+
+
+@dataclass(frozen=True)
+class Plan:
+    """Every run of a suite for one seed, and how their results become the records."""
+
+    suite: suites.Suite
+    seed: int
+    methods: tuple[str, ...]
+    """The methods run, in registry order (:func:`methods_to_run`)."""
+    missing: tuple[str, ...]
+    """The suite's methods this build's registry does not have."""
+    pairs: tuple[Pair, ...]
+
+    @property
+    def name(self) -> str:
+        return f"benchmark-{self.suite.name}"
+
+    def spec(self) -> dict:
+        """What the store holding this plan's runs is for (its key is a hash of it)."""
+        return {"benchmark": {"suite": self.suite.to_dict(), "seed": self.seed, "methods": list(self.methods),
+                              "not_in_registry": list(self.missing), "formats": list(benchmark_runs.FORMATS),
+                              "source_config": SOURCE_CONFIG.to_dict()}}
+
+    def size(self) -> int:
+        """Runs in all: a source run and every method's trials per pair."""
+        return sum(1 + len(self.methods) * p.section.trials for p in self.pairs)
+
+    def waiting(self, pair: Pair) -> int:
+        """Trial runs of ``pair`` that wait for its source run (their methods read the trajectory)."""
+        return sum(benchmark_runs.needs_trajectory(m) for m in self.methods) * pair.section.trials
+
+    def records(self, result: Lookup) -> list[dict]:
+        """One record per (section, case, source seed, method), in the plan's order, from the
+        runs' results; :class:`IncompleteError` when a run's result is not there."""
+        out, missing = [], 0
+        for pair in self.pairs:
+            source = result(pair.source_run())
+            if source is None:
+                missing += 1 + len(self.methods) * pair.section.trials
+                continue
+            trials = [(run, result(run)) for run in pair.trial_runs(self.methods, source)]
+            missing += sum(r is None for _, r in trials)
+            for name in self.methods:
+                mine = [r for run, r in trials if run["method"] == name]
+                if all(r is not None for r in mine):
+                    out.append(record(pair, name, source, cast(list, mine)))
+        if missing:
+            raise IncompleteError(f"{missing} of {self.size()} runs are not in yet", missing)
+        return out
+
+    def timings(self, result: Lookup, seconds: Callable[[dict], float | None]) -> dict:
+        """Each pair's seconds: its source run's and, per method, its trial runs' summed;
+        ``total_seconds``: every run's, summed (the work, whichever workers did it)."""
+        rows, total = [], 0.0
+        for pair in self.pairs:
+            src = pair.source_run()
+            source_seconds = seconds(src) or 0.0
+            per_method: dict[str, float] = {}
+            for run in pair.trial_runs(self.methods, result(src)):
+                per_method[run["method"]] = per_method.get(run["method"], 0.0) + (seconds(run) or 0.0)
+            total += source_seconds + sum(per_method.values())
+            rows.append({"section": pair.section.name, "case": pair.index, "source_seed": pair.source_seed,
+                         "source_seconds": round(source_seconds, 3),
+                         "methods": {m: round(v, 3) for m, v in per_method.items()}})
+        return {"runs": rows, "total_seconds": round(total, 3)}
+
+
+def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
+         ran: Sequence[str] | None = None, missing: Sequence[str] = ()) -> Plan:
+    """Every pair of ``suite`` for ``seed``, its task's cells drawn and checked for both robots
+    (an error names the case before anything runs); ``ran``: the methods (default
+    :func:`methods_to_run`'s)."""
+    if ran is None:
+        ran, missing = methods_to_run()
+    robots = robots if robots is not None else Robots({})
+    pairs = []
     for section in suite.sections:
-        config = replace(SOURCE_CONFIG, max_total_steps=section.max_total_steps)
         for ci, case in enumerate(section.cases):
             source, target = robots(case.source), robots(case.target)
             for j in range(section.source_seeds):
-                rs = run_seed(seed, section.name, ci, j)
                 start, goal = case_cells(case, source, target, seed, section.name, ci, j)
-                t0 = time.perf_counter()
-                traj, why = _source_trajectory(source, start, goal, rs)
-                per_method: dict[str, float] = {}
-                timing = {"section": section.name, "case": ci, "source_seed": j,
-                          "source_seconds": time.perf_counter() - t0, "methods": per_method}
+                source.start_state(start)
                 path = target.shortest_path(target.start_state(start), goal)
                 if path is None:
                     raise InvalidTaskError(f"{case.label}: {target.name} cannot reach the goal")
-                base = {"section": section.name, "case": ci, "label": case.label, "source": case.source,
-                        "target": case.target, "task": case.task, "start": list(target.layout.xy(start)),
-                        "goal": list(target.layout.xy(goal)), "wind": case.wind, "source_seed": j, "seed": rs,
-                        "source_steps": None if traj is None else len(traj),
-                        "source_failure": why, "optimal": len(path) - 1, "cap": section.max_total_steps,
-                        "budget": suites.BUDGET_FACTOR * (len(path) - 1)}
-                for name in run:
-                    t1 = time.perf_counter()
-                    records.append(_run_one(name, base, target, start, goal, traj, section.trials, rs, config,
-                                            case.wind, tick, threads))
-                    per_method[name] = time.perf_counter() - t1
-                timings["runs"].append(timing)
-    timings["total_seconds"] = time.perf_counter() - t_all
-    return records, timings
+                pairs.append(Pair(section, ci, case, j, run_seed(seed, section.name, ci, j), target.layout.xy(start),
+                                  target.layout.xy(goal), len(path) - 1))
+    return Plan(suite, int(seed), tuple(ran), tuple(missing), tuple(pairs))
 
 
-def _source_trajectory(source: DiscreteRobot, start: int, goal: int, seed: int) -> tuple[Trajectory | None, str | None]:
-    """Robot 1's converged greedy path, or None and why not (it did not converge)."""
-    try:
-        return experiment.source_trajectory("learned", source, start, goal, SOURCE_CONFIG, seed), None
-    except ArmTransferError:
-        return None, (f"robot 1 ({source.name}) did not converge on a path within "
-                      f"{SOURCE_CONFIG.max_episodes:,} episodes and {SOURCE_CONFIG.max_total_steps:,} steps")
-
-
-def _run_one(name: str, base: dict, target: DiscreteRobot, start: int, goal: int, traj: Trajectory | None,
-             trials: int, seed: int, config: LearnerConfig, wind: float, tick, threads) -> dict:
-    """One record: ``trials`` trials of method ``name`` (none when it could not run: then
-    ``error`` says why and every trial counts as a failure)."""
-    m = methods.get(name)
-    rec = dict(base, method=name, baselines=list(baselines_of(name)), error=None)
-    res = None
-    needs = m.shaped and getattr(m, "uses_trajectory", True)
-    if needs and traj is None:
-        rec["error"] = f"no trajectory: {base['source_failure']}"
-    else:
-        try:
-            given = [traj] if needs and traj is not None else None
-            res = experiment.run_method(name, target, start, goal, given, trials, seed, config, wind=wind,
-                                        on_trial=tick, threads=threads)
-        except PluginError:  # a plugin's bug, not a case its method refuses: the run stops, in one line
-            raise
-        except ArmTransferError as err:
-            rec["error"] = str(err)
-    if res is None:
-        if tick is not None:
-            for _ in range(trials):
-                tick()
-        rec.update(first_exposure=[None] * trials, converged=[False] * trials, convergence_steps=[None] * trials,
-                   greedy_steps=[None] * trials, episodes=[0] * trials, area=[None] * trials, curves=[])
-        return rec
-    ts = res.trials
-    curves = [learning_metrics.curve(t.episode_steps, t.greedy_steps) for t in ts]
-    rec.update(
-        first_exposure=[t.exploration_steps for t in ts],
-        converged=[bool(t.converged) for t in ts],
-        convergence_steps=[t.total_steps if t.converged else None for t in ts],
-        greedy_steps=[t.greedy_steps for t in ts],
-        episodes=[int(t.episodes) for t in ts],
-        area=[float(c.sum()) for c in curves],
-        curves=[[float(v) for v in c] for c in curves],
-    )
-    return rec
+def run_suite(suite: suites.Suite, seed: int = 0, tick: Callable[[], None] | None = None,
+              threads: int | None = None) -> tuple[list[dict], dict]:
+    """Every run of ``suite``, in this process: (records, one per (section, case, source seed,
+    method), and the seconds of the runs, kept apart so that the records depend on ``seed``
+    alone). A pair's trial runs share ``threads`` threads (None: one per CPU); ``tick`` is
+    called once per trial."""
+    robots = Robots({})
+    p = plan(suite, seed, robots)
+    results: dict[str, dict] = {}
+    seconds: dict[str, float] = {}
+    for pair in p.pairs:
+        src = pair.source_run()
+        results[src["key"]], seconds[src["key"]] = benchmark_runs.execute(src, robots.resolved)
+        runs = pair.trial_runs(p.methods, results[src["key"]])
+        done = experiment.map_trials(lambda i: benchmark_runs.execute(runs[i], robots.resolved), len(runs), threads,
+                                     on_trial=tick)
+        for run, (result, secs) in zip(runs, done):
+            results[run["key"]], seconds[run["key"]] = result, secs
+    found = lambda run: results.get(run["key"])  # noqa: E731
+    return p.records(found), p.timings(found, lambda run: seconds.get(run["key"]))

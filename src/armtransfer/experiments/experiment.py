@@ -174,14 +174,18 @@ def run_method(
     control: str | None = None,
     threads: int | None = None,
     shaping: Shaping | None = None,
+    first_trial: int = 0,
 ) -> MethodResult:
     """``trials`` independent trials of one method on the target robot, on ``threads``
     threads (None: :func:`trial_threads`); the results do not depend on how many. ``traj``:
     the transferred trajectories, or a function giving each trial its own. ``shaping``: what
     :func:`method_shaping` made already for this method and ``traj`` (its K is then not
-    checked again); None makes it here."""
+    checked again); None makes it here. The trials are numbered from ``first_trial`` (their
+    generators too), so trial k run alone is trial k of a longer run, bit for bit."""
     if trials < 1:
         raise InvalidParameterError(f"trials must be a positive integer, got {trials}")
+    if first_trial < 0:
+        raise InvalidParameterError(f"first_trial must be an integer >= 0, got {first_trial}")
     start_state = target.start_state(start_cell)
     m = methods.get(method)
     if shaping is not None and (callable(traj) or not m.shaped):
@@ -196,8 +200,8 @@ def run_method(
         shapings: list = [None] * trials
 
         def one(trial: int):
-            shapings[trial] = sh = shaping_for(traj(trial))
-            return sarsa.learn(target, start_state, goal_cell, config, trial_rng(seed, trial),
+            shapings[trial] = sh = shaping_for(traj(first_trial + trial))
+            return sarsa.learn(target, start_state, goal_cell, config, trial_rng(seed, first_trial + trial),
                                shaping=sh, wind=wind, macros=macros)
 
         out.trials = map_trials(one, trials, threads, on_trial)
@@ -207,7 +211,8 @@ def run_method(
     if shaping is None:
         shaping = shaping_for(traj)
     made = shaping
-    out.trials = map_trials(lambda trial: sarsa.learn(target, start_state, goal_cell, config, trial_rng(seed, trial),
+    out.trials = map_trials(lambda trial: sarsa.learn(target, start_state, goal_cell, config,
+                                                      trial_rng(seed, first_trial + trial),
                                                       shaping=made, wind=wind, macros=macros),
                             trials, threads, on_trial)
     if made is not None:

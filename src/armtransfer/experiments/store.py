@@ -6,6 +6,9 @@
     DIR/timings/<key>.json  how long the finished run took (wall clock, kept out of its run
                             file so that the same sweep writes the same run files, byte for byte)
 
+A benchmark's store (``armtransfer benchmark``) is the same: its sweep.json names the suite and
+seed, and its runs are robot 1's learning and single trials (``experiments.benchmark_runs``).
+
 A run file appears only by ``os.replace`` of a complete temporary file, so after a crash
 (even ``kill -9``) every run file present is whole, and a run without one is simply not
 done. Temporary files a crash leaves behind start with '.' and are removed on open.
@@ -129,10 +132,14 @@ class ResultStore:
             if not isinstance(meta.get(field), kind) or not meta[field]:
                 raise StoreError(f"{str(path)!r}: field {field!r} must be a non-empty string, got "
                                  f"{meta.get(field)!r:.60}")
-        try:
-            check_stored(meta.get("spec"), repr(str(path)))
-        except SweepFileError as err:
-            raise StoreError(str(err)) from None
+        if is_benchmark(meta.get("spec")):  # a benchmark's plan: its key below vouches for it
+            if not isinstance(meta["spec"]["benchmark"], dict):
+                raise StoreError(f"{str(path)!r}: field 'spec': benchmark must be a table")
+        else:
+            try:
+                check_stored(meta.get("spec"), repr(str(path)))
+            except SweepFileError as err:
+                raise StoreError(str(err)) from None
         if content_key(meta["spec"]) != meta["key"]:
             raise StoreError(f"{str(path)!r}: field 'spec' does not match field 'key' (the file was edited); "
                              "this store cannot be trusted")
@@ -215,6 +222,9 @@ class ResultStore:
         from armtransfer.experiments.sweep import expand
         from armtransfer.learning.config import LearnerConfig
 
+        if is_benchmark(self.meta["spec"]):
+            raise StoreError(f"{str(self.root)!r} holds a benchmark, whose trials are in its results.json "
+                             "(armtransfer summarize DIR writes it)")
         frames.pandas()
         rows, done = [], set()
         for rec in self.records():
@@ -258,6 +268,9 @@ def _highest_missing(path: Path) -> Path | None:
     while not os.path.lexists(top.parent) and top.parent != top:
         top = top.parent
     return top
+def is_benchmark(spec: object) -> bool:
+    """Whether a store's spec is a benchmark's (``armtransfer benchmark``), not a sweep's."""
+    return isinstance(spec, dict) and "benchmark" in spec
 
 
 RESULT_LISTS = ("exploration_steps", "total_steps", "greedy_steps", "converged")
@@ -287,6 +300,10 @@ def _run_problem(record: object, key: str) -> str | None:
     result = record.get("result")
     if not isinstance(result, dict):
         return "has no result"
+    if str(record["config"].get("format", "")).startswith("armtransfer-benchmark-"):
+        from armtransfer.experiments.benchmark_runs import result_problem
+
+        return result_problem(record["config"], result)
     lengths = set()
     for name in RESULT_LISTS:
         values = result.get(name)

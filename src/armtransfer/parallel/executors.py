@@ -2,7 +2,9 @@
 
 Both executors hand finished runs back to the driver, which alone writes the store, so
 a run is recorded exactly once. A run whose worker crashes (or is killed) is retried up to
-``retries`` more times, then recorded as failed; it is never lost silently.
+``retries`` more times, then recorded as failed; it is never lost silently. The driver's
+``on_done`` may answer a finished run with the runs that waited for it (a benchmark's trials
+wait for robot 1's path): they are run too, by the same workers.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ from armtransfer.cpus import ENV as CPUS_ENV
 from armtransfer.parallel.pool import DONE, Pool
 from armtransfer.tasks.robot import DiscreteRobot
 
-Done = Callable[[dict, dict, float], None]  # (run, result, seconds)
+Done = Callable[[dict, dict, float], "list[dict] | None"]  # (run, result, seconds) -> runs it releases
 Failed = Callable[[dict, str, int], None]  # (run, error, attempts)
 
 
@@ -26,10 +28,11 @@ class ExecutorError(ArmTransferError):
     """An executor cannot start (e.g. Ray is not installed or unreachable)."""
 
 
-def _execute_in_ray(run: dict, robots):
-    """``execute`` in a Ray worker, its trials on one thread: Ray's tasks are the parallelism."""
+def _execute_in_ray(run: dict, robots, fn: Callable = execute):
+    """``fn`` (a sweep's ``execute``) in a Ray worker, its trials on one thread: Ray's tasks are
+    the parallelism."""
     os.environ.setdefault(CPUS_ENV, "1")
-    return execute(run, robots)
+    return fn(run, robots)
 
 
 def run_local(
@@ -41,11 +44,13 @@ def run_local(
     Each worker holds one run at a time, so when a worker dies (at any moment, its start-up
     included) the run it held is known: that run is given to a fresh worker, up to
     ``retries`` more times, then recorded as failed. ``fn(run, robots) -> (result, seconds)``
-    is what a worker runs (tests inject faults here).
+    is what a worker runs (tests inject faults here, a benchmark its own runs). The runs that
+    ``on_done`` releases need only the robots of ``runs``. Workers start as runs are handed
+    out, so no more than the runs need ever start.
     """
     queue = deque(runs)
     attempts = {r["key"]: 0 for r in runs}
-    with Pool(max(1, min(workers, len(queue))), _robots_for(runs, robots), fn) as pool:
+    with Pool(max(1, workers), _robots_for(runs, robots), fn) as pool:
         while queue or pool.busy():
             while queue and (worker := pool.idle()) is not None:
                 pool.give(worker, queue.popleft())
@@ -60,7 +65,11 @@ def run_local(
                     queue.appendleft(run)
             elif answer[0] == DONE:
                 result, secs = cast(tuple, answer[1])  # fn's answer is (result, seconds)
-                on_done(run, result, secs)
+                while queue and (worker := pool.idle()) is not None:  # it works while the store is written
+                    pool.give(worker, queue.popleft())
+                for more in on_done(run, result, secs) or ():
+                    attempts[more["key"]] = 0
+                    queue.append(more)
             else:
                 on_failed(run, str(answer[1]), attempts[run["key"]] + 1)
 
@@ -141,9 +150,10 @@ RAY_ANSWER_TIMEOUT = 5.0
 
 def run_ray(
     runs: list[dict], robots: dict[str, DiscreteRobot], workers: int | None, address: str | None,
-    on_done: Done, on_failed: Failed, retries: int = 2,
+    on_done: Done, on_failed: Failed, retries: int = 2, fn: Callable = execute,
 ) -> None:
-    """Ray tasks on the cluster at ``address``, or on a local instance with ``workers`` CPUs.
+    """Ray tasks on the cluster at ``address``, or on a local instance with ``workers`` CPUs,
+    each running ``fn(run, robots)``.
 
     Each robot is put in Ray's object store once and shared by every task that needs it."""
     ray = _import_ray()
@@ -172,10 +182,14 @@ def run_ray(
         remote_execute = ray.remote(max_retries=retries, retry_exceptions=False)(_execute_in_ray)
         refs = {spec: ray.put(robot) for spec, robot in robots.items()}
         futures = {}
-        for run in runs:
+
+        def submit(run: dict):
             needed = {run["source"]: refs[run["source"]], run["target"]: refs[run["target"]]}
-            futures[remote_execute.remote(run, _RobotRefs(needed))] = run
-        not_done = list(futures)
+            ref = remote_execute.remote(run, _RobotRefs(needed), fn)
+            futures[ref] = run
+            return ref
+
+        not_done = [submit(run) for run in runs]
         while not_done:
             finished, not_done = ray.wait(not_done, num_returns=1)
             for ref in finished:
@@ -186,7 +200,7 @@ def run_ray(
                     cause = getattr(err, "cause", None) or err
                     on_failed(run, f"{type(cause).__name__}: {cause}".splitlines()[0], retries + 1)
                     continue
-                on_done(run, result, secs)
+                not_done += [submit(more) for more in on_done(run, result, secs) or ()]
     finally:
         if started_here:
             ray.shutdown()

@@ -1,0 +1,188 @@
+"""The benchmark's runs, as the result store holds them: what one run is, how it is run, and
+what a whole result of it looks like.
+
+There are two kinds, each keyed by a hash of its full configuration (its content):
+
+- a **source run**: robot 1 learns one (case, source seed)'s task without transfer; its
+  result is the converged greedy path it hands over (as cell ids and action indices), or
+  why there is none;
+- a **trial run**: one trial of one method on robot 2, for one (case, source seed). A method
+  that reads the trajectory carries robot 1's path in its configuration (so the trial is
+  keyed by what it was handed, and can run anywhere, on any worker or cluster node, from
+  its configuration alone); the other methods do not depend on robot 1 at all.
+
+Every run names its ``learner``: the learner that runs a trial run's trial. ``sarsa`` (the
+learner of Algorithm 1, :func:`armtransfer.experiments.experiment.run_method`) is the one
+this build has; :data:`LEARNERS` maps a name to the function that runs one trial, so a learner
+added later runs through the same store, its runs keyed apart from the built-in one's.
+
+A trial's random stream is ``SeedSequence([seed, 0, trial])``, the stream of trial ``trial``
+of the whole method, so running the trials one by one, in any order and on any worker, gives
+the bytes of running them together.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+from armtransfer.errors import ArmTransferError
+from armtransfer.experiments import experiment
+from armtransfer.experiments.stats import learning_metrics
+from armtransfer.experiments.sweep import content_key
+from armtransfer.learning import methods
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.trajectory import Trajectory
+from armtransfer.tasks.robot import DiscreteRobot
+
+SOURCE_FORMAT = "armtransfer-benchmark-source/1"
+TRIAL_FORMAT = "armtransfer-benchmark-trial/1"
+FORMATS = (SOURCE_FORMAT, TRIAL_FORMAT)
+
+LEARNER = "sarsa"
+"""The built-in learner: SARSA(lambda), Algorithm 1 with the method's shaping."""
+
+
+def _key(run: dict) -> dict:
+    return dict(run, key=content_key(run))
+
+
+def needs_trajectory(method: str) -> bool:
+    """Whether ``method``'s trials read robot 1's trajectory (so they wait for its source run)."""
+    m = methods.get(method)
+    return m.shaped and getattr(m, "uses_trajectory", True)
+
+
+def source_run(source: str, target: str, start: list[int], goal: list[int], seed: int,
+               config: LearnerConfig) -> dict:
+    """Robot 1 (``source``) learning the task from ``start`` to ``goal`` (x, y) with ``seed``;
+    ``target`` names the case's robot 2 (a random task is drawn for both)."""
+    return _key({"format": SOURCE_FORMAT, "learner": LEARNER, "source": source, "target": target,
+                 "start": list(start), "goal": list(goal), "seed": int(seed), "config": config.to_dict()})
+
+
+def trial_run(method: str, trial: int, source: str, target: str, start: list[int], goal: list[int], wind: float,
+              seed: int, config: LearnerConfig, source_result: dict | None, learner: str = LEARNER) -> dict:
+    """Trial ``trial`` of ``method`` on robot 2 (``target``). A method that reads the trajectory
+    is handed ``source_result``'s (the result of the case's source run: its path, or why there
+    is none); the others carry neither."""
+    run = {"format": TRIAL_FORMAT, "learner": learner, "method": method, "trial": int(trial), "source": source,
+           "target": target, "start": list(start), "goal": list(goal), "wind": wind, "seed": int(seed),
+           "config": config.to_dict()}
+    if needs_trajectory(method):
+        if source_result is None:
+            raise ValueError(f"a trial of {method} needs its source run's result")
+        run["trajectory"] = source_result["trajectory"]
+        run["source_failure"] = source_result["failure"]
+    return _key(run)
+
+
+def trajectory_json(traj: Trajectory) -> dict:
+    return {"cells": [int(c) for c in traj.cells], "actions": [int(a) for a in traj.actions], "goal": int(traj.goal),
+            "source": traj.source}
+
+
+def trajectory_of(data: dict) -> Trajectory:
+    return Trajectory(tuple(data["cells"]), tuple(data["actions"]), int(data["goal"]), source=data["source"])
+
+
+def learn_source(source: DiscreteRobot, start: int, goal: int, seed: int,
+                 config: LearnerConfig) -> tuple[Trajectory | None, str | None]:
+    """Robot 1's converged greedy path, or None and why not (it did not converge)."""
+    try:
+        return experiment.source_trajectory("learned", source, start, goal, config, seed), None
+    except ArmTransferError:
+        return None, (f"robot 1 ({source.name}) did not converge on a path within "
+                      f"{config.max_episodes:,} episodes and {config.max_total_steps:,} steps")
+
+
+def _cells(run: dict, robot: DiscreteRobot) -> tuple[int, int]:
+    return robot.layout.cell(*run["start"]), robot.layout.cell(*run["goal"])
+
+
+def _sarsa_trial(run: dict, target: DiscreteRobot) -> dict:
+    """One trial of the built-in learner: the fields of :func:`trial_result`."""
+    start, goal = _cells(run, target)
+    traj = run.get("trajectory")
+    given = [trajectory_of(traj)] if traj is not None else None
+    res = experiment.run_method(run["method"], target, start, goal, given, 1, run["seed"],
+                                LearnerConfig(**run["config"]), wind=run["wind"], threads=1,
+                                first_trial=run["trial"])
+    t = res.trials[0]
+    curve = learning_metrics.curve(t.episode_steps, t.greedy_steps)
+    return {"error": None, "first_exposure": t.exploration_steps, "converged": bool(t.converged),
+            "convergence_steps": t.total_steps if t.converged else None, "greedy_steps": t.greedy_steps,
+            "episodes": int(t.episodes), "area": float(curve.sum()), "curve": [float(v) for v in curve],
+            "K": res.extra.get("K")}
+
+
+LEARNERS: dict[str, Callable[[dict, DiscreteRobot], dict]] = {LEARNER: _sarsa_trial}
+"""Learner name -> the function running one trial run on robot 2: ``(run, target) -> result``
+with the fields :func:`trial_problem` checks. It may raise an ``ArmTransferError`` (the method
+refuses the case: recorded as the run's ``error``)."""
+
+
+def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
+    """(result, seconds) of one benchmark run; what a worker runs (``robots``: by spec)."""
+    t0 = time.perf_counter()
+    if run["format"] == SOURCE_FORMAT:
+        source = robots[run["source"]]
+        start, goal = _cells(run, source)
+        traj, why = learn_source(source, start, goal, run["seed"], LearnerConfig(**run["config"]))
+        result: dict = {"trajectory": None if traj is None else trajectory_json(traj), "failure": why}
+    elif run["format"] == TRIAL_FORMAT:
+        result = trial_result(run, robots[run["target"]])
+    else:
+        raise ValueError(f"not a benchmark run: format {run.get('format')!r}")
+    return result, time.perf_counter() - t0
+
+
+def trial_result(run: dict, target: DiscreteRobot) -> dict:
+    """A trial run's result: its learner's numbers, or ``error`` (and nothing else) when the
+    method cannot run: no trajectory to hand over, or a refusal of the case."""
+    if needs_trajectory(run["method"]) and run.get("trajectory") is None:
+        return {"error": f"no trajectory: {run.get('source_failure')}"}
+    learner = LEARNERS.get(run["learner"])
+    if learner is None:  # a run of a learner this build does not have fails; it is no result
+        raise ArmTransferError(f"unknown learner {run['learner']!r}; valid learners: {', '.join(LEARNERS)}")
+    try:
+        return learner(run, target)
+    except ArmTransferError as err:
+        return {"error": str(err)}
+
+
+def _int_or_none(v: object) -> bool:
+    return v is None or (isinstance(v, int) and not isinstance(v, bool))
+
+
+def _number(v: object) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def result_problem(config: dict, result: dict) -> str | None:
+    """What is wrong with a stored benchmark run's result (None: it is whole)."""
+    if config.get("format") == SOURCE_FORMAT:
+        traj, why = result.get("trajectory"), result.get("failure")
+        if traj is None:
+            return None if isinstance(why, str) else "has neither a trajectory nor why not"
+        if not isinstance(traj, dict) or not all(isinstance(traj.get(k), list) for k in ("cells", "actions")) \
+                or len(traj["cells"]) != len(traj["actions"]) or not traj["cells"] \
+                or not all(isinstance(v, int) for v in (*traj["cells"], *traj["actions"], traj.get("goal"))):
+            return "has no whole trajectory"
+        return None
+    if config.get("format") == TRIAL_FORMAT:
+        return trial_problem(result)
+    return f"is not a benchmark run (format {config.get('format')!r})"
+
+
+def trial_problem(result: dict) -> str | None:
+    if result.get("error") is not None:
+        return None if isinstance(result["error"], str) else "has an error that is not a message"
+    checks = {"first_exposure": _int_or_none, "convergence_steps": _int_or_none, "greedy_steps": _int_or_none,
+              "episodes": lambda v: isinstance(v, int) and not isinstance(v, bool),
+              "converged": lambda v: isinstance(v, bool), "area": _number,
+              "curve": lambda v: isinstance(v, list) and all(map(_number, v))}
+    for name, ok in checks.items():
+        if not ok(result.get(name)):
+            return f"has no {name!r} of a trial"
+    return None
