@@ -70,6 +70,17 @@ def test_report_names_each_methods_baseline(fast_runs):
     assert "too few pairs for a claim (2 < 10)" in report
 
 
+def test_goal_only_is_at_least_as_fast_as_plan_on_every_case(fast_runs):
+    """Knowing the goal never hurts: on every case of the fast suite `goal-only` reaches the goal
+    first at least as fast as `plan` (told nothing), on every source seed."""
+    root, _ = fast_runs
+    data = json.loads((root / "a" / "results.json").read_text())
+    for section in data["summary"].values():
+        for case in section["cases"]:
+            fe = case["methods"]["goal-only"]["against"]["plan"]["first_exposure"]
+            assert fe["factor"] >= 1.0 and fe["worst"] >= 1.0, case["label"]
+
+
 def test_a_bad_suite_name_is_one_line_listing_the_suites(tmp_path, capsys):
     out = tmp_path / "never"
     assert main(["benchmark", "--suite", "nope", "--out", str(out)]) == 2
@@ -98,15 +109,27 @@ def test_suites_are_versioned_and_marked_held_out_or_not():
     held = {c for x in standard.sections for c in x.cases}
     dev = suites.get("dev").sections[0]
     assert not {c for c in dev.cases if c.task is not None} & held
-    # a drawn case of dev draws other tasks than the held-out one of the same robots
+    # dev draws on the cells every choice was made on (even); random on cells none saw (odd)
     fine, coarse = grid_robot("fine"), grid_robot("coarse")
-    for ci, case in enumerate(dev.cases):
-        if case.task is None:
-            rs = next(x for x in standard.sections if case in x.cases)
-            hi = rs.cases.index(case)
-            ours = [benchmark.case_cells(case, coarse, fine, 0, dev.name, ci, j) for j in range(5)]
-            theirs = [benchmark.case_cells(case, coarse, fine, 0, rs.name, hi, j) for j in range(5)]
-            assert not set(ours) & set(theirs)
+    rnd = suites.get("random").sections[0]
+    assert len(rnd.cases) >= 10 and all(c.cells == "odd" for c in rnd.cases)
+    drawn_case = next(c for c in dev.cases if c.task is None)
+    assert drawn_case.cells == "even"
+    ci = dev.cases.index(drawn_case)
+    for j in range(3):
+        for cell in benchmark.case_cells(drawn_case, coarse, fine, 0, dev.name, ci, j):
+            assert all(v % 2 == 0 for v in fine.layout.xy(cell))
+    case = rnd.cases[0]
+    for j in range(3):
+        start, goal = benchmark.case_cells(case, fine if case.source == "fine" else coarse,
+                                           fine if case.target == "fine" else coarse, 0, rnd.name, 0, j)
+        for cell in (start, goal):
+            assert any(v % 2 for v in fine.layout.xy(cell))
+        d = len(fine.shortest_path(fine.start_state(start), goal)) - 1
+        assert case.distance[0] <= d < case.distance[1]
+    emb = suites.get("embodiment").sections[0]
+    assert {c.task for c in emb.cases} == {1, 2, 3, 4}
+    assert sorted({c.wind for c in suites.get("wind").sections[0].cases}) == [0.01, 0.05, 0.1]
     with pytest.raises(InvalidParameterError, match="valid suites: paper, random"):
         suites.get("Standard")
 

@@ -105,8 +105,9 @@ def sentence(name: str, ab: dict, where: str) -> str:
     else:
         whose = "a baseline sharing its learner and told less: what the rest of the transfer adds"
     conv, fe, cost = ab["convergence"], ab["first_exposure"], ab["cost"]
-    text = (f"{where}: `{name}` against `{base}` ({whose}; {conv['cases']} cases, {conv['seeds']} source seeds, "
-            f"geometric means with hierarchical bootstrap-t 95% intervals; worst seed in brackets). "
+    cases = f"{conv['cases']} case{'s' if conv['cases'] != 1 else ''}"
+    text = (f"{where}: `{name}` against `{base}` ({whose}; {cases}, {conv['seeds']} source seeds, "
+            f"geometric means with hierarchical bootstrap-t 95% intervals). "
             f"Whole cost: its greedy path settled {_factor_ci(conv)} as fast (worst seed {_factor(conv['worst'])})"
             f"{_pairs_note(conv)}: {judgement(conv)}. "
             f"First exposure: {_factor_ci(fe)} as fast (worst seed {_factor(fe['worst'])}){_pairs_note(fe)}: "
