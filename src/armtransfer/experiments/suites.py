@@ -93,6 +93,11 @@ TRIALS = 3
 """Trials of every method per source seed in the held-out sections: enough to estimate how
 much of the spread lies between source seeds (reported) beside the spread within them."""
 
+ARM_TRIALS = 2
+"""Trials per source seed on the arms (``embodiment``): a method's trials run two at a time on two
+cores, so a third trial doubles the wall time of the section that takes 80% of ``standard``'s
+(measured, docs/benchmark.md); two per seed still give the one-way ANOVA its within-seed spread."""
+
 BANDS = ((10, 20), (20, 30), (30, 45), (45, 65), (65, None))
 """The drawn tasks' distance bands of ``random``; the shortest, below 20 steps, is a length no
 choice of a parameter saw (``research/select_defaults.py`` drew 20 steps and more)."""
@@ -111,7 +116,7 @@ EMBODIMENT = Section(
     "Table I tasks 1-4",
     _both_ways([("planar2:joint", "planar3:joint"), ("planar3:joint", "planar4:joint"),
                 ("gen:planar:3:1:joint", "planar2:joint")], (1, 2, 3, 4)),
-    source_seeds=10, trials=TRIALS, max_total_steps=1_000_000)
+    source_seeds=10, trials=ARM_TRIALS, max_total_steps=1_000_000)
 WIND_LEVELS = (0.01, 0.05, 0.1)
 WIND = Section(
     "wind", "Table I tasks 1-4, coarse -> fine, with wind 0.01, 0.05 and 0.1 (a move is blown one cell aside)",
