@@ -84,11 +84,11 @@ def _pairs_note(block: dict) -> str:
 
 
 def _wins_then_loses(ab: dict) -> bool:
-    fe, conv, cost = ab.get("first_exposure", {}), ab.get("convergence", {}), ab.get("cost", {})
+    """The first exposure is judged faster and the whole cost is not (slower, or no verdict)."""
+    fe, conv = ab.get("first_exposure", {}), ab.get("convergence", {})
     if not judgement(fe).startswith("faster"):
         return False
-    return bool((conv.get("factor") is not None and conv["factor"] <= 1)
-                or (cost.get("transfer_ratio") is not None and cost["transfer_ratio"] <= 0))
+    return not judgement(conv).startswith("faster") and not judgement(conv).startswith("too few")
 
 
 def sentence(name: str, ab: dict, where: str) -> str:
@@ -118,9 +118,11 @@ def sentence(name: str, ab: dict, where: str) -> str:
                  f"[{_pct(ci[0]) if ci else 'n/a'}, {_pct(ci[1]) if ci else 'n/a'}] of `{base}`'s steps saved"
                  f"{_pairs_note(cost)}: {judgement(cost)}.")
     if _wins_then_loses(ab):
-        text += (f" It wins the first episode ({_factor(fe['factor'])}) and loses it back: "
-                 f"its whole cost is {_factor(conv['factor'])} of `{base}`'s speed"
-                 + (f" and its transfer ratio {_pct(tr)}" if tr is not None else "") + ".")
+        verdict = "slower" if judgement(conv).startswith("slower") else "not faster"
+        text += (f" It wins the first episode ({_factor(fe['factor'])}) and loses it back: by convergence it is "
+                 f"{_factor_ci(conv)} as fast as `{base}` ({verdict})"
+                 + (f", and it saves {_pct(tr)} of `{base}`'s steps over the first {HORIZON} episodes"
+                    if tr is not None else "") + ".")
     return text
 
 
