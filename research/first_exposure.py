@@ -58,7 +58,7 @@ TARGET_CONTROL = 3.0
 
 def run_oracle(target, start, goal, trials, seed, config) -> experiment.MethodResult:
     """The oracle bound on the same trial streams: Phi = -2 x the true shortest-path distance."""
-    shaping = Shaping.potential(potentials.oracle(target, goal), 2.0)
+    shaping = Shaping.potential(potentials.oracle(target, goal, config.gamma, config.step_reward), 1.0)
     out = experiment.MethodResult("oracle")
     out.trials = experiment.map_trials(lambda k: sarsa.learn(target, target.start_state(start), goal, config,
                                                              experiment.trial_rng(seed, k), shaping=shaping), trials)

@@ -13,7 +13,7 @@ from armtransfer.cli import main
 from armtransfer.errors import InvalidParameterError
 from armtransfer.experiments import benchmark, suites
 from armtransfer.experiments.reports import benchmark_report
-from armtransfer.experiments.stats import benchmark_stats, metrics, survival
+from armtransfer.experiments.stats import benchmark_stats, metrics, multiplicity, survival
 from armtransfer.learning import methods
 from armtransfer.tasks.grid_robots import grid_robot
 
@@ -84,11 +84,22 @@ def test_report_names_each_methods_baseline(fast_runs):
         assert row.split("|")[2].strip() == (", ".join(bases) or "-")
         for base in bases:
             named += 1
-            assert f"`{m}` reached the goal first" in report and f"as fast as `{base}`" in report
-            assert f"{base}: " in row.split("|")[10]
+            assert f"`{m}` against `{base}`" in report
+            assert f"{base}: " in row.split("|")[8]
     assert named >= 3
     # two source seeds: the numbers, but no claim
     assert "too few pairs for a claim (2 < 10)" in report
+
+
+def test_goal_only_is_at_least_as_fast_as_plan_on_every_case(fast_runs):
+    """Knowing the goal never hurts: on every case of the fast suite `goal-only` reaches the goal
+    first at least as fast as `plan` (told nothing), on every source seed."""
+    root, _ = fast_runs
+    data = json.loads((root / "a" / "results.json").read_text())
+    for section in data["summary"].values():
+        for case in section["cases"]:
+            fe = case["methods"]["goal-only"]["against"]["plan"]["first_exposure"]
+            assert fe["factor"] >= 1.0 and fe["worst"] >= 1.0, case["label"]
 
 
 def test_a_bad_suite_name_is_one_line_listing_the_suites(tmp_path, capsys):
@@ -119,15 +130,27 @@ def test_suites_are_versioned_and_marked_held_out_or_not():
     held = {c for x in standard.sections for c in x.cases}
     dev = suites.get("dev").sections[0]
     assert not {c for c in dev.cases if c.task is not None} & held
-    # a drawn case of dev draws other tasks than the held-out one of the same robots
+    # dev draws on the cells every choice was made on (even); random on cells none saw (odd)
     fine, coarse = grid_robot("fine"), grid_robot("coarse")
-    for ci, case in enumerate(dev.cases):
-        if case.task is None:
-            rs = next(x for x in standard.sections if case in x.cases)
-            hi = rs.cases.index(case)
-            ours = [benchmark.case_cells(case, coarse, fine, 0, dev.name, ci, j) for j in range(5)]
-            theirs = [benchmark.case_cells(case, coarse, fine, 0, rs.name, hi, j) for j in range(5)]
-            assert not set(ours) & set(theirs)
+    rnd = suites.get("random").sections[0]
+    assert len(rnd.cases) >= 10 and all(c.cells == "odd" for c in rnd.cases)
+    drawn_case = next(c for c in dev.cases if c.task is None)
+    assert drawn_case.cells == "even"
+    ci = dev.cases.index(drawn_case)
+    for j in range(3):
+        for cell in benchmark.case_cells(drawn_case, coarse, fine, 0, dev.name, ci, j):
+            assert all(v % 2 == 0 for v in fine.layout.xy(cell))
+    case = rnd.cases[0]
+    for j in range(3):
+        start, goal = benchmark.case_cells(case, fine if case.source == "fine" else coarse,
+                                           fine if case.target == "fine" else coarse, 0, rnd.name, 0, j)
+        for cell in (start, goal):
+            assert any(v % 2 for v in fine.layout.xy(cell))
+        d = len(fine.shortest_path(fine.start_state(start), goal)) - 1
+        assert case.distance[0] <= d < case.distance[1]
+    emb = suites.get("embodiment").sections[0]
+    assert {c.task for c in emb.cases} == {1, 2, 3, 4}
+    assert sorted({c.wind for c in suites.get("wind").sections[0].cases}) == [0.01, 0.05, 0.1]
     with pytest.raises(InvalidParameterError, match="valid suites: paper, random"):
         suites.get("Standard")
 
@@ -180,47 +203,80 @@ def test_bootstrap_is_deterministic_and_handles_small_samples():
     assert survival.bootstrap_ci([2.0, 2.0, 2.0]) == [2.0, 2.0]
 
 
-def _rec(method, seed, fe, cap=1000, case=0, baseline="none"):
+def _rec(method, seed, fe, cap=1000, case=0, baseline="none", conv=None):
     return {"section": "s", "case": case, "label": "c", "method": method, "baselines": [] if method == "none"
             else [baseline], "source_seed": seed, "cap": cap, "budget": 100, "optimal": 10, "error": None,
-            "first_exposure": fe, "convergence_steps": [None] * len(fe), "area": [float(v or cap) for v in fe],
+            "source_failure": None, "first_exposure": fe, "converged": [c is not None for c in (conv or [None] * len(fe))],
+            "convergence_steps": conv or [None] * len(fe), "episodes": [3] * len(fe),
             "curves": [[float(v or cap)] * 3 for v in fe]}
 
 
-def test_paired_factor_is_per_source_seed():
+def test_paired_factor_is_per_trial_and_ties_at_the_cap_are_counted_apart():
     recs = []
     for seed in range(10):
         base = [100 * (seed + 1), 300 * (seed + 1)]
-        recs += [_rec("none", seed, base), _rec("pseudo", seed, [v // 4 for v in base])]
+        recs += [_rec("none", seed, base, cap=10_000), _rec("pseudo", seed, [v // 4 for v in base], cap=10_000)]
+    # one seed converged in both, so the cost of 100 episodes is known there; elsewhere ties
+    recs[0]["converged"] = recs[1]["converged"] = [True, True]
     out = benchmark_stats.summarize(recs)
     ab = out["s"]["cases"][0]["methods"]["pseudo"]["against"]["none"]
-    assert ab["factor"] == pytest.approx(4.0) and ab["ci95"] == pytest.approx([4.0, 4.0])
-    assert ab["transfer_ratio"] == pytest.approx(0.75)
-    # no trial converged in either: every convergence median is the cap, a bound and no gain
-    assert ab["convergence"]["factor"] == 1.0 and ab["convergence"]["seeds_with_censored_median"] == 10
+    assert ab["first_exposure"]["factor"] == pytest.approx(4.0)
+    assert ab["first_exposure"]["ci95"] == pytest.approx([4.0, 4.0])
+    # no trial converged in either: every pair is a tie, counted and left out (no factor of 1.00)
+    conv = ab["convergence"]
+    assert conv["factor"] is None and conv["ties"] == 20 and conv["pairs"] == 20
+    assert ab["cost"]["ties"] == 18 and ab["cost"]["factor"] == pytest.approx(4.0)
     pooled = out["s"]["pooled"]["pseudo"]["none"]
-    assert pooled["baseline"] == "none" and pooled["n"] == 10
-    assert benchmark_report.judgement(pooled) == "faster than its baseline"
+    assert pooled["baseline"] == "none" and pooled["first_exposure"]["seeds"] == 10
+    assert benchmark_report.judgement(pooled["first_exposure"]).startswith("faster than its baseline")
     text = benchmark_report.sentence("pseudo", pooled, "s")
-    assert "4.00x [4.00x, 4.00x] as fast as `none`" in text and "settled 1.00x" in text
-    assert "In 10 pairs a median convergence was at the step cap" in text
+    assert text.index("Whole cost") < text.index("First exposure") < text.index("Transfer ratio")
+    assert "4.00x [4.00x, 4.00x] as fast" in text and "20 trial pairs capped in both are ties" in text
 
 
-def test_failures_are_counted_and_censored_medians_flagged():
+def test_a_first_episode_won_and_lost_back_is_said():
+    recs = []
+    for seed in range(10):
+        recs += [_rec("none", seed, [400 + seed, 500], conv=[1000 - seed, 900]),
+                 _rec("pseudo", seed, [40 + seed, 50], conv=[2000 + seed, 1800], cap=5000)]
+    for r in recs:
+        r["cap"] = 5000
+    pooled = benchmark_stats.summarize(recs)["s"]["pooled"]["pseudo"]["none"]
+    assert pooled["first_exposure"]["factor"] > 5 and pooled["convergence"]["factor"] < 1
+    text = benchmark_report.sentence("pseudo", pooled, "s")
+    assert "wins the first episode" in text and "loses it back" in text
+    assert benchmark_report.judgement(pooled["convergence"]).startswith("slower")
+
+
+def test_failures_are_counted_and_censored_pairs_are_bounds():
     recs = [_rec("none", s, [100, 200]) for s in range(10)]
     recs += [_rec("pseudo", s, [None, None] if s < 3 else [50, 100]) for s in range(10)]
     e = benchmark_stats.summarize(recs)["s"]["cases"][0]["methods"]["pseudo"]
     assert e["failure_rate"] == pytest.approx(6 / 20)
-    assert e["first_exposure"]["worst_seed"] == 1000 and e["first_exposure"]["worst_seed_is_lower_bound"]
-    assert e["against"]["none"]["seeds_with_censored_median"] == 3
-    assert e["against"]["none"]["worst"] == pytest.approx(150 / 1000)
-    sentence = benchmark_report.sentence("pseudo", dict(e["against"]["none"], baseline="none"), "s")
-    assert "3 pairs a median first exposure was at the step cap" in sentence
+    fe = e["against"]["none"]["first_exposure"]
+    assert fe["bounds"] == 6 and fe["ties"] == 0
+    assert fe["worst"] == pytest.approx(math.sqrt(100 / 1000 * 200 / 1000))
 
 
-def test_an_interval_spanning_one_makes_no_claim():
-    ab = {"factor": 1.2, "ci95": [0.8, 1.7], "n": 10, "worst": 0.5, "baseline": "none"}
-    assert benchmark_report.judgement(ab).startswith("cannot be told apart")
+def test_holm_adjusts_every_verdict_of_a_run():
+    recs = []
+    for seed in range(10):
+        recs += [_rec("none", seed, [100 + seed, 300], conv=[900, 950 + seed]),
+                 _rec("pseudo", seed, [50 + 3 * seed, 200 - seed], conv=[700 + 20 * seed, 990])]
+    pooled = benchmark_stats.summarize(recs)["s"]["pooled"]["pseudo"]["none"]
+    fe, conv = pooled["first_exposure"], pooled["convergence"]
+    assert fe["verdicts"] == conv["verdicts"] == 3  # both, and the cost of 100 episodes
+    assert multiplicity.holm([fe["p"], conv["p"], pooled["cost"]["p"]]) == [fe["p_holm"], conv["p_holm"],
+                                                                              pooled["cost"]["p_holm"]]
+    smallest = min((fe, conv, pooled["cost"]), key=lambda v: v["p"])
+    assert smallest["p_holm"] == pytest.approx(min(1.0, 3 * smallest["p"]))
+
+
+def test_an_interval_spanning_one_makes_no_claim_and_says_what_it_could_detect():
+    ab = {"factor": 1.2, "ci95": [0.8, 1.7], "seeds": 10, "worst": 0.5, "p_holm": 0.4, "verdicts": 3,
+          "detectable": [0.76, 1.32]}
+    text = benchmark_report.judgement(ab)
+    assert text.startswith("cannot be told apart") and "below 0.76x or above 1.32x" in text
 
 
 def test_baseline_comes_from_the_registry_when_it_names_one(monkeypatch):
@@ -274,5 +330,7 @@ def test_a_source_that_does_not_converge_is_counted_not_dropped(monkeypatch):
             assert rec["first_exposure"] == [None]
         else:  # none (and a baseline that reads no trajectory) still runs
             assert rec["error"] is None and rec["episodes"][0] > 0
-    stats = benchmark_stats.summarize(records)["fast"]["cases"][0]["methods"]
+    summary = benchmark_stats.summarize(records)["fast"]
+    stats = summary["cases"][0]["methods"]
     assert stats["pseudo"]["failure_rate"] == 1.0 and stats["pseudo"]["errors"]
+    assert summary["cases"][0]["source_failures"] == 1

@@ -100,11 +100,18 @@ def run_seed(seed: int, section: str, case: int, source_seed: int) -> int:
     return int(ss.generate_state(1, dtype=np.uint32)[0])
 
 
-def draw_task(source: DiscreteRobot, target: DiscreteRobot, rng: np.random.Generator) -> tuple[int, int]:
+def draw_task(source: DiscreteRobot, target: DiscreteRobot, rng: np.random.Generator,
+              distance: tuple[int, int | None] | None = None, cells: str = "any") -> tuple[int, int]:
     """(start cell, goal cell) drawn uniformly over the cells both robots can be placed on and
-    reach from the start, anywhere in the world, at least :data:`MIN_DISTANCE` apart."""
+    reach from the start, anywhere in the world, at least :data:`MIN_DISTANCE` apart, or with
+    the finer robot's shortest path in ``distance`` = [low, high) (high None: no limit); start
+    and goal on ``cells`` (``suites.CELLS``: even, both coordinates even; odd, not both)."""
+    low, high = distance if distance is not None else (MIN_DISTANCE, None)
     common = np.intersect1d(np.unique(source.label), np.unique(target.label))
     common = common[common >= 0]
+    if cells != "any":
+        even = np.all(source.layout.xy_of(common) % 2 == 0, axis=-1)
+        common = common[even if cells == "even" else ~even]
     for _ in range(DRAWS):
         start = int(rng.choice(common))
         reach = [np.unique(r.label[r.reachable_from(r.start_state(start))]) for r in (source, target)]
@@ -115,9 +122,10 @@ def draw_task(source: DiscreteRobot, target: DiscreteRobot, rng: np.random.Gener
         goal = int(rng.choice(goals))
         lengths = [r.shortest_path(r.start_state(start), goal) for r in (source, target)]
         steps = [len(p) - 1 for p in lengths if p is not None]
-        if len(steps) == 2 and max(steps) >= MIN_DISTANCE:
+        if len(steps) == 2 and max(steps) >= low and (high is None or max(steps) < high):
             return start, goal
-    raise InvalidTaskError(f"no task of {MIN_DISTANCE}+ steps that both {source.name} and {target.name} "
+    band = f"{low}+" if high is None else f"{low}-{high - 1}"
+    raise InvalidTaskError(f"no task of {band} steps on {cells} cells that both {source.name} and {target.name} "
                            f"can do in {DRAWS} draws")
 
 
@@ -141,7 +149,7 @@ def case_cells(case: suites.Case, source: DiscreteRobot, target: DiscreteRobot, 
         return table_task(case.task).cells()
     rng = np.random.default_rng(np.random.SeedSequence(
         [int(seed), section_key(section), int(index), int(source_seed), 1]))
-    return draw_task(source, target, rng)
+    return draw_task(source, target, rng, case.distance, case.cells)
 
 
 class IncompleteError(ArmTransferError):

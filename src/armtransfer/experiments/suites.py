@@ -28,6 +28,12 @@ BUDGET_FACTOR = 100
 shortest path from start to goal (in its own steps)."""
 
 
+CELLS = ("any", "even", "odd")
+"""Which cells a drawn task's start and goal may be on: ``even`` (both coordinates even: the
+cells every parameter of this package was chosen on, ``research/select_defaults.py``), ``odd``
+(at least one coordinate odd: cells no choice ever saw) or ``any``."""
+
+
 @dataclass(frozen=True)
 class Case:
     source: str
@@ -35,10 +41,20 @@ class Case:
     task: int | None
     """A Table I task number; None: start and goal drawn per source seed over all rooms."""
     wind: float = 0.0
+    distance: tuple[int, int | None] | None = None
+    """A drawn task's shortest path for the finer robot lies in [low, high) (high None: no
+    limit); None: at least ``benchmark.MIN_DISTANCE``."""
+    cells: str = "any"
+    """Which cells a drawn task's start and goal are on (``CELLS``)."""
 
     @property
     def label(self) -> str:
         task = "random task" if self.task is None else f"task {self.task}"
+        if self.task is None and self.distance is not None:
+            lo, hi = self.distance
+            task += f" of {lo}+ steps" if hi is None else f" of {lo}-{hi - 1} steps"
+        if self.task is None and self.cells != "any":
+            task += f" on {self.cells} cells"
         wind = f", wind {self.wind:g}" if self.wind else ""
         return f"{self.source} -> {self.target}, {task}{wind}"
 
@@ -73,26 +89,44 @@ def _both_ways(pairs: list[tuple[str, str]], tasks: tuple[int | None, ...], wind
     return tuple(Case(a, b, t, wind) for s, d in pairs for a, b in ((s, d), (d, s)) for t in tasks)
 
 
+TRIALS = 3
+"""Trials of every method per source seed in the held-out sections: enough to estimate how
+much of the spread lies between source seeds (reported) beside the spread within them."""
+
+ARM_TRIALS = 2
+"""Trials per source seed on the arms (``embodiment``): a method's trials run two at a time on two
+cores, so a third trial doubles the wall time of the section that takes 80% of ``standard``'s
+(measured, docs/benchmark.md); two per seed still give the one-way ANOVA its within-seed spread."""
+
+BANDS = ((10, 20), (20, 30), (30, 45), (45, 65), (65, None))
+"""The drawn tasks' distance bands of ``random``; the shortest, below 20 steps, is a length no
+choice of a parameter saw (``research/select_defaults.py`` drew 20 steps and more)."""
+
 PAPER = Section(
     "paper", "the paper's Table I tasks 1-4, coarse -> fine and fine -> coarse",
-    _both_ways([("coarse", "fine")], (1, 2, 3, 4)), source_seeds=10, trials=2, max_total_steps=2_000_000)
+    _both_ways([("coarse", "fine")], (1, 2, 3, 4)), source_seeds=10, trials=TRIALS, max_total_steps=2_000_000)
 RANDOM = Section(
-    "random", "start and goal drawn per source seed over all four rooms, coarse <-> fine",
-    _both_ways([("coarse", "fine")], (None,)), source_seeds=10, trials=2, max_total_steps=2_000_000)
+    "random", "start and goal drawn per source seed on cells no parameter was chosen on (at least one odd "
+    "coordinate), in five distance bands from 10-19 to 65+ steps, coarse <-> fine",
+    tuple(Case(a, b, None, distance=band, cells="odd") for a, b in (("coarse", "fine"), ("fine", "coarse"))
+          for band in BANDS),
+    source_seeds=10, trials=TRIALS, max_total_steps=2_000_000)
 EMBODIMENT = Section(
-    "embodiment", "arms that move their joints (2-4 joints) and a generated planar arm, both directions",
+    "embodiment", "arms that move their joints (2-4 joints) and a generated planar arm, both directions, "
+    "Table I tasks 1-4",
     _both_ways([("planar2:joint", "planar3:joint"), ("planar3:joint", "planar4:joint"),
-                ("gen:planar:3:1:joint", "planar2:joint")], (1,)),
-    source_seeds=10, trials=2, max_total_steps=1_000_000)
+                ("gen:planar:3:1:joint", "planar2:joint")], (1, 2, 3, 4)),
+    source_seeds=10, trials=ARM_TRIALS, max_total_steps=1_000_000)
+WIND_LEVELS = (0.01, 0.05, 0.1)
 WIND = Section(
-    "wind", "Table I tasks 1-4, coarse -> fine, with wind 0.01 (a move is blown one cell aside)",
-    tuple(Case("coarse", "fine", t, 0.01) for t in (1, 2, 3, 4)), source_seeds=10, trials=2,
-    max_total_steps=2_000_000)
+    "wind", "Table I tasks 1-4, coarse -> fine, with wind 0.01, 0.05 and 0.1 (a move is blown one cell aside)",
+    tuple(Case("coarse", "fine", t, w) for w in WIND_LEVELS for t in (1, 2, 3, 4)), source_seeds=10,
+    trials=TRIALS, max_total_steps=2_000_000)
 DEV = Section(
-    "dev", "the development cases parameters may be chosen on: tasks drawn apart from the held-out ones "
-    "(coarse -> fine), and the robot pairs earlier parameters were chosen on (ur5e_like:cartesian -> "
+    "dev", "the development cases parameters may be chosen on: tasks drawn on even cells (coarse -> fine), "
+    "as every earlier choice was, and the robot pairs earlier parameters were chosen on (ur5e_like:cartesian -> "
     "planar2:joint task 3, planar3:joint -> planar4:cartesian task 4)",
-    (Case("coarse", "fine", None), Case("ur5e_like:cartesian", "planar2:joint", 3),
+    (Case("coarse", "fine", None, cells="even"), Case("ur5e_like:cartesian", "planar2:joint", 3),
      Case("planar3:joint", "planar4:cartesian", 4)),
     source_seeds=10, trials=2, max_total_steps=2_000_000)
 FAST = Section(
@@ -102,13 +136,13 @@ FAST = Section(
 SUITES: dict[str, Suite] = {
     s.name: s
     for s in (
-        Suite("paper", 1, True, PAPER.description, (PAPER,)),
-        Suite("random", 1, True, RANDOM.description, (RANDOM,)),
-        Suite("embodiment", 1, True, EMBODIMENT.description, (EMBODIMENT,)),
-        Suite("wind", 1, True, WIND.description, (WIND,)),
-        Suite("standard", 1, True, "the held-out union: paper, random, embodiment and wind",
+        Suite("paper", 2, True, PAPER.description, (PAPER,)),
+        Suite("random", 2, True, RANDOM.description, (RANDOM,)),
+        Suite("embodiment", 2, True, EMBODIMENT.description, (EMBODIMENT,)),
+        Suite("wind", 2, True, WIND.description, (WIND,)),
+        Suite("standard", 2, True, "the held-out union: paper, random, embodiment and wind",
               (PAPER, RANDOM, EMBODIMENT, WIND)),
-        Suite("dev", 1, False, DEV.description, (DEV,)),
+        Suite("dev", 2, False, DEV.description, (DEV,)),
         Suite("fast", 1, False, FAST.description, (FAST,)),
     )
 }

@@ -33,7 +33,6 @@ from armtransfer.learning.method import DEFAULT_GAMMA, HALF_BOUND, Builder, Meth
 from armtransfer.learning.rewards import as_list, farming_bound, longest_n, union_index
 from armtransfer.learning.shaping import Shaping
 from armtransfer.learning.trajectory import Trajectory
-from armtransfer.worlds.layout import Layout
 from armtransfer.tasks.robot import DiscreteRobot
 
 def _pseudo(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
@@ -88,24 +87,32 @@ def _plan(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) 
                    np.zeros(robot.n_states), k, guide=planner_guide(robot))
 
 
-def straight_line(traj: Trajectory, layout: Layout) -> Trajectory:
-    """The cells of the straight line from ``traj``'s start to its goal, one cell apart (walls
-    included: robot 2 knows no map), ending with the goal: all a trajectory says that does not
-    depend on its route."""
-    (x0, y0), (x1, y1) = layout.xy(traj.start), layout.xy(traj.goal)
-    n = max(abs(x1 - x0), abs(y1 - y0), 1)
-    cells: list[int] = []
-    for i in range(n + 1):
-        c = layout.cell(int(np.rint(x0 + (x1 - x0) * i / n)), int(np.rint(y0 + (y1 - y0) * i / n)))
-        if not cells or cells[-1] != c:
-            cells.append(c)
-    if len(cells) > 1 and cells[-1] == traj.goal:
-        cells.pop()  # the goal is s_tg, not one of the cells
-    return Trajectory(tuple(cells), (0,) * len(cells), traj.goal, source="goal-only")
+GOAL_WINDOW = 1e6
+"""``goal-only``'s window: past any trajectory, so its score is the straight-line distance to the goal."""
+GOAL_FILL = 1.0
+"""``goal-only``'s fill in cells per move (learning real-time search on the distance to the goal).
+Chosen on the dev suite among five variants (docs/research-log.md, "goal-only as a fair learner";
+``research/goal_only_variants.py``)."""
+
+
+def goal_trajectory(traj: Trajectory) -> Trajectory:
+    """All a trajectory says that does not depend on its route: its start and its goal."""
+    return Trajectory((traj.start,), (0,), traj.goal, source="goal-only")
+
+
+def goal_guide(robot: DiscreteRobot, traj: Trajectory) -> guide.Guide:
+    """``guided``'s learner aiming at the goal as a fair learner told the goal would: its score is
+    the straight-line distance from its label to the goal cell, never given up, and learning
+    real-time search (Korf's LRTA*, the guide's fill) raises the score of a state each time it is
+    left, so that a basin behind a wall fills and the robot walks round instead of bumping it. The
+    planner after every episode is ``plan``'s. It knows no map and no route."""
+    return guide.build(robot, [goal_trajectory(traj)], window=GOAL_WINDOW, give_up=0, fill=GOAL_FILL)
 
 
 def _goal_only(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
-    return _guided(robot, [straight_line(trajs[0], robot.layout)], k, beta)
+    n = robot.n_states
+    return Shaping(modes.MODE_NONE, np.zeros(n), np.full(n, -1, np.int64), np.zeros(n), k,
+                   guide=goal_guide(robot, trajs[0]))
 
 
 def _pseudo_plan(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
@@ -136,7 +143,8 @@ _BUILTIN: dict[str, Method] = {
         Method("plan", "guided's learner with no transfer: its model of its own moves and its planning after every "
                "episode, no trajectory", paper=False, build=_plan, auto_k=0.0, chooses=True, is_baseline=True,
                uses_trajectory=False),
-        Method("goal-only", "guided told only the goal: the straight line from the start to the goal for its route",
+        Method("goal-only", "guided's learner told only the goal: it heads for the goal by straight-line distance, "
+               "with learning real-time search round the walls it meets, and plans after every episode",
                paper=False, build=_goal_only, auto_k=0.0, chooses=True, baselines=("plan",), is_baseline=True),
         Method("pseudo-plan", "the paper's pseudo reward on guided's learner told nothing (plan): the paper's reward "
                "and guided on equal footing", paper=False, build=_pseudo_plan, farmable=True, chooses=True,

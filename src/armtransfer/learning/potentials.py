@@ -30,9 +30,12 @@ part of Phi is therefore squashed, monotonically, into (-B, 0] with
 B = LOOP_MARGIN * -step_reward / (1 - gamma), so a self-loop, or any move between two states
 of equal potential, costs at least (1 - LOOP_MARGIN) of a step.
 
-``oracle`` (a control, not a transfer method): Phi(s) = -K * (the robot's true
-shortest-path distance to the goal). It uses the map, which no robot has; it bounds what
-any state potential can do for this learner.
+``oracle`` (a bound, not a transfer method): Phi = V*, the optimal value of the unshaped task,
+step_reward * (1 - gamma^d) / (1 - gamma) with d the robot's true shortest-path distance to the
+goal in moves. Ng, Harada and Russell's best potential: it uses the map, which no robot has,
+and bounds what any state potential can do for this learner. Unlike -K * d (the earlier oracle,
+whose self-loops paid once d > -step_reward / ((1 - gamma) K): 185 states of fine task 4 failed
+``farming.check_self_loops``), |V*| < -step_reward / (1 - gamma), so a self-loop always costs.
 """
 
 from __future__ import annotations
@@ -103,8 +106,18 @@ def dense(
     return K * (PROGRESS_RANGE * (best_i / max(n, 1) - 1.0) - beta * best_d)
 
 
-def oracle(robot: DiscreteRobot, goal_cell: int, K: float = 2.0) -> np.ndarray:
-    """-K times each state's breadth-first distance to the goal (unreachable: the largest)."""
+def oracle(robot: DiscreteRobot, goal_cell: int, gamma: float, step_reward: float) -> np.ndarray:
+    """The optimal value of each state without shaping, step_reward * (1 - gamma^d) / (1 - gamma)
+    (d: its breadth-first distance to the goal in moves; unreachable: one more than the largest);
+    with gamma = 1, step_reward * d."""
+    d = goal_distances(robot, goal_cell).astype(np.float64)
+    if gamma >= 1.0:
+        return step_reward * d
+    return step_reward * (1.0 - gamma ** d) / (1.0 - gamma)
+
+
+def goal_distances(robot: DiscreteRobot, goal_cell: int) -> np.ndarray:
+    """Each state's breadth-first distance to the goal in moves (unreachable: the largest + 1)."""
     n = robot.n_states
     dist = np.full(n, -1, dtype=np.int64)
     # reverse edges once, then breadth-first search from every goal state
@@ -123,4 +136,4 @@ def oracle(robot: DiscreteRobot, goal_cell: int, K: float = 2.0) -> np.ndarray:
         dist[preds] = level
         frontier = preds
     dist[dist < 0] = level
-    return -K * dist.astype(np.float64)
+    return dist

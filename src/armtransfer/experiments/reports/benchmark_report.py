@@ -4,10 +4,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from armtransfer.experiments.reports import figures
 
 from armtransfer.experiments import suites
 from armtransfer.experiments.reports.report import fmt_num, markdown_table
+from armtransfer.experiments.stats.learning_metrics import HORIZON
+from armtransfer.experiments.stats.multiplicity import ALPHA
 from armtransfer.learning import methods
 
 
@@ -46,76 +50,110 @@ def _pct(x: float | None) -> str:
     return "n/a" if x is None else f"{100 * x:.0f}%"
 
 
+WHAT = {"convergence": "whole cost (steps until its greedy path settled)",
+        "first_exposure": "first exposure (steps until it first reached the goal)",
+        "cost": "transfer ratio"}
+
+
 def judgement(ab: dict) -> str:
-    """What a paired factor's interval allows one to say, from its numbers alone."""
+    """What a paired factor allows one to say, from its numbers alone: a verdict only from
+    enough source seeds and a Holm-adjusted p below 5%; otherwise what could have been seen."""
     ci = ab.get("ci95")
     if ab.get("factor") is None:
         return "no comparison"
-    if ab["n"] < suites.MIN_SEEDS_FOR_CLAIM or ci is None:
-        return f"too few pairs for a claim ({ab['n']} < {suites.MIN_SEEDS_FOR_CLAIM})"
-    if ci[0] > 1:
-        return "faster than its baseline"
-    if ci[1] < 1:
-        return "slower than its baseline"
-    return (f"cannot be told apart from its baseline at this size (the interval spans 1; only factors "
-            f"outside {ci[0]:.2f}x-{ci[1]:.2f}x would have shown)")
+    seeds = ab.get("seeds", ab.get("n", 0))
+    if seeds < suites.MIN_SEEDS_FOR_CLAIM or ci is None:
+        return f"too few pairs for a claim ({seeds} < {suites.MIN_SEEDS_FOR_CLAIM})"
+    p = ab.get("p_holm")
+    holm = f"Holm-adjusted p = {p:.3g} over {ab.get('verdicts', 1)} verdicts" if p is not None else "no p-value"
+    if p is not None and p < ALPHA:
+        return f"{'faster' if ab['factor'] > 1 else 'slower'} than its baseline ({holm})"
+    det = ab.get("detectable")
+    seen = (f"; at 80% power only factors below {det[0]:.2f}x or above {det[1]:.2f}x would have shown"
+            if det else "")
+    return f"cannot be told apart from its baseline at this size ({holm}{seen})"
+
+
+def _pairs_note(block: dict) -> str:
+    parts = []
+    if block.get("ties"):
+        parts.append(f"{block['ties']} trial pairs capped in both are ties, left out")
+    if block.get("bounds"):
+        parts.append(f"{block['bounds']} capped in one give bounds")
+    return f" ({'; '.join(parts)})" if parts else ""
+
+
+def _wins_then_loses(ab: dict) -> bool:
+    """The first exposure is judged faster and the whole cost is not (slower, or no verdict)."""
+    fe, conv = ab.get("first_exposure", {}), ab.get("convergence", {})
+    if not judgement(fe).startswith("faster"):
+        return False
+    return not judgement(conv).startswith("faster") and not judgement(conv).startswith("too few")
 
 
 def sentence(name: str, ab: dict, where: str) -> str:
-    """One claim about ``name`` against one of its baselines, from the pooled factor ``ab``."""
+    """One claim about ``name`` against one of its baselines, from the pooled comparison ``ab``
+    (one block per metric): the whole cost first, then the first exposure, then the transfer
+    ratio, and whether a first-episode win is lost back."""
     from armtransfer.experiments.benchmark import baselines_of, registered_baseline
 
+    base = ab["baseline"]
     if not registered_baseline(name):
         whose = "the default baseline: this build's registry names none for it"
-    elif baselines_of(name)[:1] == (ab["baseline"],):
+    elif baselines_of(name)[:1] == (base,):
         whose = "its baseline: the same learner, told nothing"
     else:
         whose = "a baseline sharing its learner and told less: what the rest of the transfer adds"
-    text = (f"{where}: `{name}` reached the goal first {_factor_ci(ab)} as fast as `{ab['baseline']}` ({whose}; "
-            f"geometric mean over {ab['n']} case x source-seed pairs, 95% bootstrap interval; worst pair "
-            f"{_factor(ab['worst'])}): {judgement(ab)}.")
-    conv = ab.get("convergence")
-    if conv is not None:
-        text += (f" Its greedy path settled {_factor_ci(conv)} as fast (worst pair {_factor(conv['worst'])}): "
-                 f"{judgement(conv)}.")
-    for what, block in (("first exposure", ab), ("convergence", conv or {})):
-        if block.get("seeds_with_censored_median"):
-            text += (f" In {block['seeds_with_censored_median']} pairs a median {what} was at the step cap, so "
-                     "those factors are bounds, not values.")
+    conv, fe, cost = ab["convergence"], ab["first_exposure"], ab["cost"]
+    cases = f"{conv['cases']} case{'s' if conv['cases'] != 1 else ''}"
+    text = (f"{where}: `{name}` against `{base}` ({whose}; {cases}, {conv['seeds']} source seeds, "
+            f"geometric means with hierarchical bootstrap-t 95% intervals). "
+            f"Whole cost: its greedy path settled {_factor_ci(conv)} as fast (worst seed {_factor(conv['worst'])})"
+            f"{_pairs_note(conv)}: {judgement(conv)}. "
+            f"First exposure: {_factor_ci(fe)} as fast (worst seed {_factor(fe['worst'])}){_pairs_note(fe)}: "
+            f"{judgement(fe)}.")
+    tr, ci = cost.get("transfer_ratio"), cost.get("transfer_ratio_ci95")
+    if tr is not None:
+        text += (f" Transfer ratio over the first {HORIZON} episodes: {_pct(tr)} "
+                 f"[{_pct(ci[0]) if ci else 'n/a'}, {_pct(ci[1]) if ci else 'n/a'}] of `{base}`'s steps saved"
+                 f"{_pairs_note(cost)}: {judgement(cost)}.")
+    if _wins_then_loses(ab):
+        verdict = "slower" if judgement(conv).startswith("slower") else "not faster"
+        text += (f" It wins the first episode ({_factor(fe['factor'])}) and loses it back: by convergence it is "
+                 f"{_factor_ci(conv)} as fast as `{base}` ({verdict})"
+                 + (f", and it saves {_pct(tr)} of `{base}`'s steps over the first {HORIZON} episodes"
+                    if tr is not None else "") + ".")
     return text
 
 
-def _against(e: dict, key: str | None = None) -> str:
-    parts = [f"{b}: {_factor_ci(ab if key is None else ab[key])} ({_factor((ab if key is None else ab[key])['worst'])})"
-             for b, ab in e["against"].items()]
+def _against(e: dict, key: str) -> str:
+    parts = [f"{b}: {_factor_ci(ab[key])} ({_factor(ab[key]['worst'])})" for b, ab in e["against"].items()]
     return "; ".join(parts) or "-"
 
 
 def _transfer_ratio(e: dict) -> str:
     parts = []
     for b, ab in e["against"].items():
-        ci = ab["transfer_ratio_ci95"]
-        if ab["transfer_ratio"] is not None:
-            parts.append(f"{b}: {_pct(ab['transfer_ratio'])} [{_pct(ci[0]) if ci else 'n/a'}, "
+        c = ab["cost"]
+        ci = c["transfer_ratio_ci95"]
+        if c["transfer_ratio"] is not None:
+            parts.append(f"{b}: {_pct(c['transfer_ratio'])} [{_pct(ci[0]) if ci else 'n/a'}, "
                          f"{_pct(ci[1]) if ci else 'n/a'}]")
     return "; ".join(parts) or "-"
 
 
 def case_table(case: dict, cap: float) -> str:
-    header = ["method", "baselines", "first exposure, KM median [95%]", "median over seeds [95%]", "worst seed",
-              "failed", "success in budget", "convergence, KM median [95%]", "area (100 ep.)",
-              "first exposure vs each baseline [95%] (worst seed)", "convergence vs each baseline", "transfer ratio [95%]"]
+    header = ["method", "baselines", "convergence, KM median [95%]", "first exposure, KM median [95%]",
+              "failed", "success in budget", "seed share", "convergence vs each baseline [95%] (worst seed)",
+              "first exposure vs each baseline", "transfer ratio [95%]"]
     rows = []
     for name, e in case["methods"].items():
-        fe = e["first_exposure"]
-        worst = ("≥ " if fe["worst_seed_is_lower_bound"] else "") + _steps(fe["worst_seed"])
-        seeds_ci = fe["median_over_seeds_ci95"]
+        share = e.get("seed_share")
         rows.append([
-            name + (" (error)" if e["errors"] else ""), ", ".join(e["baselines"]) or "-", _km(fe, cap),
-            f"{_steps(fe['median_over_seeds'])} [{_steps(seeds_ci[0]) if seeds_ci else 'n/a'}, "
-            f"{_steps(seeds_ci[1]) if seeds_ci else 'n/a'}]",
-            worst, _pct(e["failure_rate"]), _pct(e["success_rate"]), _km(e["convergence"], cap),
-            fmt_num(e["area"]["mean"], 0), _against(e), _against(e, "convergence"), _transfer_ratio(e),
+            name + (" (error)" if e["errors"] else ""), ", ".join(e["baselines"]) or "-", _km(e["convergence"], cap),
+            _km(e["first_exposure"], cap), _pct(e["failure_rate"]), _pct(e["success_rate"]),
+            "n/a" if share is None else f"{share:.2f}",
+            _against(e, "convergence"), _against(e, "first_exposure"), _transfer_ratio(e),
         ])
     return markdown_table(header, rows)
 
@@ -152,6 +190,7 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
         for name, against in summary[section.name]["pooled"].items():
             for ab in against.values():
                 out.append("- " + sentence(name, ab, section.name))
+    out += ["", seed_effect_text(suite, summary)]
     for section in suite.sections:
         sec = summary[section.name]
         out += ["", f"## Section `{section.name}`", "",
@@ -171,18 +210,39 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
             for m, errs in errors.items():
                 out.append(f"\n`{m}` could not run on some source seeds (counted as failed): {'; '.join(errs)}")
     out += ["", "## How to read this report", "",
-            "- First exposure: steps until robot 2 first reaches the goal. KM median: the Kaplan-Meier median "
-            "over every trial, unreached trials censored at the cap ('> cap' where the curve never falls to "
-            "one half). Median over seeds: the median of each source seed's median; worst seed: the largest "
-            "of these ('≥': censoring reached it).",
-            "- Failed: trials that never reached the goal within the cap. Success in budget: trials that "
-            "reached it within the budget.",
-            "- Convergence: steps until the greedy path stopped changing (censored at the cap when it never did).",
-            "- Area: the area under the learning curve, steps of the first 100 episodes (a converged trial "
-            "continues at its greedy length).",
-            "- vs each baseline: baseline / method of the seeds' median first exposures (or convergence steps), "
-            "paired by source seed, geometric mean with a percentile bootstrap interval over seeds (it stays inside "
-            "the factors seen); above 1 the method is faster. Transfer ratio (Taylor and Stone): the share of the baseline's area "
-            "that the method saves, mean over seeds.",
+            "- Every claim states, in this order: the whole cost (steps until the greedy path settled, "
+            "restricted to the step cap), the first exposure (steps until the goal was first reached) and the "
+            f"transfer ratio (the share of the baseline's steps over the first {HORIZON} episodes that the method "
+            "saves; a converged trial goes on at its greedy length). Each is a time until an event: a trial that "
+            "did not get there within the cap is censored there, never given a made-up value.",
+            "- Against a baseline: trial i of the method and of its baseline share a random stream, so they are "
+            "paired; the factor is baseline / method (above 1 the method is faster), a geometric mean over cases, "
+            "then source seeds, then trials. A pair capped in both is a tie: counted, left out of the factor. "
+            "A pair capped in one gives a bound, counted. The 95% interval is a hierarchical bootstrap-t "
+            "(cases, then seeds, then trials resampled). A verdict ('faster', 'slower') needs at least "
+            f"{suites.MIN_SEEDS_FOR_CLAIM} source seeds and a p-value below 5% after Holm's correction over every "
+            "verdict of the report; otherwise the claim says which factors it could have detected at 80% power.",
+            "- KM median: the Kaplan-Meier median over every trial ('> cap' where the curve never falls to one "
+            "half); its interval resamples whole source seeds. Failed: trials that never reached the goal within "
+            "the cap. Success in budget: trials that reached it within the budget. Seed share: the share of the "
+            "variance of log first exposure that lies between source seeds.",
             ""]
     return "\n".join(out)
+
+
+def seed_effect_text(suite: suites.Suite, summary: dict) -> str:
+    """How much of the spread is the source seeds' (one line), and the seeds whose robot 1 did
+    not converge (kept, and every method that needs a trajectory failed on them)."""
+    shares = [e["seed_share"] for s in suite.sections for c in summary[s.name]["cases"]
+              for e in c["methods"].values() if e.get("seed_share") is not None]
+    failed = [(s.name, c["label"], c.get("source_failures", 0)) for s in suite.sections
+              for c in summary[s.name]["cases"] if c.get("source_failures")]
+    text = ("Seed effect: the share of the variance of log first exposure that lies between source seeds "
+            + (f"has median {float(np.median(shares)):.2f} (range {min(shares):.2f}-{max(shares):.2f}) over "
+               f"{len(shares)} case x method cells." if shares else "could not be estimated (too few trials per seed)."))
+    seeds = sum(s.source_seeds * len(s.cases) for s in suite.sections)
+    n_failed = sum(k for _, _, k in failed)
+    text += (f" Robot 1 did not converge for {n_failed} of {seeds} (case, source seed) pairs; they are kept and "
+             "every method that needs a trajectory counts as failed on them"
+             + (": " + "; ".join(f"{sec} {label}: {k}" for sec, label, k in failed) if failed else "") + ".")
+    return text

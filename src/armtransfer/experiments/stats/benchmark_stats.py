@@ -1,24 +1,32 @@
 """The statistics of a benchmark run, from its records alone.
 
-Per case and method, over every source seed and trial:
+Three step counts are measured per trial, each a time until an event, restricted to the
+trial's step cap and *censored* there when the event did not happen (survival data, never
+padded with a made-up value):
 
-  first exposure     steps until the goal is first reached: Kaplan-Meier median and 95%
-                     interval (censored at the trial's cap), the median over source seeds of
-                     each seed's median (with a percentile bootstrap interval over seeds),
-                     and the worst source seed's median
-  failure rate       the share of trials that never reached the goal within the cap (a
-                     method that could not run counts every trial as failed)
-  success rate       the share of trials that reached it within the budget
-                     (``suites.BUDGET_FACTOR`` x the target's shortest path)
-  convergence        steps until the greedy path settled: Kaplan-Meier median (censored at
-                     the cap: a trial that never settled)
-  area               the area under the learning curve (``learning_metrics.curve``: steps of
-                     the first ``HORIZON`` episodes), mean over trials
+  convergence        steps until the greedy path settled: the whole cost of learning, and
+                     every claim's headline
+  first exposure     steps until the goal was first reached
+  cost of HORIZON    steps of the first ``learning_metrics.HORIZON`` episodes (a converged trial
+  episodes           goes on at its greedy length); a trial the cap stopped before that is
+                     censored at the cap
 
-and against the method's baseline (the method sharing its learner), paired per source seed:
-the factor baseline / method of the seeds' median first exposures (geometric mean over seeds
-with a bootstrap interval on the log scale, the worst seed's factor) and Taylor and Stone's
-transfer ratio, the share of the baseline's learning-curve area the method saves.
+Per case and method: Kaplan-Meier medians of each (intervals by a cluster bootstrap over
+source seeds), failure and success rates, and the share of the variance of log first
+exposure that lies between source seeds (the seed effect, from the one-way analysis of
+variance of trials within seeds).
+
+Against a baseline (the method sharing its learner), paired trial by trial (common random
+numbers): the log factor log(baseline / method) of the restricted times. A pair where both
+trials were censored is a *tie*: it is counted and left out of the factor, whose value it
+does not inform; a pair with one censored trial gives a bound and is counted too. The
+factor is the geometric mean over cases, then source seeds, then trials, with the
+hierarchical bootstrap-t interval of ``hierarchical``, its p-value, and the factors
+detectable at 80% power. The transfer ratio (Taylor and Stone) is the share of the
+baseline's cost of HORIZON episodes that the method saves, 1 - 1 / (its factor).
+
+Every verdict of the run (each method, baseline, metric and section) is Holm-adjusted
+across the whole run (``multiplicity.holm``): ``p_holm`` decides "faster" or "slower".
 """
 
 from __future__ import annotations
@@ -28,28 +36,69 @@ from collections import defaultdict
 
 import numpy as np
 
-from armtransfer.experiments.stats import survival
-from armtransfer.experiments.stats.metrics import median_is_lower_bound
+from armtransfer.experiments.stats import hierarchical, learning_metrics, multiplicity, survival
+
+METRICS = ("convergence", "first_exposure", "cost")
+"""The paired metrics in the order every claim states them: the whole cost first."""
 
 
-def _seed_median(values: list, cap: float) -> tuple[float, bool]:
-    """(median with None counted at ``cap``, whether censoring reaches it: a lower bound)."""
-    x = np.array([cap if v is None else v for v in values], dtype=np.float64)
-    return float(np.median(x)), median_is_lower_bound(sum(v is None for v in values), len(values))
+def _restricted(rec: dict, metric: str) -> list[float | None]:
+    """One record's trials' times for ``metric`` (None: censored at the cap)."""
+    cap = rec["cap"]
+    if metric == "first_exposure":
+        return [None if v is None else min(float(v), cap) for v in rec["first_exposure"]]
+    if metric == "convergence":
+        return [None if v is None else min(float(v), cap) for v in rec["convergence_steps"]]
+    out: list[float | None] = []
+    curves = rec.get("curves") or []
+    for i, conv in enumerate(rec["converged"]):
+        if i >= len(curves):
+            out.append(None)
+            continue
+        done = conv or rec["episodes"][i] >= learning_metrics.HORIZON
+        total = float(np.sum(curves[i]))
+        out.append(min(total, cap) if done and total < cap else None)
+    return out
+
+
+def seed_share(seeds: list[list[float | None]], cap: float) -> float | None:
+    """The share of the variance of log restricted first exposure between source seeds (one-way
+    ANOVA: (MSB - MSW) / n0 over the total, at least 0); None without two seeds of two trials."""
+    groups = [np.log([cap if v is None else max(v, 1.0) for v in s]) for s in seeds if len(s) >= 2]
+    if len(groups) < 2:
+        return None
+    k = len(groups)
+    n = np.array([len(g) for g in groups], dtype=np.float64)
+    big_n = n.sum()
+    grand = np.concatenate(groups).mean()
+    msb = float(sum(len(g) * (g.mean() - grand) ** 2 for g in groups) / (k - 1))
+    msw = float(sum(((g - g.mean()) ** 2).sum() for g in groups) / (big_n - k))
+    n0 = (big_n - (n ** 2).sum() / big_n) / (k - 1)
+    between = max(0.0, (msb - msw) / n0)
+    total = between + msw
+    return float(between / total) if total > 0 else 0.0
+
+
+def _km_block(seeds: list[list[float | None]], cap: float) -> dict:
+    flat = [v for s in seeds for v in s]
+    km = survival.kaplan_meier(flat, cap)
+    return {"km_median": km["median"], "km_median_ci95": survival.cluster_median_ci(seeds),
+            "km_median_beyond_cap": km["median_beyond_cap"], "events": km["events"], "n": km["n"], "km": km}
 
 
 def cell_stats(recs: list[dict]) -> dict:
     """The statistics of one case and method (``recs``: its records, one per source seed)."""
     cap = recs[0]["cap"]
-    fe = [v for r in recs for v in r["first_exposure"]]
+    fe_seeds = [_restricted(r, "first_exposure") for r in recs]
+    fe = [v for s in fe_seeds for v in s]
     n = len(fe)
-    km = survival.kaplan_meier(fe, cap)
-    seeds = [_seed_median(r["first_exposure"], cap) for r in recs]
-    medians = [m for m, _ in seeds]
-    conv = [v for r in recs for v in r["convergence_steps"]]
-    conv_km = survival.kaplan_meier(conv, cap)
+    fe_block = _km_block(fe_seeds, cap)
+    km = fe_block.pop("km")
+    conv = _km_block([_restricted(r, "convergence") for r in recs], cap)
+    conv.pop("km")
+    cost = _km_block([_restricted(r, "cost") for r in recs], cap)
+    cost.pop("km")
     within = [v is not None and v <= r["budget"] for r in recs for v in r["first_exposure"]]
-    areas = [a for r in recs for a in r["area"] if a is not None]
     curves = [c for r in recs for c in r["curves"]]
     return {
         "trials": n,
@@ -57,94 +106,110 @@ def cell_stats(recs: list[dict]) -> dict:
         "errors": sorted({r["error"] for r in recs if r["error"]}),
         "failure_rate": sum(v is None for v in fe) / n if n else None,
         "success_rate": sum(within) / n if n else None,
-        "first_exposure": {
-            "km_median": km["median"], "km_median_ci95": km["median_ci95"],
-            "km_median_beyond_cap": km["median_beyond_cap"],
-            "seed_medians": medians,
-            "median_over_seeds": float(np.median(medians)) if medians else None,
-            "median_over_seeds_ci95": survival.bootstrap_ci(medians, np.median),
-            "worst_seed": max(medians) if medians else None,
-            "worst_seed_is_lower_bound": any(lb and m == max(medians) for m, lb in seeds),
-            "seeds_at_cap": sum(lb for _, lb in seeds),
-        },
+        "seed_share": seed_share(fe_seeds, cap),
+        "first_exposure": fe_block,
         "survival": {k: km[k] for k in ("times", "survival", "low", "high")},
-        "convergence": {"km_median": conv_km["median"], "km_median_ci95": conv_km["median_ci95"],
-                        "km_median_beyond_cap": conv_km["median_beyond_cap"],
-                        "converged": sum(v is not None for v in conv)},
-        "area": {"mean": float(np.mean(areas)) if areas else None,
-                 "ci95": survival.bootstrap_ci([np.mean(r["area"]) for r in recs if None not in r["area"]])},
+        "convergence": dict(conv, converged=conv["events"]),
+        "cost": cost,
         "curve_mean": [float(v) for v in np.mean(curves, axis=0)] if curves else [],
     }
 
 
-def _factors(method: list[dict], base: list[dict], key: str) -> dict:
-    """baseline / method of the per-seed medians of ``key`` (censored at the cap), paired by
-    source seed: the summary of :func:`survival.ratio_summary`, the log factors, and how many
-    seeds had a median that censoring reached (their factor is a bound)."""
-    cap = method[0]["cap"]
+def _pairs(method: list[dict], base: list[dict], metric: str) -> tuple[list[list[float]], int, int]:
+    """Per source seed, the trial-paired log factors log(baseline / method) of ``metric`` (ties
+    left out), the number of ties (both censored) and of bounds (one censored)."""
     by_seed = {b["source_seed"]: b for b in base}
-    logs, bounds = [], 0
+    seeds, ties, bounds = [], 0, 0
     for m in method:
-        mm, mlb = _seed_median(m[key], cap)
-        bm, blb = _seed_median(by_seed[m["source_seed"]][key], cap)
-        logs.append(math.log(bm / mm))
-        bounds += bool(mlb or blb)
-    return dict(survival.ratio_summary(logs), log_factors=logs, seeds_with_censored_median=bounds)
+        b = by_seed.get(m["source_seed"])
+        if b is None:
+            continue
+        logs = []
+        cap = m["cap"]
+        for mv, bv in zip(_restricted(m, metric), _restricted(b, metric)):
+            if mv is None and bv is None:
+                ties += 1
+                continue
+            bounds += (mv is None) or (bv is None)
+            logs.append(math.log(max(cap if bv is None else bv, 1.0) / max(cap if mv is None else mv, 1.0)))
+        seeds.append(logs)
+    return seeds, ties, bounds
 
 
-def paired(method: list[dict], base: list[dict]) -> dict:
-    """The method against one baseline, paired by source seed: the first-exposure factor (the
-    top level), the convergence factor, and the transfer ratio of the learning-curve areas."""
-    by_seed = {b["source_seed"]: b for b in base}
-    ratios = [1.0 - float(np.mean(m["area"])) / float(np.mean(by_seed[m["source_seed"]]["area"]))
-              for m in method if None not in m["area"] and None not in by_seed[m["source_seed"]]["area"]]
-    out = _factors(method, base, "first_exposure")
-    out["convergence"] = _factors(method, base, "convergence_steps")
-    out["transfer_ratio"] = float(np.mean(ratios)) if ratios else None
-    out["transfer_ratio_ci95"] = survival.bootstrap_ci(ratios)
+def compare(cases: list[tuple[list[dict], list[dict]]], metric: str) -> dict:
+    """(method records, baseline records) per case: the paired factor of ``metric`` over cases,
+    source seeds and trials, with its hierarchical bootstrap-t interval, p-value, detectable
+    factors, worst and best seed (geometric mean of its trials), ties and bounds."""
+    nested, ties, bounds = [], 0, 0
+    for method, base in cases:
+        seeds, t, b = _pairs(method, base, metric)
+        nested.append(seeds)
+        ties += t
+        bounds += b
+    out = hierarchical.as_factor(hierarchical.bootstrap_t(nested))
+    seed_factors = [math.exp(float(np.mean(s))) for c in nested for s in c if s]
+    out.update(metric=metric, ties=ties, bounds=bounds, pairs=sum(len(s) for c in nested for s in c) + ties,
+               worst=min(seed_factors) if seed_factors else None, best=max(seed_factors) if seed_factors else None)
+    if metric == "cost":
+        f, ci = out["factor"], out["ci95"]
+        out["transfer_ratio"] = None if f is None else 1.0 - 1.0 / f
+        out["transfer_ratio_ci95"] = None if ci is None else [1.0 - 1.0 / ci[0], 1.0 - 1.0 / ci[1]]
     return out
 
 
-def _pool(entries: list[dict], base: str) -> dict:
-    logs = [x for e in entries for x in e["log_factors"]]
-    cens = sum(e["seeds_with_censored_median"] for e in entries)
-    return dict(survival.ratio_summary(logs), baseline=base, seeds_with_censored_median=cens)
+def paired(method: list[dict], base: list[dict]) -> dict:
+    """The method against one baseline on one case, every metric (``METRICS``)."""
+    return {k: compare([(method, base)], k) for k in METRICS}
 
 
 def summarize(records: list[dict]) -> dict:
-    """``{section: {"cases": [{label, methods: {name: stats}}], "pooled": {name: {baseline: factor}}}}``.
+    """``{section: {"cases": [{label, methods: {name: stats}}], "pooled": {name: {baseline: {metric:
+    factor}}}}}``.
 
     A method's stats hold ``against``: per baseline it names (the no-transfer one first), the
-    paired comparison. ``pooled`` is that factor over every (case, source seed) of the section,
-    each pair one unit of the bootstrap."""
+    paired comparison on one case. ``pooled`` is the comparison over every case of the section
+    (cases, then seeds, then trials). Every pooled comparison's p-value is Holm-adjusted across
+    the run (``p_holm``)."""
     by_cell: dict = defaultdict(list)
     for r in records:
         by_cell[(r["section"], r["case"], r["method"])].append(r)
+    for recs in by_cell.values():
+        recs.sort(key=lambda r: r["source_seed"])
     out: dict = {}
     for r in records:
         sec = out.setdefault(r["section"], {"cases": {}, "pooled": {}})
         sec["cases"].setdefault(r["case"], {"label": r["label"], "optimal_per_seed": [], "methods": {}})
     for (section, case, method), recs in by_cell.items():
-        recs.sort(key=lambda r: r["source_seed"])
         entry = cell_stats(recs)
         entry["baselines"] = recs[0]["baselines"]
-        entry["against"] = {b: paired(recs, sorted(by_cell[(section, case, b)], key=lambda r: r["source_seed"]))
+        entry["against"] = {b: paired(recs, by_cell[(section, case, b)])
                             for b in entry["baselines"] if (section, case, b) in by_cell}
         out[section]["cases"][case]["methods"][method] = entry
         out[section]["cases"][case]["optimal_per_seed"] = [r["optimal"] for r in recs]
+        out[section]["cases"][case]["source_failures"] = sum(r["source_failure"] is not None for r in recs)
+    verdicts: list[dict] = []
     for section, sec in out.items():
-        order = [r["method"] for r in records if r["section"] == section]
-        names = list(dict.fromkeys(order))
+        names = list(dict.fromkeys(r["method"] for r in records if r["section"] == section))
         for name in names:
-            pairs: dict[str, list[dict]] = {}
-            for case in sec["cases"].values():
-                for base, ab in case["methods"].get(name, {}).get("against", {}).items():
-                    pairs.setdefault(base, []).append(ab)
-            if pairs:
-                sec["pooled"][name] = {base: dict(_pool(abs_, base),
-                                                  convergence=_pool([a["convergence"] for a in abs_], base))
-                                       for base, abs_ in pairs.items()}
+            bases = list(dict.fromkeys(b for (s, _, m), recs in by_cell.items() if s == section and m == name
+                                       for b in recs[0]["baselines"]))
+            pooled: dict = {}
+            for base in bases:
+                cases = [(by_cell[(section, c, name)], by_cell[(section, c, base)]) for c in sorted(sec["cases"])
+                         if (section, c, name) in by_cell and (section, c, base) in by_cell]
+                if cases:
+                    pooled[base] = dict({k: compare(cases, k) for k in METRICS}, baseline=base)
+                    verdicts += [pooled[base][k] for k in METRICS]
+            if pooled:
+                sec["pooled"][name] = pooled
         sec["cases"] = [sec["cases"][k] for k in sorted(sec["cases"])]
         for case in sec["cases"]:
             case["methods"] = {n: case["methods"][n] for n in names if n in case["methods"]}
+    tested = [v for v in verdicts if v["p"] is not None]
+    for v, adj in zip(tested, multiplicity.holm([v["p"] for v in tested])):
+        v["p_holm"] = adj
+        v["verdicts"] = len(tested)
+    for v in verdicts:
+        v.setdefault("p_holm", None)
+        v.setdefault("verdicts", len(tested))
     return out

@@ -4,8 +4,10 @@ A trial that has not reached the goal when its step cap stops it has a *censored
 exposure: all we know is that it would have taken more than the cap. The Kaplan-Meier
 estimate (``scipy.stats.ecdf`` on ``scipy.stats.CensoredData``) uses such a trial for as long
 as it was observed, so neither the cap nor the failures distort the curve below the cap; its
-median is reported with the interval where the pointwise 95% band (log-log) crosses one half,
-and a median that the data cannot reach is ``None`` and flagged as lying beyond the cap.
+median's interval is a cluster bootstrap over source seeds (:func:`cluster_median_ci`: the
+trials of one seed share its trajectory, so they are resampled together), and a median that the
+data cannot reach is ``None`` and flagged as lying beyond the cap. The curve's pointwise band
+(log-log) treats trials as independent and is drawn only.
 
 Intervals of summary statistics are percentile bootstraps (``scipy.stats.bootstrap`` with a
 fixed seed), so they are deterministic and never leave the range of the values resampled: a
@@ -65,6 +67,35 @@ def kaplan_meier(values: Sequence[float | None], cap: float) -> dict:
                median_beyond_cap=median is None,
                median_ci95=[first_time_at_or_below(times, low, 0.5), first_time_at_or_below(times, high, 0.5)])
     return out
+
+
+def km_median_of_sorted(x: np.ndarray) -> np.ndarray:
+    """The Kaplan-Meier median of rows of sorted times with every censored value at one cap at
+    or above all events (``inf`` for censored): below the cap the curve is the empirical one, so
+    the median is the ceil(n/2)-th smallest value (``inf``: beyond the cap)."""
+    n = x.shape[-1]
+    return x[..., (n + 1) // 2 - 1]
+
+
+def cluster_median_ci(seeds: Sequence[Sequence[float | None]], seed: int = BOOTSTRAP_SEED,
+                      resamples: int = BOOTSTRAP_RESAMPLES) -> list[float | None]:
+    """Percentile 95% interval of the Kaplan-Meier median resampling whole source seeds (each a
+    list of trials, None: censored at the cap), so that trials sharing a seed's trajectory are
+    not counted as independent. An end that lies beyond the cap is None; fewer than two seeds:
+    [None, None]."""
+    groups = [np.array([np.inf if v is None else float(v) for v in s]) for s in seeds if len(s)]
+    if len(groups) < 2:
+        return [None, None]
+    rng = np.random.default_rng(seed)
+    pick = rng.integers(0, len(groups), size=(resamples, len(groups)))
+    if len({len(g) for g in groups}) == 1:
+        arr = np.stack(groups)
+        draws = np.sort(arr[pick].reshape(resamples, -1), axis=1)
+        med = km_median_of_sorted(draws)
+    else:
+        med = np.array([km_median_of_sorted(np.sort(np.concatenate([groups[i] for i in row]))) for row in pick])
+    lo, hi = np.quantile(med, [(1 - LEVEL) / 2, 1 - (1 - LEVEL) / 2], method="inverted_cdf")
+    return [None if not np.isfinite(lo) else float(lo), None if not np.isfinite(hi) else float(hi)]
 
 
 def first_time_at_or_below(times: Sequence[float], curve: Sequence[float], level: float) -> float | None:
