@@ -31,6 +31,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="output directory, absent or empty; written whole or not at all "
                         "(default runs/benchmark-<suite>-<timestamp>)")
     p.add_argument("--seed", type=common.non_negative_int, default=0, help="random seed, >= 0 (default 0)")
+    common.add_preset_argument(p)
 
 
 def results_bytes(suite: suites.Suite, seed: int, ran: list[str], missing: list[str], records: list[dict],
@@ -49,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
     ran, missing = benchmark.methods_to_run()
     t0 = time.perf_counter()
     with common.progress_bar(benchmark.plan_size(suite), f"benchmark {suite.name}") as bar:
-        records, timings = benchmark.run_suite(suite, args.seed, tick=bar.update)
+        records, timings = benchmark.run_suite(suite, args.seed, tick=bar.update, preset=args.preset)
     summary = benchmark_stats.summarize(records)
     with staged_directory(out) as tmp:  # out appears only complete
         (tmp / "results.json").write_bytes(results_bytes(suite, args.seed, ran, missing, records, summary))

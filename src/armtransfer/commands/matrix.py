@@ -62,6 +62,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--trajectory", choices=["learned", "optimal"], default="learned",
                    help="each source's learned path (default) or its shortest path")
     p.add_argument("--out", required=True, help="result store directory (re-running resumes)")
+    common.add_preset_argument(p)
     common.add_arm_file_arguments(p)
     add_executor_arguments(p)
 
@@ -75,7 +76,7 @@ def run(args: argparse.Namespace) -> int:
     common.refuse_unused_method_options(args, "--methods")
     robots, arms = arm_file_robots(args)
     sweep = matrix.matrix_sweep(robots, args.tasks, args.methods, args.trials, args.seeds, args.trajectory,
-                                arms=arms)
+                                arms=arms, preset=args.preset)
     code = run_sweep(sweep, args)
     text = write_summary(ResultStore.open_existing(args.out), Path(args.out))
     print(text)

@@ -26,6 +26,7 @@ from armtransfer.errors import ArmTransferError, InvalidTaskError
 from armtransfer.experiments import experiment, suites
 from armtransfer.experiments.stats import learning_metrics
 from armtransfer.learning import methods
+from armtransfer.learning import presets
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.catalog import table_task
@@ -143,16 +144,18 @@ def plan_size(suite: suites.Suite) -> int:
 
 
 def run_suite(suite: suites.Suite, seed: int = 0, tick: Callable[[], None] | None = None,
-              threads: int | None = None) -> tuple[list[dict], dict]:
+              threads: int | None = None, preset: str = "default") -> tuple[list[dict], dict]:
     """Every run of ``suite``: (records, one per (section, case, source seed, method), and the
-    wall times of the run, kept apart so that the records depend on ``seed`` alone)."""
+    wall times of the run, kept apart so that the records depend on ``seed`` alone). Robot 2
+    learns with the settings of ``preset`` (``learning.presets``)."""
+    learner = presets.config(preset)
     run, _ = methods_to_run()
     robots = Robots({})
     records: list[dict] = []
     timings: dict = {"runs": []}
     t_all = time.perf_counter()
     for section in suite.sections:
-        config = replace(SOURCE_CONFIG, max_total_steps=section.max_total_steps)
+        config = replace(learner, max_total_steps=section.max_total_steps)
         for ci, case in enumerate(section.cases):
             source, target = robots(case.source), robots(case.target)
             for j in range(section.source_seeds):
