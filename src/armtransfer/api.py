@@ -19,7 +19,7 @@ from pathlib import Path
 
 import armtransfer.checks as checks
 from armtransfer.errors import InvalidCellError, InvalidParameterError, InvalidTaskError
-from armtransfer.learning import potentials
+from armtransfer.learning import potentials, presets
 from armtransfer.experiments import experiment
 from armtransfer.learning import methods as registry
 from armtransfer.learning import trajectory as trajectories
@@ -72,6 +72,7 @@ def transfer(
     progress: Callable[[], None] | None = None,
     state: str = "discrete",
     world: str | Path | Layout | None = None,
+    preset: str = "default",
     **learner_options,
 ) -> TransferResult | ContinuousResult:
     """Transfer a trajectory from ``source`` to ``target`` and learn with each method.
@@ -84,7 +85,8 @@ def transfer(
     also runs, before the methods that need them, the baselines sharing their learners
     (``Method.baselines``, see :func:`armtransfer.learning.methods.with_baselines`). ``mapping`` (for method ``mapping``) is a mapping or its JSON file;
     with ``save_mapping`` the file is updated from this run's converged trials.
-    ``learner_options`` are :class:`LearnerConfig` fields (``alpha``, ``epsilon``, ...).
+    ``learner_options`` are :class:`LearnerConfig` fields (``alpha``, ``epsilon``, ...), over
+    the settings of ``preset`` (``learning.presets``: ``default`` or ``paper-calibrated``).
     ``progress`` is called after every trial.
 
     ``world`` is where the robots move: ``"rooms"`` (the paper's, the default), ``"rooms11"``,
@@ -100,7 +102,7 @@ def transfer(
     """
     if not isinstance(state, str) or state not in STATES:
         raise InvalidParameterError(f"unknown state {state!r}; valid states: {', '.join(STATES)}")
-    config = LearnerConfig.from_options(learner_options)
+    config = presets.config(preset, learner_options)
     method_names = [registry.get(m).name for m in _as_sequence(methods, "methods")]
     if not method_names:
         raise InvalidParameterError(f"give at least one method; valid methods: {', '.join(registry.METHODS)}")

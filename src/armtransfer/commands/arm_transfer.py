@@ -84,7 +84,8 @@ def _fast_overrides(args: argparse.Namespace) -> dict:
     """--fast: 2 trials, convergence after 5 unchanged episodes, no controls."""
     if not args.fast:
         return {}
-    return dict({k: min(getattr(args, k), cap) for k, cap in FAST_CAPS.items()}, controls=False)
+    given = {k: getattr(args, k) for k in FAST_CAPS}  # a learner flag not given is None (the preset's value)
+    return dict({k: cap if given[k] is None else min(given[k], cap) for k, cap in FAST_CAPS.items()}, controls=False)
 
 
 def _check_fast(args: argparse.Namespace) -> None:

@@ -47,6 +47,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "every method of an installed plugin); a method's records are the same bytes either way")
     common.add_world_argument(p)
     add_executor_arguments(p)
+    common.add_preset_argument(p)
 
 
 def results_bytes(suite: suites.Suite, seed: int, ran: list[str], missing: list[str], records: list[dict],
@@ -74,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
         wanted = tuple(methods.get(m).name for m in args.method)  # a typo lists the valid names
     ran, missing = benchmark.methods_to_run(wanted)
     robots = benchmark.Robots({})
-    plan = benchmark.plan(suite, args.seed, robots, ran, missing)
+    plan = benchmark.plan(suite, args.seed, robots, ran, missing, preset=args.preset)
     from armtransfer.learning.methods import probe_on, refuse_run_time
 
     # a plugin's fault stops the run here, in one line, before its store is opened
@@ -182,7 +183,8 @@ def plan_of(store: ResultStore) -> benchmark.Plan:
         suite = suites.get(spec["suite"]["name"])
     except Exception:  # noqa: BLE001 - any malformed spec is the same one-line refusal
         raise StoreError(f"{str(store.root)!r} holds a benchmark of a suite this build does not have") from None
-    plan = benchmark.plan(suite, spec["seed"], ran=spec["methods"], missing=spec["not_in_registry"])
+    plan = benchmark.plan(suite, spec["seed"], ran=spec["methods"], missing=spec["not_in_registry"],
+                          preset=spec.get("preset", "default"))
     if content_key(plan.spec()) != store.meta.get("key"):
         raise StoreError(f"{str(store.root)!r} holds a benchmark of suite {suite.name!r} as another build defined "
                          "it (its version, methods or learner settings differ); rebuild it with that build")

@@ -114,7 +114,7 @@ def add_task_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def add_learning_arguments(p: argparse.ArgumentParser, trials: int = 10) -> None:
-    """--trials, --seed, --wind, --K and one flag per settable LearnerConfig field."""
+    """--trials, --seed, --wind, --K, --preset and one flag per settable LearnerConfig field."""
     p.add_argument("--trials", type=positive_int, default=trials, help=f"trials per method (default {trials})")
     p.add_argument("--seed", type=non_negative_int, default=0, help="random seed, an integer >= 0 (default 0)")
     p.add_argument("--wind", type=probability, default=0.0, help="wind probability (paper: 0.01; default 0)")
@@ -124,13 +124,33 @@ def add_learning_arguments(p: argparse.ArgumentParser, trials: int = 10) -> None
     add_config_arguments(p)
 
 
+def add_preset_argument(p: argparse.ArgumentParser) -> None:
+    """--preset: a named set of learner settings (``learning.presets``) that the flags override."""
+    from armtransfer.learning import presets
+
+    p.add_argument("--preset", type=preset_name, default=presets.DEFAULT, metavar="NAME",
+                   help=f"learner settings by name, which the learner's flags override: {', '.join(presets.names())} "
+                        "(default: default; paper-calibrated: fitted to the paper's no-transfer columns, "
+                        "docs/methods.md)")
+
+
+def preset_name(text: str) -> str:
+    from armtransfer.learning import presets
+
+    if text not in presets.PRESETS:
+        raise argparse.ArgumentTypeError(f"unknown preset {text!r}; valid presets: {', '.join(presets.names())}")
+    return text
+
+
 def add_config_arguments(p: argparse.ArgumentParser) -> None:
-    """One flag per LearnerConfig field, made from the field (name, type, default, help)."""
+    """--preset and one flag per LearnerConfig field, made from the field (name, type, default,
+    help). A flag not given is None, so that the preset's value (or the field's default) holds."""
+    add_preset_argument(p)
     for f in fields(LearnerConfig):
         if not f.metadata.get("cli"):
             continue
         integer = f.type in (int, "int")
-        p.add_argument(f"--{f.name.replace('_', '-')}", dest=f.name, default=f.default,
+        p.add_argument(f"--{f.name.replace('_', '-')}", dest=f.name, default=None,
                        type=positive_int if integer else finite_float,
                        help=f"{f.metadata['help']} (default {f.default:,})" if integer
                        else f"{f.metadata['help']} (default {f.default:g})")
@@ -154,8 +174,10 @@ def finite_float(text: str) -> float:
 
 
 def config_options(args: argparse.Namespace) -> dict:
-    """The LearnerConfig fields the command line set, as API keyword options."""
-    return {f.name: getattr(args, f.name) for f in fields(LearnerConfig) if f.metadata.get("cli")}
+    """The LearnerConfig fields the command line set, and its preset, as API keyword options."""
+    out = {f.name: getattr(args, f.name) for f in fields(LearnerConfig)
+           if f.metadata.get("cli") and getattr(args, f.name) is not None}
+    return {"preset": args.preset, **out}
 
 
 def transfer_kwargs(args: argparse.Namespace) -> dict:

@@ -87,6 +87,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--trajectory", choices=["learned", "optimal"], default="learned",
                    help="each source's learned path (default) or its shortest path")
     p.add_argument("--out", required=True, help="result store directory (re-running resumes)")
+    common.add_preset_argument(p)
     common.add_arm_file_arguments(p)
     add_executor_arguments(p)
 
@@ -102,7 +103,7 @@ def run(args: argparse.Namespace) -> int:
     tasks = world_tasks(args.tasks, layout)
     robots, arms = arm_file_robots(args)
     sweep = matrix.matrix_sweep(robots, tasks, args.methods, args.trials, args.seeds, args.trajectory,
-                                arms=arms, world=args.world)
+                                arms=arms, world=args.world, preset=args.preset)
     code = run_sweep(sweep, args)
     text = write_summary(ResultStore.open_existing(args.out), Path(args.out))
     print(text)

@@ -17,6 +17,7 @@ from armtransfer.experiments import beyond
 from armtransfer.experiments.reports import figures
 from armtransfer.experiments import reproduce as rep
 from armtransfer.experiments.reports import reproduce_report as rr
+from armtransfer.learning import presets
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import ActionMapping
 from armtransfer.tasks.catalog import TABLE_I
@@ -37,7 +38,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--trials", type=common.positive_int, default=30,
                    help="trials per table cell (default 30; the paper used 10)")
     p.add_argument("--seed", type=common.non_negative_int, default=0, help="random seed, >= 0 (default 0)")
-    p.add_argument("--max-total-steps", type=common.positive_int, default=LearnerConfig.max_total_steps,
+    common.add_preset_argument(p)
+    p.add_argument("--max-total-steps", type=common.positive_int, default=None,
                    help="steps per trial at most, over all its episodes; a trial that has not reached "
                         f"the goal by then counts at this cap (default {LearnerConfig.max_total_steps:,})")
     p.add_argument("--trajectory", choices=rep.TRAJECTORIES, default="learned",
@@ -100,12 +102,13 @@ def run(args: argparse.Namespace) -> int:
     common.refuse_world(args, "reproduce", "the paper's Tables I-V and figures are set in its rooms world")
     out = Path(args.out) if args.out else Path("runs") / _dt.datetime.now().strftime("reproduce-%Y%m%d-%H%M%S")
     check_output_dir(out)  # before the long run, not after
-    config = LearnerConfig(max_total_steps=args.max_total_steps)
+    config = presets.config(args.preset, {} if args.max_total_steps is None else
+                            {"max_total_steps": args.max_total_steps})
     t0 = time.perf_counter()
     with staged_directory(out) as tmp:  # out appears only complete; a second run into it is refused now
-        with common.progress_bar(rep.plan(args.trials), "reproduce") as bar:
+        with common.progress_bar(rep.plan(args.trials, args.preset), "reproduce") as bar:
             res = rep.run_all(args.trials, args.seed, config, tick=bar.update,
-                              trajectory=args.trajectory, mapping_from=args.mapping_from)
+                              trajectory=args.trajectory, mapping_from=args.mapping_from, preset=args.preset)
         _write(res, tmp)
     print(f"wrote {out / 'report.md'} ({time.perf_counter() - t0:.0f} s)")
     print(rr.table_ii_markdown(res["table_ii"], rr.paper.TABLE_II, "Table II A-C: coarse -> fine"))

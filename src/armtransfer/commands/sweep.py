@@ -6,12 +6,11 @@ import argparse
 import os
 
 from armtransfer.commands import common
-from armtransfer.experiments.execute import robot_specs
+from armtransfer.experiments.execute import learner_config, robot_specs
 from armtransfer.tasks.catalog import custom_task
 from armtransfer.parallel.executors import ExecutorError, _check_reachable, _import_ray, run_local, run_ray
 from armtransfer.tasks.specs import resolve
 from armtransfer.experiments import sweep as sweeps
-from armtransfer.learning.config import LearnerConfig
 from armtransfer.experiments.store import ResultStore
 
 HELP = "Run a grid of tasks, robots, methods and settings from a TOML file into a resumable result store."
@@ -111,7 +110,7 @@ def _check_farming_bounds(runs: list[dict], robots: dict) -> None:
             start, goal = custom_task(tuple(run["start"]), tuple(run["goal"]), robots[run["source"]].layout).cells()
             shortest[key] = trajectory.shortest(robots[run["source"]], start, goal).n
         n = max(shortest[key], 1)
-        step = LearnerConfig.from_options({k: run[k] for k in LearnerConfig.options() if k in run}).step_reward
+        step = learner_config(run).step_reward
         if step + n * float(run["K"]) >= 0:
             raise sweeps.SweepFileError(
                 f"K={run['K']:g} can be farmed for {run['method']} on {run['source']} -> {run['target']} "

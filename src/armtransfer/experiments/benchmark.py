@@ -31,6 +31,7 @@ import numpy as np
 from armtransfer.errors import ArmTransferError, InvalidTaskError
 from armtransfer.experiments import benchmark_runs, experiment, suites
 from armtransfer.learning import methods
+from armtransfer.learning import presets
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.tasks.catalog import table_task
 from armtransfer.tasks.robot import DiscreteRobot
@@ -180,11 +181,13 @@ class Pair:
     goal: tuple[int, int]
     optimal: int
     """Robot 2's shortest path, in its own steps."""
+    learner: LearnerConfig = SOURCE_CONFIG
+    """Robot 2's learner settings (a preset's; the defaults unless one is named)."""
 
     @property
     def config(self) -> LearnerConfig:
-        """Robot 2's learner: the defaults, with the section's step cap."""
-        return replace(SOURCE_CONFIG, max_total_steps=self.section.max_total_steps)
+        """Robot 2's learner: :attr:`learner`, with the section's step cap."""
+        return replace(self.learner, max_total_steps=self.section.max_total_steps)
 
     def source_run(self) -> dict:
         return benchmark_runs.source_run(self.case.source, self.case.target, list(self.start), list(self.goal),
@@ -243,6 +246,8 @@ class Plan:
     missing: tuple[str, ...]
     """The suite's methods this build's registry does not have."""
     pairs: tuple[Pair, ...]
+    preset: str = "default"
+    """The learner preset robot 2 learns with (``learning.presets``)."""
 
     @property
     def name(self) -> str:
@@ -250,9 +255,12 @@ class Plan:
 
     def spec(self) -> dict:
         """What the store holding this plan's runs is for (its key is a hash of it)."""
-        return {"benchmark": {"suite": self.suite.to_dict(), "seed": self.seed, "methods": list(self.methods),
-                              "not_in_registry": list(self.missing), "formats": list(benchmark_runs.FORMATS),
-                              "source_config": SOURCE_CONFIG.to_dict()}}
+        spec = {"suite": self.suite.to_dict(), "seed": self.seed, "methods": list(self.methods),
+                "not_in_registry": list(self.missing), "formats": list(benchmark_runs.FORMATS),
+                "source_config": SOURCE_CONFIG.to_dict()}
+        if self.preset != "default":  # the default's store keeps the key it had before presets
+            spec["preset"] = self.preset
+        return {"benchmark": spec}
 
     def size(self) -> int:
         """Runs in all: a source run and every method's trials per pair."""
@@ -299,10 +307,12 @@ class Plan:
 
 
 def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
-         ran: Sequence[str] | None = None, missing: Sequence[str] = ()) -> Plan:
+         ran: Sequence[str] | None = None, missing: Sequence[str] = (), preset: str = "default") -> Plan:
     """Every pair of ``suite`` for ``seed``, its task's cells drawn and checked for both robots
     (an error names the case before anything runs); ``ran``: the methods (default
-    :func:`methods_to_run`'s)."""
+    :func:`methods_to_run`'s); robot 2 learns with the settings of ``preset`` (robot 1 always
+    with the defaults)."""
+    learner = presets.config(preset)
     if ran is None:
         ran, missing = methods_to_run()
     robots = robots if robots is not None else Robots({})
@@ -317,18 +327,18 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
                 if path is None:
                     raise InvalidTaskError(f"{case.label}: {target.name} cannot reach the goal")
                 pairs.append(Pair(section, ci, case, j, run_seed(seed, section.name, ci, j), target.layout.xy(start),
-                                  target.layout.xy(goal), len(path) - 1))
-    return Plan(suite, int(seed), tuple(ran), tuple(missing), tuple(pairs))
+                                  target.layout.xy(goal), len(path) - 1, learner))
+    return Plan(suite, int(seed), tuple(ran), tuple(missing), tuple(pairs), preset)
 
 
 def run_suite(suite: suites.Suite, seed: int = 0, tick: Callable[[], None] | None = None,
-              threads: int | None = None) -> tuple[list[dict], dict]:
+              threads: int | None = None, preset: str = "default") -> tuple[list[dict], dict]:
     """Every run of ``suite``, in this process: (records, one per (section, case, source seed,
     method), and the seconds of the runs, kept apart so that the records depend on ``seed``
     alone). A pair's trial runs share ``threads`` threads (None: one per CPU); ``tick`` is
-    called once per trial."""
+    called once per trial. Robot 2 learns with the settings of ``preset`` (``learning.presets``)."""
     robots = Robots({})
-    p = plan(suite, seed, robots)
+    p = plan(suite, seed, robots, preset=preset)
     results: dict[str, dict] = {}
     seconds: dict[str, float] = {}
     for pair in p.pairs:

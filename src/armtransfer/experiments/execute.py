@@ -11,14 +11,15 @@ import time
 
 from armtransfer.tasks.catalog import custom_task
 from armtransfer.tasks.robot import DiscreteRobot
-from armtransfer.learning import methods
+from armtransfer.learning import methods, presets
 from armtransfer.experiments import experiment
 from armtransfer.learning.config import LearnerConfig
 
 
 def learner_config(run: dict) -> LearnerConfig:
-    """The learner settings a sweep run carries (every LearnerConfig field it names)."""
-    return LearnerConfig.from_options({k: run[k] for k in LearnerConfig.options() if k in run})
+    """The learner settings a sweep run carries (every LearnerConfig field it names, over its preset)."""
+    return presets.config(run.get("preset", presets.DEFAULT),
+                          {k: run[k] for k in LearnerConfig.options() if k in run})
 
 
 def robot_specs(runs: list[dict]) -> list[str]:

@@ -52,10 +52,11 @@ def family(spec: str) -> str:
 
 def matrix_spec(robots: Sequence[str], tasks: Sequence[int | str], methods: Sequence[str], trials: int,
                 seeds: Sequence[int] = (0,), trajectory: str = "learned", name: str = "matrix",
-                arms: dict | None = None, world: str | None = None) -> dict:
+                arms: dict | None = None, world: str | None = None, preset: str = "default") -> dict:
     """The sweep of every ordered pair of ``robots`` (each robot to itself too); ``arms`` names
     bring-your-own arms as a sweep file's ``[arms.NAME]`` tables do (``NAME[:ACTIONS]`` robots);
-    ``world`` is the sweep's world (the paper's rooms when None)."""
+    ``world`` is the sweep's world (the paper's rooms when None); ``preset`` the learner's
+    settings (``learning.presets``)."""
     robots = list(robots)
     if len(robots) < 2:
         raise InvalidParameterError("a matrix needs at least two robots")
@@ -66,6 +67,8 @@ def matrix_spec(robots: Sequence[str], tasks: Sequence[int | str], methods: Sequ
         raise InvalidParameterError("a matrix needs a transfer method beside 'none'")
     raw = {"sweep": {"name": name, "tasks": list(tasks), "pairs": [[s, t] for s in robots for t in robots],
                      "methods": methods, "seeds": list(seeds), "trials": trials, "trajectory": trajectory}}
+    if preset != "default":  # the default's spec (and its store's key) is the one it was before presets
+        raw["sweep"]["preset"] = preset
     if arms:
         raw["arms"] = arms
     if world is not None:
@@ -75,8 +78,8 @@ def matrix_spec(robots: Sequence[str], tasks: Sequence[int | str], methods: Sequ
 
 def matrix_sweep(robots: Sequence[str], tasks: Sequence[int | str], methods: Sequence[str], trials: int,
                  seeds: Sequence[int] = (0,), trajectory: str = "learned", name: str = "matrix",
-                 arms: dict | None = None, world: str | None = None) -> sweeps.Sweep:
-    spec = matrix_spec(robots, tasks, methods, trials, seeds, trajectory, name, arms, world)
+                 arms: dict | None = None, world: str | None = None, preset: str = "default") -> sweeps.Sweep:
+    spec = matrix_spec(robots, tasks, methods, trials, seeds, trajectory, name, arms, world, preset)
     return sweeps.Sweep(spec["name"], spec, tuple(sweeps.expand(spec)))
 
 

@@ -27,9 +27,10 @@ from collections.abc import Callable
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.worlds.layout import ROOMS
-from armtransfer.experiments import beyond, experiment, paper
+from armtransfer.experiments import beyond, calibrated, experiment, paper
 from armtransfer.experiments.stats import metrics
 from armtransfer.learning.mapping import ActionMapping, MacroTable
+from armtransfer.learning import presets
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.errors import InvalidParameterError
@@ -82,11 +83,12 @@ def _compare(
     }
 
 
-def plan(trials: int) -> int:
+def plan(trials: int, preset: str = presets.DEFAULT) -> int:
     """How many trials ``run_all`` runs (for progress bars)."""
     main = 2 * len(TASKS) * 3 + len(paper.TABLE_IV_WAYPOINTS) + 1 + 3 * len(TASKS)
     alternatives = len(TASKS) + len(TASKS)  # pseudo with the other trajectory; the other mapping
-    return trials * (main + alternatives) + beyond.plan(trials)
+    study = calibrated.plan(trials) if preset == presets.PAPER_CALIBRATED else 0
+    return trials * (main + alternatives) + beyond.plan(trials) + study
 
 
 TOP_ENTRIES = 12
@@ -168,13 +170,17 @@ def _improve(r: dict, base: dict) -> None:
 
 def run_all(
     trials: int, seed: int, config: LearnerConfig, tick: Callable[[], None] | None = None,
-    trajectory: str = "learned", mapping_from: str = "single",
+    trajectory: str = "learned", mapping_from: str = "single", preset: str = presets.DEFAULT,
 ) -> dict:
+    """Everything the report needs, with the learner ``config``; ``preset`` names the preset it
+    came from, and with ``paper-calibrated`` the calibrated learner's prediction and ablation
+    (``experiments.calibrated``) run too."""
+    presets.check(preset)
     if trajectory not in TRAJECTORIES:
         raise InvalidParameterError(f"unknown trajectory kind {trajectory!r}; valid: {', '.join(TRAJECTORIES)}")
     if mapping_from not in MAPPING_FROM:
         raise InvalidParameterError(f"unknown mapping source {mapping_from!r}; valid: {', '.join(MAPPING_FROM)}")
-    out: dict = {"trials": trials, "seed": seed, "config": config.to_dict(),
+    out: dict = {"trials": trials, "seed": seed, "config": config.to_dict(), "preset": preset,
                  "trajectory": trajectory, "mapping_from": mapping_from}
     both = ("none", "pseudo")
     kw: dict[str, Any] = dict(tick=tick, kind=trajectory)
@@ -219,6 +225,8 @@ def run_all(
     fine = grid_robot("fine")
     out["methods"] = beyond.run_methods(coarse, fine, trials, seed, config, tick=tick)
     out["oracle_text"], out["oracle"] = beyond.oracle_markdown(coarse, fine, trials, seed, config)
+    if preset == presets.PAPER_CALIBRATED:
+        out["calibrated"] = calibrated.run_study(config, trials, seed, tick=tick)
     return out
 
 

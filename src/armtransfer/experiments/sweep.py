@@ -57,6 +57,7 @@ from armtransfer.errors import ArmTransferError
 from armtransfer.io import read_input
 from armtransfer.tasks.arms import ARM_NAME, ARM_NAME_FORM
 from armtransfer.learning import methods as _methods
+from armtransfer.learning import presets as _presets
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.lazy_registry import Names
 
@@ -80,7 +81,9 @@ _AXES: dict[str, list] = {
     "wind": [0.0],
 }
 _SCALARS = {"name": "sweep", "trials": 10, "trajectory": "optimal", "patience": LearnerConfig.patience,
-            "max_episodes": LearnerConfig.max_episodes}
+            "max_episodes": LearnerConfig.max_episodes, "preset": _presets.DEFAULT}
+_FROM_PRESET = ("epsilon", "lam", "alpha", "gamma", "patience", "max_episodes")
+"""The keys whose default is the preset's value when the sweep names a preset."""
 
 
 class SweepFileError(ArmTransferError):
@@ -210,10 +213,16 @@ def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, ba
         if key not in _AXES and key not in _SCALARS and key != "world":
             raise SweepFileError(f"{where}: unknown key {key!r}; valid keys: {', '.join(valid)}")
     spec: dict = {}
+    preset = body.get("preset", _presets.DEFAULT)
+    if not isinstance(preset, str) or preset not in _presets.PRESETS:
+        raise SweepFileError(f"{where}: unknown preset {preset!r}; valid presets: {', '.join(_presets.names())}")
+    chosen = _presets.values(preset)
     for key, default in _SCALARS.items():
-        spec[key] = body.get(key, default)
+        spec[key] = body.get(key, chosen[key] if key in _FROM_PRESET else default)
     for key, default in _AXES.items():
-        spec[key] = _as_list(key, body[key]) if key in body else list(default)
+        spec[key] = _as_list(key, body[key]) if key in body else ([chosen[key]] if key in _FROM_PRESET else list(default))
+    if preset == _presets.DEFAULT:
+        del spec["preset"]  # a sweep without a preset keeps the spec (and its store's key) it had before presets
     w = where
     if not isinstance(spec["name"], str) or not spec["name"]:
         raise SweepFileError(f"{w}: name must be a non-empty string")
@@ -353,6 +362,8 @@ def expand(spec: dict) -> list[dict]:
             "patience": spec["patience"],
             "max_episodes": spec["max_episodes"],
         }
+        if "preset" in spec:  # its other settings (rewards, caps) come from the preset (execute.learner_config)
+            run["preset"] = spec["preset"]
         used = {p.partition(":")[0] for p in pair} & set(spec.get("arms", {}))
         if used:  # a named arm's definition is part of the run (and of its key)
             run["arms"] = {name: spec["arms"][name] for name in sorted(used)}

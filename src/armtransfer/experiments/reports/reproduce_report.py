@@ -10,6 +10,7 @@ from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.worlds.layout import ROOMS
 from armtransfer.experiments import beyond, paper
 from armtransfer.learning.mapping import ActionMapping
+from armtransfer.experiments.reports import calibrated_report
 from armtransfer.experiments.reports.report import fmt_ci, fmt_mean, fmt_num, markdown_table
 
 TASKS = (1, 2, 3, 4)
@@ -458,7 +459,7 @@ def report_markdown(res: dict, figures: dict[str, str]) -> str:
         "ratio of means, on paired trials (all methods share the random stream of trial i: common random "
         "numbers).",
         "",
-        f"Learner: SARSA(lambda), alpha {cfg['alpha']}, gamma {cfg['gamma']}, lambda {cfg['lam']}, "
+        f"Learner{' (preset ' + res['preset'] + ')' if res.get('preset', 'default') != 'default' else ''}: SARSA(lambda), alpha {cfg['alpha']}, gamma {cfg['gamma']}, lambda {cfg['lam']}, "
         f"epsilon {cfg['epsilon']}, step reward {cfg['step_reward']}, goal reward {cfg['goal_reward']}, "
         f"Q = 0 initially. K = 'auto' (half the farming bound -step_reward/n): "
         f"{', '.join(f'{k:g}' for k in ks) if ks else 'n/a'} in this run. Transferred trajectory: "
@@ -523,5 +524,6 @@ def report_markdown(res: dict, figures: dict[str, str]) -> str:
         "## Where we differ from the paper, and why",
         "",
         *differences_markdown(res),
+        *(["", *calibrated_report.section_markdown(res)] if "calibrated" in res else []),
     ]
     return "\n".join(lines) + "\n"
