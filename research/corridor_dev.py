@@ -11,7 +11,7 @@ method name, or ``corridor:R:F[:C]`` / ``corridor-plan:R:F[:C]``: ``guided`` / `
 with the planner's untried optimism fading by F per cell beyond R cells of the trajectory and by C per
 cell of trajectory left (``guide.corridor_prior``). The factor of a (case, seed) pair is plan's median steps to
 convergence over the variant's (unconverged trials count at the cap); reported as the geometric
-mean over pairs and the worst pair.
+mean over pairs with a 95% percentile bootstrap interval over the pairs, and the worst pair.
 
 Writes ``DIR/corridor_dev.json`` and prints a table.
 """
@@ -92,13 +92,18 @@ def main(argv: list[str] | None = None) -> int:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "corridor_dev.json").write_text(json.dumps(rows, indent=1) + "\n")
-    print("| variant | geo. mean factor vs plan | worst pair | converged | median greedy / optimal |")
+    print("| variant | geo. mean factor vs plan [95% bootstrap over pairs] | worst pair | converged | "
+          "median greedy / optimal |")
+    boot = np.random.default_rng(0)
     for v in variants:
         f = [np.median(r["methods"]["plan"]["convergence"]) / np.median(r["methods"][v]["convergence"]) for r in rows]
+        logs = np.log(f)
+        means = logs[boot.integers(0, len(logs), (2000, len(logs)))].mean(axis=1)
+        lo, hi = np.exp(np.percentile(means, [2.5, 97.5]))
         conv = sum(sum(r["methods"][v]["converged"]) for r in rows)
         n = sum(len(r["methods"][v]["converged"]) for r in rows)
         g = [x / r["optimal"] for r in rows for x in r["methods"][v]["greedy"] if x is not None]
-        print(f"| {v} | {np.exp(np.mean(np.log(f))):.2f}x | {min(f):.2f}x | {conv}/{n} | "
+        print(f"| {v} | {np.exp(logs.mean()):.2f}x [{lo:.2f}, {hi:.2f}] | {min(f):.2f}x | {conv}/{n} | "
               f"{np.median(g) if g else float('nan'):.2f} |")
     return 0
 
