@@ -70,6 +70,23 @@ def _guided(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float
     return Shaping(modes.MODE_NONE, np.zeros(n), ids, np.zeros(n), k, guide=guide.build(robot, trajs))
 
 
+CORRIDOR_RADIUS = 1.5
+"""``corridor``: cells from the trajectory within which an untried move keeps its full optimism."""
+CORRIDOR_FADE = 50.0
+"""``corridor``: optimism lost per cell beyond CORRIDOR_RADIUS, in units of Q."""
+CORRIDOR_ROUTE = 1.0
+"""``corridor``: optimism lost per cell of trajectory left from the nearest trajectory cell, in
+units of Q. The three were chosen on the dev suite by research/corridor_dev.py
+(docs/research-log.md, "a transfer that pays for the whole of learning")."""
+
+
+def _corridor(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
+    # guided, and after its first episode the planner's optimism for untried moves follows the route
+    sh = _guided(robot, trajs, k, beta)
+    return replace(sh, guide=guide.build(robot, trajs, radius=CORRIDOR_RADIUS, fade=CORRIDOR_FADE,
+                                         route=CORRIDOR_ROUTE))
+
+
 def planner_guide(robot: DiscreteRobot) -> guide.Guide:
     """``guided``'s learner told nothing: the same model of robot 2's own moves (a move tried
     here and blocked every time is never chosen, a move tried nowhere yet is tried first), the
@@ -140,6 +157,9 @@ _BUILTIN: dict[str, Method] = {
                "joints: where its tip is) and, until the goal is first reached, prefers those predicted to lead on along "
                "the trajectory; after every episode it plans over the moves it has tried",
                paper=False, build=_guided, auto_k=0.0, chooses=True, baselines=("plan", "goal-only")),
+        Method("corridor", "guided, and after every episode it plans with the optimism of an untried move fading "
+               "with its distance from the trajectory and with the trajectory left to the goal",
+               paper=False, build=_corridor, auto_k=0.0, chooses=True, baselines=("plan",)),
         Method("plan", "guided's learner with no transfer: its model of its own moves and its planning after every "
                "episode, no trajectory", paper=False, build=_plan, auto_k=0.0, chooses=True, is_baseline=True,
                uses_trajectory=False),

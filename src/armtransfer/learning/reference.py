@@ -307,7 +307,7 @@ class Planner:
         for x in range(n_states):
             for a in range(n_actions):
                 if (x, a) not in self.successors:
-                    Q[x, a] = guide_module.UNTRIED
+                    Q[x, a] = self.g.untried[x]  # UNTRIED, or less away from the route (corridor_prior)
         v = [float(Q[x].max()) for x in range(n_states)]
         queue = deque(sorted({s for s, _ in self.successors}))
         queued = set(queue)

@@ -32,17 +32,17 @@ from pathlib import Path
 
 from armtransfer.learning import jitcache
 from armtransfer.learning.guide import choice, displacement, fill, model, planner, progress, tip
-from armtransfer.learning.guide.model import Guide, Model, build, inactive, new_model
+from armtransfer.learning.guide.model import Guide, Model, build, corridor_prior, inactive, new_model
 from armtransfer.learning.guide.params import (
-    BLOCKED, EPISODES, FILL, FILL_COST, GIVE_UP, KNN, MEMORY, PLAN, PLAN_CAP, PLAN_TOL, REACH, SUCCESSORS, TIP,
+    BLOCKED, EPISODES, FADE, FILL, FILL_COST, GIVE_UP, KNN, MEMORY, PLAN, PLAN_CAP, PLAN_TOL, RADIUS, REACH, ROUTE, SUCCESSORS, TIP,
     TIP_ANCHOR, TIP_NEAREST, TIP_ORDER, TIP_RIDGE, UNTRIED, WEIGHT, WINDOW, Params,
 )
 from armtransfer.learning.guide.tip import tip_features, uses_tip
 
 __all__ = [
-    "BLOCKED", "EPISODES", "FILL", "FILL_COST", "GIVE_UP", "KNN", "MEMORY", "PLAN", "PLAN_CAP", "PLAN_TOL", "REACH",
+    "BLOCKED", "EPISODES", "FADE", "FILL", "FILL_COST", "GIVE_UP", "KNN", "MEMORY", "PLAN", "PLAN_CAP", "PLAN_TOL", "RADIUS", "REACH", "ROUTE",
     "SUCCESSORS", "TIP", "TIP_ANCHOR", "TIP_NEAREST", "TIP_ORDER", "TIP_RIDGE", "UNTRIED", "WEIGHT", "WINDOW",
-    "FILES", "Guide", "Model", "Params", "build", "inactive", "new_model", "tip_features", "uses_tip",
+    "FILES", "Guide", "Model", "Params", "build", "corridor_prior", "inactive", "new_model", "tip_features", "uses_tip",
 ]
 
 FILES = sorted(Path(__file__).parent.glob("*.py"))

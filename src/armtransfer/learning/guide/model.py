@@ -17,8 +17,8 @@ from armtransfer.learning.guide.planner import Planner
 from armtransfer.learning.guide.progress import Progress
 from armtransfer.learning.guide.tip import TipModel, tip_features, uses_tip
 from armtransfer.learning.guide.params import (
-    BLOCKED, EPISODES, FILL, FILL_COST, GIVE_UP, KNN, MEMORY, PLAN, PLAN_TOL, REACH, TIP, TIP_ANCHOR, TIP_NEAREST,
-    TIP_ORDER, TIP_RIDGE, WEIGHT, WINDOW, Params,
+    BLOCKED, EPISODES, FADE, FILL, FILL_COST, GIVE_UP, KNN, MEMORY, PLAN, PLAN_TOL, RADIUS, REACH, ROUTE, TIP, TIP_ANCHOR, TIP_NEAREST,
+    TIP_ORDER, TIP_RIDGE, UNTRIED, WEIGHT, WINDOW, Params,
 )
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.robot import DiscreteRobot
@@ -46,6 +46,9 @@ class Guide(NamedTuple):
     """int64 [F, TIP_ORDER]: the joints (columns of tq) each tip feature multiplies, -1 past its last."""
     fk: np.ndarray
     """int64 [F, TIP_ORDER]: 0 for the cosine of that joint, 1 for its sine."""
+    untried: np.ndarray
+    """float64 [S]: the planned Q of a pair never tried at each state (``planner.plan``): UNTRIED
+    everywhere, or less away from the trajectories (``corridor_prior``)."""
 
 
 class Model(NamedTuple):
@@ -62,9 +65,13 @@ def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW,
           knn: int = KNN, memory: int = MEMORY, weight: float = WEIGHT, episodes: int = EPISODES,
           blocked: bool = BLOCKED, give_up: int = GIVE_UP, plan: bool = PLAN, tip: bool | None = TIP,
           tip_ridge: float = TIP_RIDGE, tip_nearest: int = TIP_NEAREST, tip_anchor: bool = TIP_ANCHOR,
-          fill: float | None = FILL) -> Guide:
+          fill: float | None = FILL, radius: float = RADIUS, fade: float = FADE,
+          route: float = ROUTE) -> Guide:
     """The guide for ``robot`` following ``trajs`` (one or several). ``tip`` None: the tip
-    model for robots whose actions move a joint (``uses_tip``)."""
+    model for robots whose actions move a joint (``uses_tip``). ``fade`` > 0: the optimism
+    of an untried pair fades by ``fade`` per cell its state's label lies beyond ``radius`` cells
+    from the trajectories' cells, and by ``route`` per cell of trajectory left from the nearest
+    cell (``corridor_prior``)."""
     for name, v in (("window", window), ("reach", reach), ("weight", weight)):
         if not (np.isfinite(v) and v >= 0):
             raise InvalidParameterError(f"{name} must be a non-negative number, got {v}")
@@ -76,6 +83,8 @@ def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW,
         raise InvalidParameterError(f"tip_ridge must be a positive number, got {tip_ridge}")
     if int(tip_nearest) < 1:
         raise InvalidParameterError(f"tip_nearest must be a positive integer, got {tip_nearest}")
+    if not (np.isfinite(fade) and fade >= 0 and np.isfinite(route) and route >= 0) or not (radius >= 0):
+        raise InvalidParameterError(f"fade, route and radius must be non-negative numbers, got {fade}, {route}, {radius}")
     if fill is not None and not (np.isfinite(fill) and fill >= 0):
         raise InvalidParameterError(f"fill must be a non-negative number of cells, got {fill}")
     layout = robot.layout
@@ -105,10 +114,37 @@ def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW,
                     plan_tol=PLAN_TOL, tip=use_tip, tip_ridge=float(tip_ridge), tip_nearest=int(tip_nearest),
                     tip_anchor=bool(tip_anchor),
                     fill=(FILL_COST if use_tip else 0.0) if fill is None else float(fill))
+    tx, ty, trem = np.concatenate(xs), np.concatenate(ys), np.concatenate(rem)
     return Guide(feat=np.ascontiguousarray(feat), lxy=np.ascontiguousarray(lxy),
-                 tx=np.concatenate(xs), ty=np.concatenate(ys), trem=np.concatenate(rem),
+                 tx=tx, ty=ty, trem=trem,
                  tstart=np.array(starts, np.int64), params=params,
-                 tq=np.ascontiguousarray(tq, dtype=np.float64), fj=fj, fk=fk)
+                 tq=np.ascontiguousarray(tq, dtype=np.float64), fj=fj, fk=fk,
+                 untried=corridor_prior(lxy, tx, ty, trem, radius, fade, route))
+
+
+def corridor_prior(lxy: np.ndarray, tx: np.ndarray, ty: np.ndarray, trem: np.ndarray, radius: float, fade: float,
+                   route: float = 0.0) -> np.ndarray:
+    """float64 [S]: the planned Q of an untried pair at each state, UNTRIED minus ``fade`` per
+    cell its label ``lxy`` lies beyond ``radius`` cells from the nearest trajectory cell (tx, ty,
+    the goals s_tg included), minus ``route`` per cell of trajectory left from that cell (trem).
+    The planner then leads to untried pairs along the route before those away from it, and to
+    one ``d`` cells off it only when that could save more than about fade * (d - radius) steps.
+    Reads the trajectories' cells and robot 2's labels only: no map, nothing about the task
+    beyond the trajectories. ``fade`` and ``route`` 0: UNTRIED everywhere (``plan``, ``guided``)."""
+    out = np.full(len(lxy), UNTRIED)
+    if (fade > 0.0 or route > 0.0) and len(lxy) and len(tx):
+        d = np.full(len(lxy), np.inf)
+        left = np.zeros(len(lxy))
+        for j in range(len(tx)):  # one trajectory cell at a time: an arm has up to 1e6 states
+            dj = np.sqrt((lxy[:, 0] - tx[j]) ** 2 + (lxy[:, 1] - ty[j]) ** 2)
+            closer = dj < d
+            d[closer] = dj[closer]
+            left[closer] = trem[j]
+        if fade > 0.0:
+            out -= fade * np.maximum(d - radius, 0.0)
+        if route > 0.0:
+            out -= route * left
+    return out
 
 
 def new_model(g: Guide, n_states: int, n_actions: int) -> Model:
@@ -127,7 +163,8 @@ def inactive(n_actions: int) -> tuple[Guide, Model]:
     params = Params(window=0.0, reach=0.0, knn=1, memory=1, weight=0.0, episodes=0, blocked=False, give_up=0,
                     plan=False, plan_tol=0.0, tip=False, tip_ridge=1.0, tip_nearest=1, tip_anchor=False, fill=0.0)
     g = Guide(np.zeros((0, 1)), np.zeros((0, 2)), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(1, np.int64),
-              params, np.zeros((0, 1)), np.zeros((0, TIP_ORDER), np.int64), np.zeros((0, TIP_ORDER), np.int64))
+              params, np.zeros((0, 1)), np.zeros((0, TIP_ORDER), np.int64), np.zeros((0, TIP_ORDER), np.int64),
+              np.zeros(0))
     return g, new_model(g, 0, n_actions)
 
 

@@ -30,6 +30,15 @@ PLAN_CAP = 1000
 """Backups per planning at most, in robot 2's number of states (a guard: gamma = 1 can loop); not tuned."""
 UNTRIED = 1e-9
 """The planned Q of an untried pair: just above 0, the bound on every return, so it wins ties; not tuned."""
+RADIUS = 0.0
+"""Cells from the trajectories within which an untried pair keeps the full optimism UNTRIED
+(``model.corridor_prior``); only read when FADE > 0."""
+FADE = 0.0
+"""Optimism lost per cell beyond RADIUS, in units of Q (0: none, ``plan`` and ``guided``); the
+method ``corridor`` sets its own, chosen on the dev suite (docs/research-log.md)."""
+ROUTE = 0.0
+"""Optimism lost per cell of trajectory left beyond the nearest trajectory cell, in units of Q (0:
+none); ``model.corridor_prior``."""
 SUCCESSORS = 4
 """Distinct observed successors kept per pair (a move and its wind push are at most 2); not tuned."""
 TIP = None

@@ -17,7 +17,7 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-from armtransfer.learning.guide.params import PLAN_CAP, SUCCESSORS, UNTRIED
+from armtransfer.learning.guide.params import PLAN_CAP, SUCCESSORS
 
 
 class Planner(NamedTuple):
@@ -97,7 +97,8 @@ def plan(g, pl, Q, label, goal, gamma, r_step, r_goal):
     """Value iteration over the pairs robot 2 has tried, on what it observed of them, after an
     episode: Q(s, a) = sum over the observed successors s' of (count / tries) * (r + gamma V(s')),
     r = r_step (+ r_goal when s' is labelled the goal, where V = 0), V(s') = max over a' of
-    Q(s', a'). A pair never tried gets Q = UNTRIED. Returns the number of backups.
+    Q(s', a'). A pair never tried at x gets Q = g.untried[x] (UNTRIED, or less away from the
+    trajectories: ``model.corridor_prior``). Returns the number of backups.
 
     Order: every state with a tried pair, in index order, is queued; a state taken from the
     front of the queue gets its tried pairs (in action order) backed up from the planned values
@@ -111,7 +112,7 @@ def plan(g, pl, Q, label, goal, gamma, r_step, r_goal):
     for x in range(n_states):
         for a in range(n_actions):
             if nsucc[x * n_actions + a] == 0:
-                Q[x, a] = UNTRIED
+                Q[x, a] = g.untried[x]
         best = Q[x, 0]
         for a in range(1, n_actions):
             if Q[x, a] > best:
