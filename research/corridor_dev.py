@@ -18,13 +18,13 @@ Writes ``DIR/corridor_dev.json`` and prints a table.
 
 from __future__ import annotations
 
-import argparse
 import json
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
+from armtransfer import script
 from armtransfer.experiments import benchmark, experiment, suites
 from armtransfer.learning import guide, methods, sarsa
 from armtransfer.learning.shaping import MODE_NONE, Shaping
@@ -54,7 +54,7 @@ def shaping_of(variant: str, robot, traj: Trajectory, config):
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = script.parser(__doc__)
     p.add_argument("--out", required=True)
     p.add_argument("--seeds", type=int, default=2)
     p.add_argument("--first-seed", type=int, default=0, help="the first source seed (a check on seeds not chosen on)")
@@ -109,4 +109,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    script.exit_with(main)

@@ -14,10 +14,10 @@ both is a tie and left out), and the worst trial's first-exposure factor.
 
 from __future__ import annotations
 
-import argparse
 import math
 from dataclasses import replace
 
+from armtransfer import script
 from armtransfer.experiments import benchmark, experiment, suites
 from armtransfer.learning import guide, methods
 from armtransfer.learning.shaping import Shaping
@@ -58,7 +58,7 @@ def builder(variant: str):
 
 
 def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = script.parser(__doc__)
     p.add_argument("--seeds", type=int, default=4)
     p.add_argument("--trials", type=int, default=2)
     p.add_argument("--cases", type=int, nargs="*", default=None)
@@ -104,4 +104,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    script.exit_with(main)

@@ -18,13 +18,13 @@ Writes ``DIR/whole_cost.json`` and prints a table.
 
 from __future__ import annotations
 
-import argparse
 import json
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
+from armtransfer import script
 from armtransfer.experiments import experiment
 from armtransfer.learning import methods, sarsa
 from armtransfer.learning.config import LearnerConfig
@@ -103,7 +103,7 @@ def run_case(source_spec, target_spec, task, names, trials, seed, config) -> dic
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p = script.parser(__doc__)
     p.add_argument("--out", required=True)
     p.add_argument("--trials", type=int, default=5)
     p.add_argument("--seed", type=int, default=8123)
@@ -132,4 +132,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    script.exit_with(main)

@@ -95,7 +95,7 @@ def test_goal_only_is_at_least_as_fast_as_plan_on_every_case(fast_runs):
     """Knowing the goal never hurts: on every case of the fast suite `goal-only` reaches the goal
     first at least as fast as `plan` (told nothing), on every source seed."""
     root, _ = fast_runs
-    data = json.loads((root / "a" / "results.json").read_text())
+    data = json.loads((root / "one" / "results.json").read_text())
     for section in data["summary"].values():
         for case in section["cases"]:
             fe = case["methods"]["goal-only"]["against"]["plan"]["first_exposure"]

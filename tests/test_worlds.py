@@ -212,7 +212,7 @@ def test_arm_env_takes_an_arm_file_on_a_world():
     from armtransfer.models import ARMS
 
     env = gym.make("armtransfer/ArmRooms-v0", xml_path=str(ARMS["planar2"].xml_path), actions="cartesian",
-                   base_pos=(-0.03, 0.03, 0.0), world="rooms11", task=3)
+                   base_pos=(-0.03, 0.03, 0.0), arm_name="my_planar2", world="rooms11", task=3)
     robot = env.unwrapped.robot
     assert robot.layout.name == "rooms11" and robot.arm.kind == "custom"
     _, info = env.reset(seed=0)

@@ -286,30 +286,37 @@ def check_stored(spec: object, where: str) -> dict:
     form; else ``SweepFileError``, one line naming ``where`` and the field."""
     if not isinstance(spec, dict):
         raise SweepFileError(f"{where}: field 'spec' " + ("is missing" if spec is None else f"must be a table, got {type(spec).__name__}"))
-    keys = {*_SCALARS, *_AXES, "arms"}
+    optional = {"world", "preset"}  # written only when not the default (the default keeps the old key)
+    keys = {*_SCALARS, *_AXES, "arms"} - optional
     for key in sorted(keys - set(spec)):
         raise SweepFileError(f"{where}: field 'spec' has no {key!r}")
-    for key in sorted(set(spec) - keys - {"world"}, key=str):
+    for key in sorted(set(spec) - keys - optional, key=str):
         raise SweepFileError(f"{where}: field 'spec' has an unknown key {key!r}; valid keys: "
-                             f"{', '.join(sorted(keys | {'world'}))}")
-    if spec.get("world") is not None:  # stored as the layout's data; a sweep file names it
-        try:
-            layout_of_data(spec["world"], f"{where}: field 'spec': world")
-        except ArmTransferError as err:
-            raise SweepFileError(str(err)) from None
-    body = {k: v for k, v in spec.items() if k not in ("arms", "world")}
+                             f"{', '.join(sorted(keys | optional))}")
+    body = {k: v for k, v in spec.items() if k != "arms"}  # a world is stored as its layout's data
     if isinstance(spec["start_goal"], list):  # stored as cells; a sweep file writes "X,Y"
         body["start_goal"] = [[f"{c[0]},{c[1]}" if isinstance(c, list) and len(c) == 2 else c for c in sg]
                               if isinstance(sg, list) else sg for sg in spec["start_goal"]]
     again = normalise({"sweep": body, "arms": spec["arms"]}, f"{where}: field 'spec'", max_runs=2**62)
+    for key in sorted(optional & set(spec)):
+        if json.dumps(again.get(key)) != json.dumps(spec[key]):
+            raise SweepFileError(f"{where}: field 'spec': {key} is not as a sweep writes it ({spec[key]!r:.80})")
     for key in sorted(keys):
         if again[key] != spec[key] or json.dumps(again[key]) != json.dumps(spec[key]):
             raise SweepFileError(f"{where}: field 'spec': {key} is not as a sweep writes it ({spec[key]!r:.80})")
     return spec
+
+
 def _world(given: object, where: str, base: Path | None):
     """The sweep's world (``world = ...``), or None for the paper's rooms (its runs name none)."""
     if given is None:
         return None
+    if isinstance(given, dict):  # a store's sweep.json holds the layout's own data
+        try:
+            layout = layout_of_data(given, f"{where}: world")
+        except ArmTransferError as err:
+            raise SweepFileError(str(err)) from None
+        return None if is_default(layout) else layout
     if not isinstance(given, str) or not given.strip():
         raise SweepFileError(f"{where}: world must be a world's name or a layout file, got {given!r}")
     if base is not None and given.lower().endswith((".toml", ".json")) and not os.path.isabs(given):
