@@ -169,6 +169,6 @@ def test_wheel_installs_only_the_armtransfer_namespace(wheel):
     names = zipfile.ZipFile(wheel).namelist()
     top = {n.split("/")[0] for n in names}
     assert {t for t in top if not t.endswith(".dist-info")} == {"armtransfer"}
-    for module in ("learning/sarsa.py", "ik/compile.py", "tasks/layout.py", "models/planar2/planar2.xml",
+    for module in ("learning/sarsa.py", "ik/compile.py", "worlds/layout.py", "models/planar2/planar2.xml",
                    "commands/rooms.py"):
         assert "armtransfer/" + module in names
