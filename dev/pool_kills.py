@@ -37,6 +37,9 @@ from collections import deque
 from collections.abc import Callable
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from contract import cmdline, session, settle  # noqa: E402  the kill tests' own helpers
+
 HERE = Path(__file__).resolve().parent
 BACKENDS = ("ours", "loky", "loky-per-task")
 """Our pool; loky with the robots given once per worker (its initializer's arguments); loky with
@@ -197,36 +200,6 @@ def _stat(pid: int) -> list[str] | None:
         return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
     except OSError:
         return None
-
-
-def session(sid: int) -> list[int]:
-    out = []
-    for entry in Path("/proc").glob("[0-9]*"):
-        fields = _stat(int(entry.name))
-        if fields and int(fields[3]) == sid and fields[0] != "Z":
-            out.append(int(entry.name))
-    return out
-
-
-def cmdline(pid: int) -> bytes:
-    try:
-        return Path(f"/proc/{pid}/cmdline").read_bytes()
-    except OSError:
-        return b""
-
-
-def settle(sid: int, seconds: float) -> list[int]:
-    """The session's processes left after ``seconds``; those left are killed."""
-    deadline = time.time() + seconds
-    while time.time() < deadline and session(sid):
-        time.sleep(0.1)
-    left = session(sid)
-    for pid in left:
-        try:
-            os.kill(pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
-    return left
 
 
 def _env(**extra: str) -> dict[str, str]:
