@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass
 
 from armtransfer.errors import InvalidParameterError
 
-METHODS = ("none", "pseudo", "dense", "guided", "plan", "goal-only", "pseudo-plan")
+METHODS = ("none", "pseudo", "dense", "guided", "plan", "goal-only", "pseudo-plan", "corridor")
 """The methods every suite runs (those this build's registry has), each beside its baseline."""
 
 MIN_SEEDS_FOR_CLAIM = 10
@@ -136,14 +136,14 @@ FAST = Section(
 SUITES: dict[str, Suite] = {
     s.name: s
     for s in (
-        Suite("paper", 2, True, PAPER.description, (PAPER,)),
-        Suite("random", 2, True, RANDOM.description, (RANDOM,)),
-        Suite("embodiment", 2, True, EMBODIMENT.description, (EMBODIMENT,)),
-        Suite("wind", 2, True, WIND.description, (WIND,)),
-        Suite("standard", 2, True, "the held-out union: paper, random, embodiment and wind",
+        Suite("paper", 3, True, PAPER.description, (PAPER,)),
+        Suite("random", 3, True, RANDOM.description, (RANDOM,)),
+        Suite("embodiment", 3, True, EMBODIMENT.description, (EMBODIMENT,)),
+        Suite("wind", 3, True, WIND.description, (WIND,)),
+        Suite("standard", 3, True, "the held-out union: paper, random, embodiment and wind",
               (PAPER, RANDOM, EMBODIMENT, WIND)),
-        Suite("dev", 2, False, DEV.description, (DEV,)),
-        Suite("fast", 1, False, FAST.description, (FAST,)),
+        Suite("dev", 3, False, DEV.description, (DEV,)),
+        Suite("fast", 2, False, FAST.description, (FAST,)),
     )
 }
 """Every suite by name."""
