@@ -118,18 +118,67 @@ def method_table(results: dict) -> str:
     return table
 
 
+def _baseline_of(entry: dict) -> str | None:
+    """The baseline that shares a row's learner (the no-transfer one first), or None for a
+    baseline's own row."""
+    return next(iter(entry.get("improvement_against") or {}), None)
+
+
+def transfer_order(out: dict) -> list[tuple[str, dict]]:
+    """A transfer's rows in reading order: the baselines first, then each method followed by
+    its control runs (``method [kind]``). ``out`` is ``TransferResult.to_json()``."""
+    results = out["results"]
+    controls = out.get("controls", {})
+    rows = [(m, e) for m, e in results.items() if _baseline_of(e) is None]
+    for m, e in results.items():
+        if _baseline_of(e) is not None:
+            rows.append((m, e))
+            rows.extend((f"{m} [{kind}]", by[m]) for kind, by in controls.items() if m in by)
+    return rows
+
+
 def transfer_table(out: dict) -> str:
-    """A transfer's methods, then their control runs (``method [kind]``), as one Table II-style
-    table; ``out`` is ``TransferResult.to_json()``."""
-    rows = dict(out["results"])
-    for kind, by in out.get("controls", {}).items():
-        rows.update({f"{m} [{kind}]": entry for m, entry in by.items()})
-    return method_table(rows)
+    """A transfer as one table, the whole cost first: each method beside the baseline that
+    shares its learner, and under it its control runs. Columns: steps to convergence (the
+    whole cost), then the first exposure (exploration steps, mean and median), then the
+    improvement of the first exposure over the row's baseline; ``out`` is
+    ``TransferResult.to_json()``."""
+    rows_in = transfer_order(out)
+    median_header, median_cell = median_column(e for _, e in rows_in)
+    header = ["method", "baseline", "mean steps to converge", "converged", "reached goal",
+              "mean exploration steps [95% CI]", median_header, "improvement over baseline % [95% CI]",
+              "mean greedy steps"]
+    rows, designs, capped = [], set(), False
+    for label, e in rows_in:
+        base = _baseline_of(e)
+        conv = e.get("converged", [])
+        against = (e.get("improvement_against") or {}).get(base) if base else None
+        if against is None:
+            improvement = "n/a"
+        else:
+            improvement = fmt_num(against.get("percent")) + (CAP_MARK if against.get("cap_dominated") else "")
+            improvement += " " + fmt_ci(against.get("ci95"))
+            designs.add(against.get("design"))
+            capped |= bool(against.get("cap_dominated"))
+        rows.append([label, base or "(baseline)", fmt_num(e.get("total_mean"), 0),
+                     f"{sum(bool(c) for c in conv)}/{len(conv)}", fmt_reached(e),
+                     f"{fmt_mean(e)} {fmt_ci(e.get('ci95'))}", median_cell(e), improvement,
+                     fmt_num(e.get("greedy_mean"))])
+    table = markdown_table(header, rows)
+    if any(e.get("mean_is_lower_bound") for _, e in rows_in):
+        table += ("\n\n≥: some trials never reached the goal; they count at the step cap, so the mean "
+                  "is a lower bound.")
+    if capped:
+        table += "\n\n" + CAP_NOTE
+    designs.discard(None)
+    if designs:
+        table += "\n\nImprovement CIs: " + "; ".join(sorted(designs)) + "."
+    return table
 
 
-CONTROLS_NOTE = ("[shuffled] and [random] are controls: the same method given the trajectory's cells in a "
-                 "random order, or a random walk of the source robot of the same length, a new draw each "
-                 "trial, neither ending at the task's goal.")
+CONTROLS_NOTE = ("[shuffled] and [random] are controls, the method given the trajectory's cells in a random order "
+                 "or a random walk of the same length: a control that does as well as its method, within the "
+                 "intervals, means this many trials cannot credit the gain to the trajectory's route.")
 
 
 def transfer_heading(out: dict) -> str:
