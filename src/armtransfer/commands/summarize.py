@@ -1,25 +1,37 @@
 """armtransfer summarize: per-group tables (mean, 95% CI, improvement) and plots of a sweep; a
-benchmark store's report, written again from its runs."""
+benchmark store's report, written again from its runs; or a benchmark's results file
+(``results.json``, or ``results.json.gz`` as docs/ keeps it), its statistics recomputed from its
+records, checked against the file's, and its report written into ``--out``."""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
 
+from armtransfer.errors import InvalidParameterError
 from armtransfer.io import write_json_atomic, write_text_atomic
 from armtransfer.experiments.store import ResultStore, is_benchmark
 from armtransfer.experiments.reports.summary import plot, summarize, summary_markdown
 
 HELP = ("Turn a result store into tables and a plot: summary.md, summary.json and summary.png (a benchmark's "
-        "store: its report again).")
+        "store: its report again; a benchmark's results.json[.gz]: its statistics recomputed from its records).")
 EXAMPLE = "armtransfer summarize runs/quick"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("dir", metavar="DIR", help="a directory written by `armtransfer sweep`, `matrix` or `benchmark`")
+    p.add_argument("dir", metavar="DIR", help="a directory written by `armtransfer sweep`, `matrix` or `benchmark`, "
+                                              "or a benchmark's results.json or results.json.gz")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="with a results file: an absent or empty directory for the report made again from it")
 
 
 def run(args: argparse.Namespace) -> int:
+    if Path(args.dir).is_file():
+        from armtransfer.commands.benchmark_file import report_from_file
+
+        return report_from_file(Path(args.dir), args.out)
+    if args.out is not None:
+        raise InvalidParameterError("--out is for a results file; a store's summary is written into the store")
     store = ResultStore.open_existing(args.dir)
     if is_benchmark(store.meta["spec"]):
         from armtransfer.commands.benchmark import summarize as benchmark_report

@@ -1,0 +1,87 @@
+"""`armtransfer summarize RESULTS --out DIR`: a benchmark's results file, as docs/ keeps it,
+made into its report again; every number recomputed from the records and checked against
+the file's own bytes."""
+
+from __future__ import annotations
+
+import gzip
+import json
+from pathlib import Path
+
+import pytest
+
+from armtransfer.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def results(benchmark_fast):
+    codes, root = benchmark_fast
+    assert codes == [0, 0]
+    return root / "one"
+
+
+@pytest.mark.parametrize("packed", [False, True], ids=["json", "gzip"])
+def test_a_results_file_gives_its_report_again_byte_for_byte(results, tmp_path, packed, capsys):
+    src = tmp_path / ("results.json.gz" if packed else "results.json")
+    data = (results / "results.json").read_bytes()
+    src.write_bytes(gzip.compress(data) if packed else data)
+    out = tmp_path / "again"
+    assert main(["summarize", str(src), "--out", str(out)]) == 0
+    assert "the same bytes" in capsys.readouterr().out
+    for name in ("report.md", "results.json", "survival_fast.png", "learning_curves_fast.png"):
+        assert (out / name).read_bytes() == (results / name).read_bytes(), name
+
+
+def _refused(argv, capsys) -> str:
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "Traceback" not in err
+    return err
+
+
+def test_an_edited_record_is_caught_and_nothing_is_written(results, tmp_path, capsys):
+    data = json.loads((results / "results.json").read_text())
+    data["records"][0]["first_exposure"][0] += 1
+    src = tmp_path / "results.json"
+    src.write_text(json.dumps(data, indent=1) + "\n")
+    err = _refused(["summarize", str(src), "--out", str(tmp_path / "again")], capsys)
+    assert "differ from the file's" in err
+    assert not (tmp_path / "again").exists()
+
+
+def test_another_version_of_the_suite_is_named(results, tmp_path, capsys):
+    data = json.loads((results / "results.json").read_text())
+    data["suite"]["version"] += 7
+    src = tmp_path / "results.json"
+    src.write_text(json.dumps(data))
+    err = _refused(["summarize", str(src), "--out", str(tmp_path / "again")], capsys)
+    assert f"version {data['suite']['version']}" in err and "this build has version" in err
+
+
+@pytest.mark.parametrize("content, words", [
+    (b"\x1f\x8b not really", "not valid gzip"),
+    (b"[1, 2]", "not a benchmark's results file"),
+    (b'{"records": [], "suite": {}, "seed": "0"}', "field 'seed' must be a int"),
+])
+def test_bad_results_files_are_one_line(tmp_path, capsys, content, words):
+    src = tmp_path / ("r.json.gz" if content.startswith(b"\x1f") else "r.json")
+    src.write_bytes(content)
+    assert words in _refused(["summarize", str(src), "--out", str(tmp_path / "o")], capsys)
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_results_file_needs_an_out_directory(results, capsys):
+    assert "needs --out" in _refused(["summarize", str(results / "results.json")], capsys)
+
+
+KEPT = ROOT / "docs" / "benchmark-standard" / "results.json.gz"
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not KEPT.exists(), reason="no standard report kept in docs/")
+def test_the_kept_standard_report_comes_back_from_its_records(tmp_path, capsys):
+    out = tmp_path / "again"
+    assert main(["summarize", str(KEPT), "--out", str(out)]) == 0
+    assert (out / "report.md").read_text() == (KEPT.parent / "report.md").read_text()
