@@ -85,3 +85,16 @@ def test_the_kept_standard_report_comes_back_from_its_records(tmp_path, capsys):
     out = tmp_path / "again"
     assert main(["summarize", str(KEPT), "--out", str(out)]) == 0
     assert (out / "report.md").read_text() == (KEPT.parent / "report.md").read_text()
+
+
+def test_the_readme_shows_the_tables_of_the_kept_report():
+    """README's benchmark tables are research/readme_table.py's output on the kept results file,
+    character for character: no number in them is typed by hand."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("readme_table", ROOT / "research" / "readme_table.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    readme = (ROOT / "README.md").read_text()
+    shown = readme.split("<!-- benchmark-tables -->\n", 1)[1].split("<!-- /benchmark-tables -->", 1)[0]
+    assert shown == module.tables(module.pooled(KEPT))

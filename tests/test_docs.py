@@ -244,7 +244,7 @@ def test_readme_reads_in_two_minutes() -> None:
 
 
 PATH_LIKE = re.compile(r"(?<![\w./-])((?:src/armtransfer|armtransfer|scripts|research|benchmarks|examples|docs|tests|dev)"
-                       r"/[\w./-]*\.(?:py|md|toml|json|xml|png|txt))\b")
+                       r"/[\w./-]*\.(?:py|md|toml|json\.gz|json|xml|png|txt))\b")
 LINK = re.compile(r"\]\(([^)#\s]+)(?:#[^)]*)?\)")
 MODULE = re.compile(r"`(armtransfer(?:\.\w+)+)")
 

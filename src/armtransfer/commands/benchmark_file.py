@@ -40,7 +40,7 @@ def _unpack(path: Path, raw: bytes) -> bytes:
 
 def read_results(path: Path) -> tuple[dict, bytes]:
     """(the results, their uncompressed bytes); anything else is a one-line error."""
-    raw = _unpack(path, read_input(path, "results file", InvalidParameterError))
+    raw = _unpack(path, read_input(path, "results file", InvalidParameterError, limit=MAX_UNPACKED_BYTES))
     try:
         data = parse_json_bytes(raw)
     except ValueError as err:

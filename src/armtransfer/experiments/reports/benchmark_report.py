@@ -126,6 +126,18 @@ def sentence(name: str, ab: dict, where: str) -> str:
     return text
 
 
+def stratum_text(where: str, stratum: dict) -> str:
+    """The comparisons over the (case, source seed) pairs on which robot 1 handed a trajectory
+    over: a description beside the claims, with intervals and no verdict."""
+    parts = [f"`{name}` against `{base}`: whole cost {_factor_ci(ab['convergence'])} (worst seed "
+             f"{_factor(ab['convergence']['worst'])}), first exposure {_factor_ci(ab['first_exposure'])} (worst seed "
+             f"{_factor(ab['first_exposure']['worst'])})"
+             for name, against in stratum["pooled"].items() for base, ab in against.items()]
+    return (f"{where}, where robot 1 handed a trajectory over ({stratum['pairs']} of {stratum['of']} case x source "
+            "seed pairs; on the others it did not converge, and the claims above count every method that needs a "
+            "trajectory as failed there). A description of that stratum, with no verdict: " + "; ".join(parts) + ".")
+
+
 def _against(e: dict, key: str) -> str:
     parts = [f"{b}: {_factor_ci(ab[key])} ({_factor(ab[key]['worst'])})" for b, ab in e["against"].items()]
     return "; ".join(parts) or "-"
@@ -190,6 +202,10 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
         for name, against in summary[section.name]["pooled"].items():
             for ab in against.values():
                 out.append("- " + sentence(name, ab, section.name))
+    for section in suite.sections:
+        stratum = summary[section.name].get("with_trajectory")
+        if stratum:
+            out.append("- " + stratum_text(section.name, stratum))
     out += ["", seed_effect_text(suite, summary)]
     for section in suite.sections:
         sec = summary[section.name]

@@ -169,7 +169,9 @@ def summarize(records: list[dict]) -> dict:
     A method's stats hold ``against``: per baseline it names (the no-transfer one first), the
     paired comparison on one case. ``pooled`` is the comparison over every case of the section
     (cases, then seeds, then trials). Every pooled comparison's p-value is Holm-adjusted across
-    the run (``p_holm``)."""
+    the run (``p_holm``). A section where robot 1 did not converge on some (case, source seed)
+    pairs also has ``with_trajectory``: the same comparisons over the other pairs alone, a
+    stratum described beside the claims (:func:`with_trajectory`)."""
     by_cell: dict = defaultdict(list)
     for r in records:
         by_cell[(r["section"], r["case"], r["method"])].append(r)
@@ -205,6 +207,9 @@ def summarize(records: list[dict]) -> dict:
         sec["cases"] = [sec["cases"][k] for k in sorted(sec["cases"])]
         for case in sec["cases"]:
             case["methods"] = {n: case["methods"][n] for n in names if n in case["methods"]}
+    for section, sec in out.items():
+        if any(case["source_failures"] for case in sec["cases"]):
+            sec["with_trajectory"] = with_trajectory(section, by_cell)
     tested = [v for v in verdicts if v["p"] is not None]
     for v, adj in zip(tested, multiplicity.holm([v["p"] for v in tested])):
         v["p_holm"] = adj
@@ -213,3 +218,30 @@ def summarize(records: list[dict]) -> dict:
         v.setdefault("p_holm", None)
         v.setdefault("verdicts", len(tested))
     return out
+
+
+def with_trajectory(section: str, by_cell: dict) -> dict:
+    """The stratum of a section's (case, source seed) pairs on which robot 1 converged and
+    handed a trajectory over: ``{"pairs", "of", "pooled": {name: {baseline: {metric: factor}}}}``.
+    On the other pairs every method that needs a trajectory counts as failed (the claims keep
+    them); this says what the methods did where there was something to transfer. It is a
+    description: its comparisons carry no verdict and do not enter Holm's correction."""
+    def kept(recs: list[dict]) -> list[dict]:
+        return [r for r in recs if r["source_failure"] is None]
+
+    names = list(dict.fromkeys(m for (s, _, m) in by_cell if s == section))
+    case_ids = sorted({c for (s, c, _) in by_cell if s == section})
+    pooled: dict = {}
+    for name in names:
+        bases = list(dict.fromkeys(b for (s, _, m), recs in by_cell.items() if s == section and m == name
+                                   for b in recs[0]["baselines"]))
+        for base in bases:
+            cases = [(kept(by_cell[(section, c, name)]), kept(by_cell[(section, c, base)]))
+                     for c in case_ids if (section, c, name) in by_cell and (section, c, base) in by_cell]
+            cases = [(a, b) for a, b in cases if a and b]
+            if cases:
+                pooled.setdefault(name, {})[base] = dict(
+                    {k: dict(compare(cases, k), p_holm=None, verdicts=0) for k in METRICS}, baseline=base)
+    pairs = {(c, r["source_seed"]): r["source_failure"] is None for (s, c, _), recs in by_cell.items()
+             if s == section for r in recs}
+    return {"pairs": sum(pairs.values()), "of": len(pairs), "pooled": pooled}

@@ -1,0 +1,80 @@
+"""The README's benchmark tables, made from a benchmark's results file and nothing else.
+
+    python research/readme_table.py docs/benchmark-standard/results.json.gz
+
+prints two markdown tables, one row per section of the suite and one column per method
+against a baseline that shares its learner: the whole cost (steps until the greedy path
+settled) first, then the first exposure. A cell is the factor (baseline / method, above 1 the
+method is faster), its 95% hierarchical bootstrap-t interval and the worst case x source seed
+pair; a verdict that survives Holm's correction is marked "faster" or "slower", anything else
+is "n.s." (not told apart at this size). tests/test_benchmark_file.py checks that the README shows
+exactly these tables for the results file kept in docs/.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from armtransfer.commands.benchmark_file import read_results
+from armtransfer.errors import ArmTransferError
+from armtransfer.experiments.reports.benchmark_report import judgement
+
+COLUMNS = (("pseudo", "none"), ("dense", "none"), ("guided", "plan"), ("corridor", "plan"),
+           ("guided", "goal-only"), ("pseudo-plan", "plan"))
+"""(method, baseline) pairs shown, each a method against a baseline sharing its learner."""
+
+SECTIONS = {"paper": "paper (Table I)", "random": "random tasks", "embodiment": "joint-space arms",
+            "wind": "wind 0.01-0.1"}
+
+
+def _x(f: float) -> str:
+    return f"{f:.3g}×" if f < 100 else f"{f:,.0f}×"
+
+
+def cell(ab: dict | None) -> str:
+    if ab is None or ab.get("factor") is None:
+        return "n/a"
+    ci = ab["ci95"]
+    verdict = judgement(ab)
+    mark = verdict.split(" ")[0] if verdict.startswith(("faster", "slower")) else "n.s."
+    return f"{_x(ab['factor'])} [{_x(ci[0])}, {_x(ci[1])}], {_x(ab['worst'])}, {mark}"
+
+
+def tables(summary: dict) -> str:
+    header = "| suite | " + " | ".join(f"`{m}` vs `{b}`" for m, b in COLUMNS) + " |"
+    rule = "|---|" + "---|" * len(COLUMNS)
+    out = []
+    for metric, title in (("convergence", "Whole cost: steps until the greedy path settled"),
+                          ("first_exposure", "First exposure: steps until the goal was first reached")):
+        out += [f"**{title}**", "", header, rule]
+        for section, pooled in summary.items():
+            row = [cell(pooled.get(m, {}).get(b, {}).get(metric)) for m, b in COLUMNS]
+            out.append(f"| {SECTIONS.get(section, section)} | " + " | ".join(row) + " |")
+        out.append("")
+    return "\n".join(out).rstrip("\n") + "\n"
+
+
+def pooled(path: Path) -> dict:
+    data, _ = read_results(path)
+    return {name: sec["pooled"] for name, sec in data["summary"].items()}
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("results", type=Path, help="a benchmark's results.json or results.json.gz")
+    args = p.parse_args(argv)
+    try:
+        text = tables(pooled(args.results))
+    except ArmTransferError as err:
+        print(f"readme_table: error: {err}", file=sys.stderr)
+        return 2
+    sys.stdout.write(text)
+    return 0
+
+
+if __name__ == "__main__":
+    from armtransfer import script
+
+    script.exit_with(main)
