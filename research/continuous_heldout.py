@@ -162,6 +162,11 @@ def _fx(f: dict) -> str:
     return f"{f['factor']:.2f}{ci}" + (f" ({', '.join(extra)})" if extra else "")
 
 
+def _pc(v: float) -> str:
+    """A percentage's interval end: whole numbers, one decimal below 1 in size (so -0.2 is not "-0")."""
+    return f"{v:.1f}" if abs(v) < 1 else f"{v:.0f}"
+
+
 def _n(v) -> str:
     return "> cap" if v is None else f"{v:,.0f}"
 
@@ -183,7 +188,7 @@ def markdown(cases: list[dict]) -> str:
                  f" [{100 * cost['transfer_ratio_ci95'][0]:+.0f}, {100 * cost['transfer_ratio_ci95'][1]:+.0f}]"))
         imp = s["improvement"]
         ip = "n/a" if imp["percent"] is None else f"{imp['percent']:+.0f}%" + (
-            "" if imp["ci95"] is None else f" [{imp['ci95'][0]:.0f}, {imp['ci95'][1]:.0f}]")
+            "" if imp["ci95"] is None else f" [{_pc(imp['ci95'][0])}, {_pc(imp['ci95'][1])}]")
         lines.append(
             f"| {c['pair']} | {c['task']} | {c['cap']:,} | {_fx(cv)} | {_x(cv['worst'])} | "
             f"{mn['converged']}/{mn['n']} / {mp['converged']}/{mp['n']} | "
@@ -211,6 +216,8 @@ def _run(args) -> int:
             if not path.is_file():
                 raise InvalidParameterError(f"--report {d!r} holds no heldout.json")
             cases += json.loads(path.read_text())["cases"]
+        order = {p: i for i, p in enumerate(PAIRS)}
+        cases.sort(key=lambda c: (order.get(c["pair"], len(order)), c["pair"], c["cap"], c["task"]))
         print(markdown(cases), end="")
         return 0
     if args.out is None:
