@@ -165,18 +165,30 @@ class Robots:
 
     resolved: dict
 
-    def __call__(self, spec: str) -> DiscreteRobot:
-        if spec not in self.resolved:
+    def __call__(self, spec: str, world: str = suites.DEFAULT_WORLD) -> DiscreteRobot:
+        key = benchmark_runs.robot_key(spec, world)
+        if key not in self.resolved:
             from armtransfer.tasks.specs import resolve
 
-            self.resolved[spec] = resolve(spec)
-        return self.resolved[spec]
+            if world == suites.DEFAULT_WORLD:
+                self.resolved[key] = resolve(spec)
+            else:
+                from armtransfer.worlds.resolve import world as layout_of
+
+                self.resolved[key] = resolve(spec, layout=layout_of(world))
+        return self.resolved[key]
 
 
 def case_cells(case: suites.Case, source: DiscreteRobot, target: DiscreteRobot, seed: int, section: str,
                index: int, source_seed: int) -> tuple[int, int]:
     if case.task is not None:
-        return table_task(case.task).cells()
+        if case.world == suites.DEFAULT_WORLD:
+            if isinstance(case.task, bool) or not isinstance(case.task, int):
+                raise InvalidTaskError(f"{case.label}: a task of the rooms is a Table I task number")
+            return table_task(case.task).cells()
+        from armtransfer.tasks.catalog import world_task
+
+        return world_task(target.layout, case.task).cells()
     rng = np.random.default_rng(np.random.SeedSequence(
         [int(seed), section_key(section), int(index), int(source_seed), 1]))
     return draw_task(source, target, rng, case.distance, case.cells)
@@ -220,7 +232,7 @@ class Pair:
 
     def source_run(self) -> dict:
         return benchmark_runs.source_run(self.case.source, self.case.target, list(self.start), list(self.goal),
-                                         self.seed, SOURCE_CONFIG)
+                                         self.seed, SOURCE_CONFIG, world=self.case.world)
 
     def trial_runs(self, names: Sequence[str], source_result: dict | None,
                    learner: str = benchmark_runs.LEARNER) -> list[dict]:
@@ -228,7 +240,7 @@ class Pair:
         without the source run's result, only those of the methods that read no trajectory."""
         return [benchmark_runs.trial_run(name, k, self.case.source, self.case.target, list(self.start),
                                          list(self.goal), self.case.wind, self.seed, self.config, source_result,
-                                         learner=learner)
+                                         learner=learner, world=self.case.world)
                 for name in names if source_result is not None or not benchmark_runs.needs_trajectory(name)
                 for k in range(self.section.trials)]
 
@@ -248,7 +260,8 @@ class Pair:
                 "source_seed": self.source_seed, "seed": self.seed,
                 "source_steps": None if traj is None else len(traj["cells"]),
                 "source_failure": source_result["failure"], "optimal": self.optimal,
-                "cap": self.section.max_total_steps, "budget": suites.BUDGET_FACTOR * self.optimal}
+                "cap": self.section.max_total_steps, "budget": suites.BUDGET_FACTOR * self.optimal,
+                **({} if self.case.world == suites.DEFAULT_WORLD else {"world": self.case.world})}
 
 
 def record(pair: Pair, name: str, source_result: dict, trials: list[dict]) -> dict:
@@ -388,7 +401,7 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
     pairs = []
     for section in suite.sections:
         for ci, case in enumerate(section.cases):
-            source, target = robots(case.source), robots(case.target)
+            source, target = robots(case.source, case.world), robots(case.target, case.world)
             for j in range(section.source_seeds):
                 start, goal = case_cells(case, source, target, seed, section.name, ci, j)
                 source.start_state(start)
