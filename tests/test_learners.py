@@ -205,6 +205,10 @@ def test_an_outside_learner_runs_only_none_and_the_reward_term_methods():
     assert benchmark.learner_methods("sarsa", ran) == ran
     assert benchmark.learner_methods("dqn", ran) == ["none", "pseudo", "dense"]
     assert benchmark.baselines_of("pseudo@dqn") == ("none@dqn",) and benchmark.baselines_of("pseudo") == ("none",)
+    from armtransfer.experiments.reports.benchmark_report import describe
+
+    assert describe("none@dqn", benchmark.parse_label) == "no transfer; learned by dqn"
+    assert describe("none", benchmark.parse_label) == "Algorithm 1 without transfer"
 
 
 def test_the_default_learners_keep_the_suites_key_and_bytes():
