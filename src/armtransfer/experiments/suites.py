@@ -34,18 +34,25 @@ cells every parameter of this package was chosen on, ``research/select_defaults.
 (at least one coordinate odd: cells no choice ever saw) or ``any``."""
 
 
+DEFAULT_WORLD = "rooms"
+
+
 @dataclass(frozen=True)
 class Case:
     source: str
     target: str
-    task: int | None
-    """A Table I task number; None: start and goal drawn per source seed over all rooms."""
+    task: int | str | None
+    """A task of the case's world (a Table I number on the rooms, a task name or number of another
+    world); None: start and goal drawn per source seed over the whole world."""
     wind: float = 0.0
     distance: tuple[int, int | None] | None = None
     """A drawn task's shortest path for the finer robot lies in [low, high) (high None: no
     limit); None: at least ``benchmark.MIN_DISTANCE``."""
     cells: str = "any"
     """Which cells a drawn task's start and goal are on (``CELLS``)."""
+    world: str = "rooms"
+    """The world the robots move in: a name ``armtransfer.worlds.resolve.world`` knows (``rooms``,
+    the paper's; ``rooms11``, ``rooms15``, ``generated:SEED[:SIDE]``)."""
 
     @property
     def label(self) -> str:
@@ -56,7 +63,11 @@ class Case:
         if self.task is None and self.cells != "any":
             task += f" on {self.cells} cells"
         wind = f", wind {self.wind:g}" if self.wind else ""
-        return f"{self.source} -> {self.target}, {task}{wind}"
+        world = f", in {self.world}" if self.world != DEFAULT_WORLD else ""
+        return f"{self.source} -> {self.target}, {task}{wind}{world}"
+
+
+DEFAULT_LEARNERS = ("sarsa",)
 
 
 @dataclass(frozen=True)
@@ -69,6 +80,23 @@ class Section:
     """Trials of every method per source seed."""
     max_total_steps: int
     """A trial's step cap: a first exposure not reached by then is censored there."""
+    learners: tuple[str, ...] = ("sarsa",)
+    """The learners every method runs on (``armtransfer.learning.learners``), each method beside
+    the baseline run by the same learner; an outside learner runs ``none`` and the reward-term
+    methods."""
+
+    def to_dict(self) -> dict:
+        """The section as stored and reported; the default learners are left out, so a suite that
+        runs the built-in learner alone keeps the store key and the bytes it had before."""
+        out = asdict(self)
+        for case in out["cases"]:  # a case of the default world keeps the bytes it had before worlds
+            if case["world"] == DEFAULT_WORLD:
+                del case["world"]
+        if self.learners == DEFAULT_LEARNERS:
+            del out["learners"]
+        else:
+            out["learners"] = list(self.learners)
+        return out
 
 
 @dataclass(frozen=True)
@@ -82,7 +110,7 @@ class Suite:
     def to_dict(self) -> dict:
         return {"name": self.name, "version": self.version, "held_out": self.held_out,
                 "description": self.description, "methods": list(METHODS), "budget_factor": BUDGET_FACTOR,
-                "sections": [asdict(s) for s in self.sections]}
+                "sections": [s.to_dict() for s in self.sections]}
 
 
 def _both_ways(pairs: list[tuple[str, str]], tasks: tuple[int | None, ...], wind: float = 0.0) -> tuple[Case, ...]:
