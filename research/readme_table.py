@@ -13,7 +13,6 @@ exactly these tables for the results file kept in docs/.
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
@@ -62,13 +61,15 @@ def pooled(path: Path) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    from armtransfer import script
+
+    p = script.parser(__doc__)
     p.add_argument("results", type=Path, help="a benchmark's results.json or results.json.gz")
     args = p.parse_args(argv)
     try:
         text = tables(pooled(args.results))
     except ArmTransferError as err:
-        print(f"readme_table: error: {err}", file=sys.stderr)
+        print(f"readme_table.py: error: {err}", file=sys.stderr)
         return 2
     sys.stdout.write(text)
     return 0
