@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import armtransfer.checks as checks
 from armtransfer.errors import InvalidParameterError
@@ -21,6 +22,9 @@ from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.tiles import TileCoding
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.catalog import Task
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 @dataclass(frozen=True)
@@ -112,9 +116,62 @@ class ContinuousResult:
                 "approximation": self.approximation.to_json(),
                 "results": {m: summary[r.label] for m, r in self.methods.items()}}
 
+    def _rows(self, out: dict) -> list[list[str]]:
+        """The table of :meth:`__repr__` and :meth:`_repr_html_`: a header, then per method its
+        mean exploration steps with their 95% CI, how many trials reached the goal and
+        converged, and the improvement over ``none``."""
+        from armtransfer.experiments.reports import report
+
+        rows = [["method", "mean exploration steps [95% CI]", "reached", "converged", "improvement"]]
+        for m, e in out["results"].items():
+            imp = e.get("improvement_percent")
+            conv = e.get("converged", [])
+            rows.append([m, f"{report.fmt_mean(e)} {report.fmt_ci(e['ci95'])}", report.fmt_reached(e),
+                         f"{sum(bool(c) for c in conv)}/{len(conv)}", "" if imp is None else f"{imp:+.1f}%"])
+        return rows
+
+    def _heading(self) -> str:
+        t = self.task
+        return (f"{t.name}: {tuple(t.start)} -> {tuple(t.goal)}, {self.source} -> {self.target}, "
+                f"{self.trials} trials, seed {self.seed}")
+
     def __repr__(self) -> str:
-        lines = [f"<ContinuousResult {self.task.name}: {self.source} -> {self.target} (continuous state), "
-                 f"{self.trials} trials"]
-        for r in self.methods.values():
-            lines.append(f"  {r!r}")
-        return "\n".join(lines) + ">"
+        """A few lines: the task and robots (the target's name says it is continuous), then a
+        row per method."""
+        rows = self._rows(self.to_json())
+        widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+        lines = ["  " + "  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
+        return f"<ContinuousResult {self._heading()}\n" + "\n".join(lines) + ">"
+
+    def _repr_html_(self) -> str:
+        """What Jupyter shows: the heading and the table of :meth:`__repr__`, as HTML."""
+        from html import escape
+
+        rows = self._rows(self.to_json())
+        head = "".join(f"<th>{escape(c)}</th>" for c in rows[0])
+        body = "".join("<tr>" + "".join(f"<td>{escape(c)}</td>" for c in r) + "</tr>" for r in rows[1:])
+        return (f"<p><b>{escape(self._heading())}</b></p>"
+                f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
+
+    def to_frame(self) -> "pd.DataFrame":
+        """A tidy pandas DataFrame, as ``TransferResult.to_frame``'s: one row per trial of every
+        method (``control`` is ``"none"``: a continuous run has no controls), every per-trial
+        metric a column, then the run's settings (task, robots, seed, trajectory length, the
+        tile coding, every learner setting). A trial that never reached the goal has
+        ``reached`` False and ``exploration_steps`` missing, censored at ``step_cap``. Needs
+        pandas (``pip install 'armtransfer[frames]'``)."""
+        from armtransfer.experiments.reports import frames
+        from armtransfer.experiments.results import _per_trial
+
+        frames.pandas()
+        out = self.to_json()
+        t = self.task
+        settings = {"task": t.name, "start": list(t.start), "goal": list(t.goal), "source": self.source,
+                    "target": self.target, "state": "continuous", "seed": self.seed, "trials": self.trials,
+                    "trajectory_length": len(self.trajectories[0]) if self.trajectories else None,
+                    **{f"approximation_{k}": v for k, v in self.approximation.to_json().items()},
+                    **self.config.to_dict()}
+        rows = []
+        for m, entry in out["results"].items():
+            rows += frames.trial_rows(m, None, _per_trial(entry, self.config.max_total_steps), settings)
+        return frames.frame(rows)
