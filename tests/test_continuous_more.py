@@ -44,3 +44,50 @@ def test_a_continuous_result_says_continuous_once_and_shows_a_table(result):
     assert lines[1].split()[:2] == ["method", "mean"] and [ln.split()[0] for ln in lines[2:]] == ["none", "pseudo"]
     html = result._repr_html_()
     assert html.count("<tr>") == 3 and "<th>method</th>" in html and "-&gt;" in html
+
+
+def test_the_environment_reports_the_tool_point_of_the_moves_own_kinematics():
+    """One MuJoCo kinematics per step: the observation's tool point is the move's, and it is the
+    point a fresh kinematics call gives (the old observation), bit for bit, on a seeded rollout
+    with blocked moves and resets."""
+    import gymnasium as gym
+    import mujoco
+
+    env = gym.make("armtransfer/ContinuousArmRooms-v0", arm="planar3", task=1).unwrapped
+    arm = env.arm
+    calls = []
+    real = mujoco.mj_kinematics
+
+    def counting(m, d):
+        calls.append(1)
+        real(m, d)
+
+    in_move = []
+    move = arm.move
+
+    def counted_move(a):
+        before = len(calls)
+        out = move(a)
+        in_move.append(len(calls) - before)
+        return out
+
+    arm.move = counted_move
+    rng = np.random.default_rng(5)
+    blocked = 0
+    for episode in range(3):
+        obs, _ = env.reset(seed=episode)
+        assert obs.tobytes() == np.concatenate([arm.q, arm.tool_point()]).tobytes()
+        for _ in range(400):
+            mujoco.mj_kinematics = counting
+            try:
+                before = len(calls)
+                obs, _, terminated, _, info = env.step(int(rng.integers(env.action_space.n)))
+                per_step = len(calls) - before
+            finally:
+                mujoco.mj_kinematics = real
+            blocked += info["blocked"]
+            assert per_step == in_move[-1] <= 4  # the move's own (with up to 3 probes near a wall)
+            assert obs.tobytes() == np.concatenate([arm.q, arm.tool_point()]).tobytes()
+            if terminated:
+                break
+    assert blocked > 0

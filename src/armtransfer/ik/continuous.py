@@ -158,7 +158,8 @@ class ContinuousArm:
         self._nlo: list[int] = [0] * self.dof
         self._nhi: list[int] = [0] * self.dof
         self.label = OFF_TABLE
-        self._start: tuple[np.ndarray, int] | None = None
+        self._tip: tuple[float, float, float] = (math.nan, math.nan, math.nan)
+        self._start: tuple[np.ndarray, int, tuple[float, float, float]] | None = None
         self.moves = 0
         """MuJoCo kinematics + collision calls made by :meth:`move` (blocked ones too)."""
 
@@ -177,6 +178,7 @@ class ContinuousArm:
         if self.checker.touches(q):
             raise ArmModelError("the arm touches the table, a wall or itself at this configuration")
         tip = self.data.site_xpos[self._tip_id].copy()
+        x, y, z = tip.tolist()
         cell = int(cells_of_xy(tip, self.scene.cell, self.layout))
         if cell < 0 or not self.layout.free[cell]:
             raise InvalidCellError("the arm's tool point is not over a free cell at this configuration")
@@ -186,7 +188,8 @@ class ContinuousArm:
         self._nlo = np.ceil((lo - q) / self.step - 1e-9).astype(np.int64).tolist()
         self._nhi = np.floor((hi - q) / self.step + 1e-9).astype(np.int64).tolist()
         self._qpos[:] = q
-        self._start = (q.copy(), cell)
+        self._start = (q.copy(), cell, (x, y, z))
+        self._tip = (x, y, z)
         self.label = cell
         return cell
 
@@ -194,9 +197,10 @@ class ContinuousArm:
         """Back to the configuration last set (:meth:`set_configuration`, :meth:`place`); its label."""
         if self._start is None:
             raise ArmModelError("place the arm (place or set_configuration) before resetting it")
-        q, cell = self._start
+        q, cell, tip = self._start
         self._qpos[:] = q
         self._n = [0] * self.dof
+        self._tip = tip
         self.label = cell
         return cell
 
@@ -271,7 +275,7 @@ class ContinuousArm:
         if d.ncon and self.checker.touches_now():  # the kinematics and contacts just computed
             qpos[j] = old
             return BLOCKED
-        x, y, _ = self._site_xpos[self._tip_id].tolist()
+        x, y, z = self._site_xpos[self._tip_id].tolist()
         cx, cy = round(x / self._cell_size) - self._lo, round(y / self._cell_size) - self._lo
         width = self._width
         cell = cy * width + cx if 0 <= cx < width and 0 <= cy < width else -1
@@ -286,6 +290,7 @@ class ContinuousArm:
             qpos[j] = old
             return BLOCKED
         self._n[j] = n
+        self._tip = (x, y, z)
         self.label = cell
         return cell
 
@@ -303,6 +308,12 @@ class ContinuousArm:
         q[j] = end
         self._qpos[:] = q  # the data's configuration is the end's again (kinematics are refreshed by the next move)
         return hit
+
+    def tip(self) -> tuple[float, float, float]:
+        """The tool point (x, y, z) at the current configuration, as the kinematics of the move
+        (or placement) that reached it computed it: no MuJoCo call. The same numbers as
+        :meth:`tool_point` (MuJoCo's kinematics are deterministic)."""
+        return self._tip
 
     def tool_point(self) -> np.ndarray:
         """The tool point at the current configuration (MuJoCo's kinematics, run now)."""

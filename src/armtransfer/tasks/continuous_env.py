@@ -4,7 +4,8 @@
 
 The observation is a ``Box``: the joint configuration q followed by the tool point (x, y, z)
 in metres; the action is ``Discrete(2 * dof)``: joint j turned by +delta (``2j``) or -delta
-(``2j+1``), as the ``joint`` action model. Every step runs MuJoCo (``ik.continuous``): a move
+(``2j+1``), as the ``joint`` action model. Every step runs MuJoCo once (``ik.continuous``; the tool point
+observed is that of the move's own kinematics, ``ContinuousArm.tip``): a move
 that is blocked leaves the arm where it was (``info["blocked"]``). Each step costs
 ``step_reward``; reaching the goal cell pays ``goal_reward`` and ends the episode.
 ``info["label"]`` is the cell under the tool point, which is what a transferred trajectory's
@@ -55,12 +56,17 @@ class ContinuousArmRoomsEnv(gym.Env):
         self.observation_space = spaces.Box(np.concatenate([lo, [-REACH] * 3]), np.concatenate([hi, [REACH] * 3]),
                                             dtype=np.float64)
         self.action_space = spaces.Discrete(arm.n_actions)
+        self._obs_size = arm.dof + 3
         self.robot = cell_robot(layout)
         """The cells as a robot (states = cells): what ``TransferReward`` pays transfer by."""
         self.start_state = self.start_cell
 
     def _obs(self) -> np.ndarray:
-        return np.concatenate([self.arm.q, self.arm.tool_point()])
+        obs = np.empty(self._obs_size)  # q, then the tool point of the move's own kinematics (no second call)
+        dof = self.arm.dof
+        obs[:dof] = self.arm.q
+        obs[dof:] = self.arm.tip()
+        return obs
 
     def state_of(self, obs: np.ndarray, info: dict) -> int:
         """The state ``TransferReward`` pays by: the cell under the tool point."""
