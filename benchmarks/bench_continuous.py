@@ -39,10 +39,11 @@ from typing import Any
 
 import numpy as np
 
-from armtransfer import script
+from armtransfer import checks, script
 from armtransfer.errors import InvalidParameterError
 from armtransfer.experiments import continuous as runs
 from armtransfer.experiments.stats import learning_metrics, metrics, survival
+from armtransfer.ik.continuous import MAX_NOISE, NOISE_CLIP
 from armtransfer.experiments.experiment import source_trajectory, trial_rng
 from armtransfer.learning import linear
 from armtransfer.learning.config import LearnerConfig
@@ -57,29 +58,30 @@ BYO = "planar5"
 (meshes in a folder, a stylus body for its tool point), mounted where that module suggests."""
 
 
-def byo_arm(directory: Path, fast: bool):
+def byo_arm(directory: Path, fast: bool, noise: float = 0.0):
     sys.path.insert(0, str(ROOT / "tests"))
     import menagerie_like  # the project's own Menagerie-style arm files (tests/)
 
     xml = menagerie_like.planar5_straight(directory)
     opts = menagerie_like.SUGGESTED[BYO]
-    return continuous_arm(None, xml_path=xml, joint_step=0.35, **opts), f"{BYO} arm file (joint step 0.35)"
+    return (continuous_arm(None, xml_path=xml, joint_step=0.35, noise=noise, **opts),
+            f"{BYO} arm file (joint step 0.35)")
 
 
 PAIRS = ("planar2:joint->planar3", "ur5e_like:cartesian->planar2", f"planar2:joint->{BYO}")
 """The pairs measured, by the names ``--pairs`` takes."""
 
 
-def pairs(directory: Path, fast: bool, chosen: list[str]) -> list[tuple[str, str, Any]]:
+def pairs(directory: Path, fast: bool, chosen: list[str], noise: float = 0.0) -> list[tuple[str, str, Any]]:
     """(source spec, target name, target arm) of each chosen pair."""
     out = []
     for name in chosen:
         source, target = name.split("->")
         if target == BYO:
-            arm, label = byo_arm(directory, fast)
+            arm, label = byo_arm(directory, fast, noise)
             out.append((source, label + " (continuous)", arm))
         else:
-            out.append((source, f"{target}:joint (continuous)", continuous_arm(target)))
+            out.append((source, f"{target}:joint (continuous)", continuous_arm(target, noise=noise)))
     return out
 
 
@@ -153,9 +155,9 @@ def method_stats(trials: list, cap: int, horizon: int) -> dict:
 
 
 def table_one(seeds: int, config: LearnerConfig, source_config: LearnerConfig, approx: runs.Approximation,
-              directory: Path, fast: bool, tasks: list[int], chosen: list[str]) -> list[dict]:
+              directory: Path, fast: bool, tasks: list[int], chosen: list[str], noise: float = 0.0) -> list[dict]:
     out = []
-    for source_spec, target_name, arm in pairs(directory, fast, chosen):
+    for source_spec, target_name, arm in pairs(directory, fast, chosen, noise):
         source = tabular_robot(source_spec)
         for task in tasks:
             start, goal = TABLE_I[task].cells(arm.layout)
@@ -271,6 +273,7 @@ def _run(args) -> int:
     if args.seeds < 1 or args.rounds < 1 or args.rate_steps < 100:
         raise InvalidParameterError("--seeds and --rounds must be positive and --rate-steps at least 100")
     approx = runs.Approximation(tilings=args.tilings, width=args.width)
+    noise = checks.real(args.noise, "--noise (the actuation noise sigma)", 0.0, MAX_NOISE)
     bad = [t for t in args.tasks if t not in TABLE_I] + [p for p in args.pairs if p not in PAIRS]
     if bad:
         raise InvalidParameterError(f"unknown task or pair {bad[0]!r}; valid tasks: {', '.join(map(str, TABLE_I))}; "
@@ -290,11 +293,11 @@ def _run(args) -> int:
     if not args.rate_only:
         print("Table I ...", file=sys.stderr, flush=True)
         with tempfile.TemporaryDirectory() as tmp:
-            table = table_one(args.seeds, config, source_config, approx, Path(tmp), args.fast, tasks, chosen)
+            table = table_one(args.seeds, config, source_config, approx, Path(tmp), args.fast, tasks, chosen, noise)
     result = {"command": " ".join(["python", "benchmarks/bench_continuous.py", *sys.argv[1:]]),
               "machine": machine(),
               "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "seeds": args.seeds,
-              "config": config.to_dict(), "approximation": dataclasses.asdict(approx),
+              "config": config.to_dict(), "approximation": dataclasses.asdict(approx), "noise": noise,
               "rate": rate, "table_one": table}
     out.mkdir(parents=True, exist_ok=True)
     (out / "continuous.json").write_text(json.dumps(result, indent=1, default=float) + "\n")
@@ -323,6 +326,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--episodes", type=int, default=300)
     p.add_argument("--episode-cap", type=int, default=50_000, help="steps per episode after the first at most")
     p.add_argument("--patience", type=int, default=LearnerConfig().patience)
+    p.add_argument("--noise", type=float, default=0.0, metavar="SIGMA",
+                   help="the target arm's actuation noise in Table I (each move turns delta * (1 + eps), "
+                        f"eps ~ N(0, SIGMA^2) clipped to +-{NOISE_CLIP}; default 0: none)")
     args = p.parse_args(argv)
     if args.fast:
         args.seeds, args.rounds, args.rate_steps = min(args.seeds, 2), min(args.rounds, 2), min(args.rate_steps, 3000)

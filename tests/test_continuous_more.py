@@ -91,3 +91,141 @@ def test_the_environment_reports_the_tool_point_of_the_moves_own_kinematics():
             if terminated:
                 break
     assert blocked > 0
+
+
+def _planar3(noise=0.0):
+    from armtransfer.tasks.catalog import TABLE_I
+    from armtransfer.tasks.continuous import continuous_arm
+
+    arm = continuous_arm("planar3", noise=noise)
+    start, goal = TABLE_I[1].cells(arm.layout)
+    arm.place(start)
+    return arm, goal
+
+
+@pytest.fixture(scope="module")
+def noisy():
+    return _planar3(0.2)
+
+
+def test_with_noise_the_arm_leaves_the_lattice_and_every_move_is_checked(noisy):
+    """Noise: the start is IK's (not snapped), a move turns its joint by 0.5 to 1.5 steps the
+    right way, q leaves the lattice, and a move that is not blocked ends touching nothing with
+    every point of its arc (checked densely, by MuJoCo) over a free cell."""
+    from armtransfer.ik.labels import cells_of_xy
+
+    arm, _ = noisy
+    home = arm.scene.home.astype(float)
+    arm.seed_noise(np.random.default_rng(4))
+    arm.reset()
+    q0 = arm.q.copy()
+    assert not np.allclose((q0 - home) / arm.step, np.rint((q0 - home) / arm.step), atol=1e-6)
+    rng = np.random.default_rng(0)
+    free = arm.layout.free
+    moved = blocked = 0
+    for _ in range(300):
+        q = arm.q.copy()
+        a = int(rng.integers(arm.n_actions))
+        label = arm.move(a)
+        after = arm.q.copy()
+        j, sign = a // 2, 1 - 2 * (a % 2)
+        if label < 0:
+            blocked += 1
+            assert after.tobytes() == q.tobytes()
+            continue
+        moved += 1
+        turn = (after[j] - q[j]) / arm.step * sign
+        assert 0.5 - 1e-9 <= turn <= 1.5 + 1e-9 and np.delete(after - q, j).tolist() == [0.0] * (arm.dof - 1)
+        assert not arm.checker.touches(after)
+        assert label == int(cells_of_xy(arm.checker.tip(after), arm.scene.cell, arm.layout))
+        for t in np.linspace(0, 1, 41):
+            mid = q.copy()
+            mid[j] = q[j] + t * (after[j] - q[j])
+            cell = int(cells_of_xy(arm.checker.tip(mid), arm.scene.cell, arm.layout))
+            assert cell >= 0 and free[cell]
+        arm.q[:] = after
+    assert moved > 100 and blocked > 0
+    steps = (arm.q - q0) / arm.step
+    assert not np.allclose(steps, np.rint(steps), atol=1e-6)  # off the lattice
+
+
+def test_noisy_learning_is_deterministic_and_its_greedy_path_is_noiseless(noisy):
+    from armtransfer.learning import linear
+    from armtransfer.learning.config import LearnerConfig
+    from armtransfer.learning.tiles import TileCoding
+
+    arm, goal = noisy
+    coding = TileCoding.over(*arm.bounds, 2 * arm.step, 4)
+    config = LearnerConfig(max_episodes=3, max_total_steps=3000)
+    class Recorded:  # the arm, with every move's result and configuration recorded
+        def __init__(self):
+            self.seen = []
+
+        def __getattr__(self, name):
+            return getattr(arm, name)
+
+        def move(self, a):
+            out = arm.move(a)
+            self.seen.append((out, arm.q.tobytes()))
+            return out
+
+    runs = []
+    for seed in (1, 1, 2):
+        arm.seed_noise(np.random.default_rng(seed))
+        rec = Recorded()
+        r = linear.learn(rec, goal, coding, config, np.random.default_rng(9))
+        runs.append((r.episode_steps.tobytes(), rec.seen))
+    assert runs[0] == runs[1]
+    assert runs[0][1] != runs[2][1]  # only the noise differs
+    with arm.noiseless():
+        arm.reset()
+        arm.move(0)
+        arm.move(1)
+        assert arm.key() == (0, 0, 0)
+    assert arm.noise == 0.2
+
+
+def test_no_noise_is_the_arm_without_noise_bit_for_bit():
+    from armtransfer.learning import linear
+    from armtransfer.learning.config import LearnerConfig
+    from armtransfer.learning.tiles import TileCoding
+
+    out = []
+    for noise in (None, 0.0):
+        arm, goal = _planar3() if noise is None else _planar3(noise)
+        arm.seed_noise(np.random.default_rng(3))
+        coding = TileCoding.over(*arm.bounds, 2 * arm.step, 4)
+        r = linear.learn(arm, goal, coding, LearnerConfig(max_episodes=2, max_total_steps=2000),
+                         np.random.default_rng(2))
+        out.append((arm.q.tobytes(), r.episode_steps.tobytes(), arm.key()))
+    assert out[0] == out[1]
+
+
+def test_the_noisy_environment_and_api_are_reproducible_and_refuse_bad_noise_in_one_line():
+    import gymnasium as gym
+
+    from armtransfer.errors import ArmTransferError
+
+    def rollout(seed):
+        env = gym.make("armtransfer/ContinuousArmRooms-v0", arm="planar3", task=1, noise=0.1).unwrapped
+        obs = [env.reset(seed=seed)[0]]
+        for a in np.random.default_rng(0).integers(0, 6, 200):
+            obs.append(env.step(int(a))[0])
+        return np.array(obs)
+
+    a, b, c = rollout(1), rollout(1), rollout(2)
+    assert a.tobytes() == b.tobytes() and a.tobytes() != c.tobytes()
+    r = armtransfer.transfer(source="planar2:joint", target="planar3:joint", state="continuous", task=1, trials=2,
+                             trajectory="optimal", max_episodes=2, max_total_steps=2000, noise=0.1)
+    again = armtransfer.transfer(source="planar2:joint", target="planar3:joint", state="continuous", task=1,
+                                 trials=2, trajectory="optimal", max_episodes=2, max_total_steps=2000, noise=0.1)
+    assert r.to_json() == again.to_json() and r.methods["none"].extra["noise"] == 0.1
+    for make in (lambda: gym.make("armtransfer/ContinuousArmRooms-v0", arm="planar3", noise=-0.1),
+                 lambda: gym.make("armtransfer/ContinuousArmRooms-v0", arm="planar3", noise=float("nan")),
+                 lambda: gym.make("armtransfer/ContinuousArmRooms-v0", arm="planar3", noise="x"),
+                 lambda: armtransfer.transfer(source="planar2", target="planar3:joint", noise=0.1),
+                 lambda: armtransfer.transfer(source="planar2:joint", target="planar3:joint", state="continuous",
+                                              noise=0.6)):
+        with pytest.raises(ArmTransferError, match="noise") as err:
+            make()
+        assert "\n" not in str(err.value)

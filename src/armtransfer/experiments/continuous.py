@@ -27,6 +27,10 @@ if TYPE_CHECKING:
     import pandas as pd
 
 
+NOISE_STREAM = 2
+"""``trial_rng``'s stream of a trial's actuation noise (0: the learner's, 1: the source robot's)."""
+
+
 @dataclass(frozen=True)
 class Approximation:
     """How the linear learner sees the arm's configuration: tile coding and traces."""
@@ -64,12 +68,17 @@ def run_method(method: str, arm, goal_cell: int, trajs: Sequence[Trajectory] | N
     shaping = cells.cell_shaping(method, arm.layout, trajs, K, config)
     coding, lin = approx.coding(arm), approx.linear()
     out = MethodResult(method)
+    noise = float(getattr(arm, "noise", 0.0))
     for trial in range(trials):
+        if noise > 0.0:  # the arm's own stream, trial by trial (the learner's is trial_rng(seed, trial))
+            arm.seed_noise(trial_rng(seed, trial, stream=NOISE_STREAM))
         out.trials.append(linear.learn(arm, goal_cell, coding, config, trial_rng(seed, trial), shaping, lin))
         if on_trial is not None:
             on_trial()
     out.extra["state"] = "continuous"
     out.extra["approximation"] = {**approx.to_json(), "features": coding.size}
+    if noise > 0.0:
+        out.extra["noise"] = noise
     if shaping is not None:
         out.extra["K"] = shaping.K
     return out

@@ -16,6 +16,15 @@ The label is the cell under the tool point (``ik.labels.cells_of_xy``'s rule: th
 (x, y) divided by the cell size and rounded half to even). The configuration is kept as
 q0 + n * delta with integer n, so a move and its reverse return to the same bits.
 
+**Actuation noise** (``noise=sigma`` > 0, the arm's counterpart of the paper's wind): each
+move turns its joint by delta * (1 + eps) instead of delta, eps ~ Normal(0, sigma^2) clipped
+to [-NOISE_CLIP, NOISE_CLIP], drawn from the arm's own generator (:meth:`ContinuousArm.seed_noise`).
+The configuration then leaves the lattice: q is q's previous value plus the noisy turn, the
+limits are the same box, the arc's points are spaced for the longest turn, (1 + NOISE_CLIP) *
+delta, and :meth:`ContinuousArm.place` starts at the IK solution itself (no snapping to the
+lattice). Inside :meth:`ContinuousArm.noiseless` (a greedy path's roll-out) the moves are the
+lattice's, from the start. With sigma = 0 nothing is drawn and every move is as without noise.
+
 A planar arm's joint axes are vertical, so the points along a move's arc are the tip rotated
 about the moved joint's anchor: they are computed from MuJoCo's tip and anchor at the end of
 the move (``_sweep``), without another MuJoCo call.
@@ -38,6 +47,12 @@ from armtransfer.ik.solve import TipIK
 
 BLOCKED = -2
 """What :meth:`ContinuousArm.move` returns for a blocked move (``OFF_TABLE`` is -1)."""
+NOISE_CLIP = 0.5
+"""The largest |eps| of a noisy move: it turns its joint by between 0.5 and 1.5 steps."""
+MAX_NOISE = 0.5
+"""The largest actuation noise sigma (the clip makes a larger one a uniform-like coin at the clip)."""
+NOISE_BUFFER = 1024
+"""Noise draws taken from the arm's generator at a time."""
 
 
 @numba.njit(cache=True)
@@ -48,6 +63,28 @@ def _cell(x, y, cell_size, lo, width):
     if cx < 0 or cy < 0 or cx >= width or cy >= width:
         return -1
     return cy * width + cx
+
+
+@numba.njit(cache=True)
+def _sweep_turn(tx, ty, ax, ay, back, m, cell_size, lo, width, free, near):
+    """``_sweep`` for a move of any turn: the k-th of the ``m`` points of the arc (k = 1..m) is
+    the tip turned back about the anchor by (1 - k / (m + 1)) * ``back`` radians."""
+    end = _cell(tx, ty, cell_size, lo, width)
+    if end < 0 or not free[end]:
+        return -1, False
+    close = near[end]
+    dx = tx - ax
+    dy = ty - ay
+    for k in range(1, m + 1):
+        angle = (1.0 - k / (m + 1)) * back
+        c = math.cos(angle)
+        s = math.sin(angle)
+        cell = _cell(ax + c * dx - s * dy, ay + s * dx + c * dy, cell_size, lo, width)
+        if cell < 0 or not free[cell]:
+            return -1, False
+        if near[cell]:
+            close = True
+    return end, close
 
 
 @numba.njit(cache=True)
@@ -100,7 +137,7 @@ class ContinuousArm:
     ``label`` the cell under the tool point, :meth:`tool_point` the point (x, y, z) in metres.
     Place the arm with :meth:`place` (over a cell, by IK) or :meth:`set_configuration`."""
 
-    def __init__(self, scene: ArmScene, step: float) -> None:
+    def __init__(self, scene: ArmScene, step: float, noise: float = 0.0) -> None:
         if not scene.planar:
             raise ArmModelError("the continuous arm moves its joints, which needs a planar arm (all joint axes "
                                 "vertical); this arm is spatial")
@@ -109,6 +146,15 @@ class ContinuousArm:
             raise ArmModelError("the continuous arm needs an arm with hinge joints only")
         if not (math.isfinite(step) and 0.0 < step <= math.pi):
             raise ArmModelError(f"the joint step must be in (0, pi] radians, got {step!r}")
+        if isinstance(noise, bool) or not isinstance(noise, (int, float, np.floating, np.integer)) \
+                or not (math.isfinite(noise) and 0.0 <= noise <= MAX_NOISE):
+            raise ArmModelError(f"the actuation noise sigma must be a number in [0, {MAX_NOISE}], got {noise!r}")
+        self.noise = float(noise)
+        """sigma of the actuation noise (0: none); see the module docstring."""
+        self._noisy = self.noise > 0.0
+        self._rng = np.random.default_rng(0)
+        self._eps: list[float] = []
+        self._k = 0
         self.scene = scene
         self.step = float(step)
         self.checker = ContactChecker(scene)
@@ -153,6 +199,13 @@ class ContinuousArm:
         lo = np.where(np.isfinite(scene.lower), scene.lower, -np.inf)
         hi = np.where(np.isfinite(scene.upper), scene.upper, np.inf)
         self._limits = (lo, hi)
+        # a noisy move's arc: points spaced for the longest turn, and the clearance it needs
+        longest = (1.0 + NOISE_CLIP) * self.step
+        self._axis_sign = axis_sign.tolist()
+        self._m_noisy = [max(1, int(math.ceil(2.0 * longest * reach[a // 2] / scene.cell)))
+                         for a in range(self.n_actions)]
+        self._clear_noisy = [int(math.ceil(longest * reach[a // 2] / scene.cell)) + 3 for a in range(self.n_actions)]
+        self._box: tuple[list[float], list[float]] = ([0.0] * self.dof, [0.0] * self.dof)
         self._q0: list[float] = [0.0] * self.dof  # lists: indexing them is cheaper than numpy's
         self._n: list[int] = [0] * self.dof
         self._nlo: list[int] = [0] * self.dof
@@ -183,6 +236,7 @@ class ContinuousArm:
         if cell < 0 or not self.layout.free[cell]:
             raise InvalidCellError("the arm's tool point is not over a free cell at this configuration")
         lo, hi = joint_box(self.scene, q)
+        self._box = (lo.tolist(), hi.tolist())
         self._q0 = q.tolist()
         self._n = [0] * self.dof
         self._nlo = np.ceil((lo - q) / self.step - 1e-9).astype(np.int64).tolist()
@@ -210,7 +264,10 @@ class ContinuousArm:
 
     @property
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """(lowest, highest) configuration the moves from the current q0 can reach."""
+        """(lowest, highest) configuration the moves from the current q0 can reach (with noise:
+        the joint box itself)."""
+        if self._noisy:
+            return np.array(self._box[0]), np.array(self._box[1])
         q0 = np.array(self._q0)
         return q0 + np.array(self._nlo) * self.step, q0 + np.array(self._nhi) * self.step
 
@@ -229,7 +286,13 @@ class ContinuousArm:
         res = ik.solve(target, self.scene.home)
         if not ik.ok(res):
             res = ik.solve_any(target, self.scene.home, np.random.default_rng(0))
-        if ik.ok(res):
+        if ik.ok(res) and self._noisy:  # no lattice to snap to
+            try:
+                if self.set_configuration(res.q) == cell:
+                    return self.q.copy()
+            except (ArmModelError, InvalidCellError):
+                pass
+        elif ik.ok(res):
             home = self.scene.home.astype(float)
             base = np.rint((res.q - home) / self.step)
             best, best_d = None, np.inf
@@ -252,15 +315,54 @@ class ContinuousArm:
         raise UnreachableTableError(f"the arm cannot place its tool point over cell {(x, y)} without touching "
                                     "anything")
 
-    def key(self) -> tuple[int, ...]:
-        """The configuration as integer steps from q0: equal keys are equal configurations."""
+    def key(self) -> tuple:
+        """The configuration as integer steps from q0 (with noise, the joint angles themselves):
+        equal keys are equal configurations."""
+        if self._noisy:
+            return tuple(self._qpos.tolist())
         return tuple(self._n)
+
+    # ------------------------------------------------------------------ actuation noise
+
+    def seed_noise(self, rng: np.random.Generator) -> None:
+        """Draw the actuation noise from ``rng`` from now on (nothing is drawn when sigma is 0)."""
+        if not isinstance(rng, np.random.Generator):
+            raise ArmModelError(f"the noise generator must be a numpy.random.Generator, got {rng!r}")
+        self._rng = rng
+        self._eps = []
+        self._k = 0
+
+    def _next_eps(self) -> float:
+        k = self._k
+        if k >= len(self._eps):
+            self._eps = np.clip(self._rng.normal(0.0, self.noise, NOISE_BUFFER), -NOISE_CLIP, NOISE_CLIP).tolist()
+            k = 0
+        self._k = k + 1
+        return self._eps[k]
+
+    class _Noiseless:
+        def __init__(self, arm: "ContinuousArm") -> None:
+            self.arm, self.was = arm, arm._noisy
+
+        def __enter__(self) -> "ContinuousArm":
+            self.arm._noisy = False
+            return self.arm
+
+        def __exit__(self, *exc: object) -> None:
+            self.arm._noisy = self.was
+
+    def noiseless(self) -> "ContinuousArm._Noiseless":
+        """A context in which the moves have no noise (a greedy path's roll-out: reset first,
+        the moves are then the lattice's from the start); no draw is taken inside it."""
+        return ContinuousArm._Noiseless(self)
 
     # ------------------------------------------------------------------ moving
 
     def move(self, a: int) -> int:
         """Take action ``a`` (0 .. 2 * dof - 1): the cell under the tool point after the move,
         or ``BLOCKED`` when the move is blocked (the arm has not moved)."""
+        if self._noisy:
+            return self._move_noisy(a)
         j = a >> 1
         n = self._n[j] + 1 - 2 * (a & 1)
         self.moves += 1
@@ -290,6 +392,43 @@ class ContinuousArm:
             qpos[j] = old
             return BLOCKED
         self._n[j] = n
+        self._tip = (x, y, z)
+        self.label = cell
+        return cell
+
+    def _move_noisy(self, a: int) -> int:
+        """:meth:`move` with actuation noise: the turn is step * (1 + eps) (one draw per move,
+        blocked moves included), from q itself."""
+        j = a >> 1
+        sign = 1.0 - 2.0 * (a & 1)
+        turn = sign * self.step * (1.0 + self._next_eps())
+        self.moves += 1
+        qpos = self._qpos
+        old = float(qpos[j])
+        new = old + turn
+        if new < self._box[0][j] or new > self._box[1][j]:
+            return BLOCKED
+        qpos[j] = new
+        m, d = self.model, self.data
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_collision(m, d)
+        if d.ncon and self.checker.touches_now():
+            qpos[j] = old
+            return BLOCKED
+        x, y, z = self._site_xpos[self._tip_id].tolist()
+        cx, cy = round(x / self._cell_size) - self._lo, round(y / self._cell_size) - self._lo
+        width = self._width
+        cell = cy * width + cx if 0 <= cx < width and 0 <= cy < width else -1
+        if cell < 0 or self._clear[cell] < self._clear_noisy[a]:
+            anchor = self._xanchor[self._jnt[j]]
+            cell, close = _sweep_turn(x, y, anchor[0], anchor[1], -turn * self._axis_sign[j], self._m_noisy[a],
+                                      self._cell_size, self._lo, width, self._free, self._near)
+            if cell < 0 or ((close or self._always_probe) and self._probe_touches(a, old)):
+                qpos[j] = old
+                return BLOCKED
+        elif self._always_probe and self._probe_touches(a, old):
+            qpos[j] = old
+            return BLOCKED
         self._tip = (x, y, z)
         self.label = cell
         return cell

@@ -24,7 +24,9 @@ the same steps, bit for bit:
 The robot is any object with the :class:`Mover` interface: ``reset()`` puts it at the
 start and returns its label, ``move(a)`` returns the label reached or a negative number when
 the move is blocked (the robot stays), ``q`` is its configuration (float64, read after every
-move), ``key()`` a hashable name of its state (equal keys: the same configuration).
+move), ``key()`` a hashable name of its state (equal keys: the same configuration). A robot
+whose moves are noisy may have ``noiseless()``, a context in which they are not: the greedy
+path is rolled out inside it (as the tabular learner's greedy path has no wind).
 
 The random stream is drawn in the tabular learner's order: one draw for epsilon-greedy and
 one more for a random action or a tie (``sarsa``'s docstring, point 2). The robot draws
@@ -313,7 +315,16 @@ def learn(mover: Mover, goal: int, coding: TileCoding, config: LearnerConfig, rn
 
 def _greedy_path(mover: Mover, learner: _Learner, goal: int, cap: int) -> tuple[list, bool]:
     """The greedy path from the start: (the states' keys, whether it reached the goal). It
-    stops at the goal, at a state visited before, or after ``cap`` states."""
+    stops at the goal, at a state visited before, or after ``cap`` states (without noise, when
+    the robot has ``noiseless()``)."""
+    quiet = getattr(mover, "noiseless", None)
+    if quiet is not None:
+        with quiet():
+            return _greedy_path_of(mover, learner, goal, cap)
+    return _greedy_path_of(mover, learner, goal, cap)
+
+
+def _greedy_path_of(mover: Mover, learner: _Learner, goal: int, cap: int) -> tuple[list, bool]:
     label = mover.reset()
     key = mover.key()
     path = [key]

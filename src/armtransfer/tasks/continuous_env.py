@@ -75,6 +75,8 @@ class ContinuousArmRoomsEnv(gym.Env):
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         check_reset_options(options)
         super().reset(seed=seed)
+        if self.arm.noise > 0.0:  # the actuation noise draws from the environment's generator
+            self.arm.seed_noise(self.np_random)
         label = self.arm.reset()
         return self._obs(), {"label": label}
 
@@ -108,6 +110,6 @@ def make_continuous_arm_rooms_env(arm: str | None = "planar3", task: int | str |
     the_task = rooms_task(task, start, goal, world)
     arm_kwargs = {k: kwargs.pop(k) for k in ARM_OPTIONS if k in kwargs}
     if kwargs.pop("wind", 0.0) != 0.0:
-        raise InvalidParameterError("the continuous arm has no wind; valid wind: 0")
+        raise InvalidParameterError("the continuous arm has no wind (its counterpart is noise=SIGMA); valid wind: 0")
     spec = None if arm_kwargs.get("xml_path") is not None else arm
     return ContinuousArmRoomsEnv(continuous_arm(spec, layout=the_task.layout, **arm_kwargs), the_task, **kwargs)
