@@ -272,7 +272,7 @@ def _run(args) -> int:
         raise InvalidParameterError(f"--out {str(out)!r} must be an absent or empty directory")
     if args.seeds < 1 or args.rounds < 1 or args.rate_steps < 100:
         raise InvalidParameterError("--seeds and --rounds must be positive and --rate-steps at least 100")
-    approx = runs.Approximation(tilings=args.tilings, width=args.width)
+    approx = runs.Approximation(tilings=args.tilings, width=args.width, table_bits=args.table_bits)
     noise = checks.real(args.noise, "--noise (the actuation noise sigma)", 0.0, MAX_NOISE)
     bad = [t for t in args.tasks if t not in TABLE_I] + [p for p in args.pairs if p not in PAIRS]
     if bad:
@@ -322,6 +322,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--rate-steps", type=int, default=100_000)
     p.add_argument("--tilings", type=int, default=runs.Approximation().tilings)
     p.add_argument("--width", type=float, default=runs.Approximation().width, help="tile width in joint steps")
+    p.add_argument("--table-bits", type=int, default=0, metavar="K",
+                   help="hashed tile coding into 2**K features per action (default 0: dense tiles)")
     p.add_argument("--cap", type=int, default=150_000, help="steps per trial at most")
     p.add_argument("--episodes", type=int, default=300)
     p.add_argument("--episode-cap", type=int, default=50_000, help="steps per episode after the first at most")

@@ -229,3 +229,87 @@ def test_the_noisy_environment_and_api_are_reproducible_and_refuse_bad_noise_in_
         with pytest.raises(ArmTransferError, match="noise") as err:
             make()
         assert "\n" not in str(err.value)
+
+
+def _reference_hash(t, coords, table):
+    """The hash the tiles module documents, on Python integers."""
+    m, g = 2**64, 0x9E3779B97F4A7C15
+
+    def mix(z):
+        z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) % m
+        z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) % m
+        return z ^ (z >> 31)
+
+    h = mix((t + 1) * g % m)
+    for c in coords:
+        h = mix((h + int(c) + g) % m)
+    return h & (table - 1)
+
+
+def test_hashed_tiles_are_the_dense_tiles_under_the_documented_hash():
+    from armtransfer.learning.tiles import TileCoding
+
+    lo, hi = [-3.0, -2.0, -2.5], [3.0, 2.0, 2.5]
+    dense = TileCoding.over(lo, hi, 0.24, 8)
+    hashed = TileCoding.over(lo, hi, 0.24, 8, table_bits=12)
+    assert hashed.size == 4096 and hashed.tilings == 8
+    rng = np.random.default_rng(0)
+    points = rng.uniform(lo, hi, (300, 3))
+    for q in points[:50]:
+        f = hashed.active(q)
+        assert f.tolist() == [_reference_hash(t, c, 4096) for t, c in enumerate(hashed.tiles(q))]
+    # the same tiles: two points share a hashed feature of tiling t whenever they share the dense one
+    fd = np.array([dense.active(q) for q in points])
+    fh = np.array([hashed.active(q) for q in points])
+    same_dense = fd[:, None, :] == fd[None, :, :]
+    same_hashed = fh[:, None, :] == fh[None, :, :]
+    assert np.all(same_hashed[same_dense]) and same_dense.sum() > 300 * 8
+    for bits in (12, 4):
+        coding = TileCoding.over(lo, hi, 0.24, 8, table_bits=bits)
+        tiles = {(t, *coding.tiles(q)[t].tolist()) for q in points for t in range(8)}
+        feature = {k: _reference_hash(k[0], k[1:], 2**bits) for k in tiles}
+        owners = {}
+        for f in feature.values():
+            owners[f] = owners.get(f, 0) + 1
+        expected = {"tiles": len(tiles), "features": len(owners),
+                    "tiles_sharing": sum(v for v in owners.values() if v > 1)}
+        assert coding.collisions(points) == expected
+        assert expected["tiles_sharing"] > 0 and (bits == 4 or expected["features"] > 0.6 * expected["tiles"])
+    assert dense.collisions(points)["tiles_sharing"] == 0
+    for bad in (-1, 25, 2.0, True):
+        with pytest.raises(armtransfer.errors.InvalidParameterError, match="table_bits"):
+            TileCoding.over(lo, hi, 0.24, 8, table_bits=bad)
+
+
+def test_hashed_tiles_generalise_two_steps_and_their_memory_does_not_grow_with_the_joints():
+    """A 6-joint planar arm: its dense tiles are refused (the lattice is too big), hashed ones
+    take 2**16 features per action whatever the joint count; a configuration two steps away
+    (one step in each of two joints) shares features with q; the learner runs on it."""
+    from armtransfer.errors import InvalidParameterError
+    from armtransfer.experiments.continuous import Approximation
+    from armtransfer.learning import linear
+    from armtransfer.learning.config import LearnerConfig
+    from armtransfer.tasks.catalog import TABLE_I
+    from armtransfer.tasks.continuous import continuous_arm
+
+    sizes = {}
+    for spec in ("planar3", "gen:planar:6:0"):
+        arm = continuous_arm(spec)
+        start, goal = TABLE_I[1].cells(arm.layout)
+        arm.place(start)
+        coding = Approximation(table_bits=16).coding(arm)
+        sizes[arm.dof] = coding.size
+        q = arm.q.copy()
+        for j in range(arm.dof - 1):
+            two = q.copy()
+            two[j] += arm.step
+            two[j + 1] -= arm.step
+            assert len(set(coding.active(q)) & set(coding.active(two))) >= 1
+        far = q + 4 * arm.step
+        assert not set(coding.active(q)) & set(coding.active(far))
+    assert sizes == {3: 2**16, 6: 2**16}
+    with pytest.raises(InvalidParameterError, match="features"):
+        Approximation().coding(arm)  # 6 joints, dense: 2.7e7 features
+    r = linear.learn(arm, goal, coding, LearnerConfig(max_episodes=2, max_total_steps=2000), np.random.default_rng(0))
+    assert r.episodes >= 1 and np.abs(r.episode_steps).sum() <= 2000
+    assert Approximation(table_bits=16).to_json()["table_bits"] == 16 and "table_bits" not in Approximation().to_json()

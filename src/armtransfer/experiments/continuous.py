@@ -19,7 +19,7 @@ from armtransfer.errors import InvalidParameterError
 from armtransfer.experiments.experiment import MethodResult, trial_rng
 from armtransfer.learning import cells, linear
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.learning.tiles import TileCoding
+from armtransfer.learning.tiles import MAX_TABLE_BITS, TileCoding
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.catalog import Task
 
@@ -40,22 +40,26 @@ class Approximation:
     """A tile's width in joint steps (the arm's ``step``)."""
     traces: str = "accumulating"
     greedy_cap: int = linear.LinearConfig().greedy_cap
+    table_bits: int = 0
+    """0: dense tiles; k > 0: hashed into a table of 2**k features per action (``tiles``)."""
 
     def __post_init__(self) -> None:
         checks.whole(self.tilings, "tilings", 1, 64)
+        checks.whole(self.table_bits, "table_bits (0: dense tiles)", 0, MAX_TABLE_BITS)
         checks.real(self.width, "the tile width (joint steps)", 0.0, 1000.0, lo_open=True)
         linear.LinearConfig(self.traces, self.greedy_cap)  # its checks
 
     def coding(self, arm) -> TileCoding:
         """Tiles over the configurations the arm can reach from its start (``arm.bounds``)."""
         lo, hi = arm.bounds
-        return TileCoding.over(lo, hi, self.width * arm.step, self.tilings)
+        return TileCoding.over(lo, hi, self.width * arm.step, self.tilings, table_bits=self.table_bits)
 
     def linear(self) -> linear.LinearConfig:
         return linear.LinearConfig(self.traces, self.greedy_cap)
 
     def to_json(self) -> dict:
-        return {"tilings": self.tilings, "tile_width_steps": self.width, "traces": self.traces}
+        hashed = {"table_bits": self.table_bits} if self.table_bits else {}  # the dense runs' JSON is as it was
+        return {"tilings": self.tilings, "tile_width_steps": self.width, "traces": self.traces, **hashed}
 
 
 def run_method(method: str, arm, goal_cell: int, trajs: Sequence[Trajectory] | None, trials: int, seed: int,

@@ -109,22 +109,22 @@ def _values(w, feat, n_actions, qrow):
 
 
 @numba.njit(cache=True, nogil=True)
-def _begin(w, q, lower, width, offsets, dims, strides, per_tiling, feats, qrow, tr_sa, pos, p, c, u):
+def _begin(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa, pos, p, c, u):
     """Start an episode at the configuration ``q``: traces dropped, the features of q in
     ``feats[0]``, the first action chosen (epsilon-greedy) and returned."""
     for k in range(c[I_NTR]):
         pos[tr_sa[k]] = -1
     c[I_NTR] = 0
-    _tiles.active(q, lower, width, offsets, dims, strides, per_tiling, feats[0])
+    _tiles.features(q, lower, width, offsets, dims, strides, per_tiling, table, feats[0])
     n_actions = qrow.shape[1]
     _values(w, feats[0], n_actions, qrow)
     return _egreedy(qrow, n_actions, p[P_EPS], u, c)
 
 
 @numba.njit(cache=True, nogil=True)
-def _greedy(w, q, lower, width, offsets, dims, strides, per_tiling, feats, qrow):
+def _greedy(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow):
     """argmax Q at the configuration ``q`` (lowest index on ties), as ``sarsa._greedy_path``."""
-    _tiles.active(q, lower, width, offsets, dims, strides, per_tiling, feats[1])
+    _tiles.features(q, lower, width, offsets, dims, strides, per_tiling, table, feats[1])
     n_actions = qrow.shape[1]
     _values(w, feats[1], n_actions, qrow)
     best = qrow[0, 0]
@@ -137,7 +137,7 @@ def _greedy(w, q, lower, width, offsets, dims, strides, per_tiling, feats, qrow)
 
 
 @numba.njit(cache=True, nogil=True)
-def _update(w, q, lower, width, offsets, dims, strides, per_tiling, feats, qrow, tr_sa, tr_e, pos, p, c, u,
+def _update(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa, tr_e, pos, p, c, u,
             bonus, traj_index, phi, paid_stamp, a, label, label2, goal, best):
     """One step of Algorithm 1 after action ``a`` took the robot from a state labelled
     ``label`` (features ``feats[0]``) to one labelled ``label2`` at configuration ``q``: the
@@ -159,7 +159,7 @@ def _update(w, q, lower, width, offsets, dims, strides, per_tiling, feats, qrow,
         q_next = 0.0
         a2 = 0
     else:
-        _tiles.active(q, lower, width, offsets, dims, strides, per_tiling, feat2)
+        _tiles.features(q, lower, width, offsets, dims, strides, per_tiling, table, feat2)
         _values(w, feat2, n_actions, qrow)
         a2 = _egreedy(qrow, n_actions, p[P_EPS], u, c)
         q_next = qrow[0, a2]
@@ -202,8 +202,7 @@ class _Learner:
                  shaping: Shaping, rng: np.random.Generator) -> None:
         pairs = coding.size * n_actions
         self.w = np.zeros(pairs)
-        self.coding = (coding.lower, coding.width, coding.offsets, coding.dims, coding.strides,
-                       int(coding.per_tiling))
+        self.coding = coding.kernel_args()
         self.feats = np.zeros((2, coding.tilings), np.int64)
         self.qrow = np.zeros((1, n_actions))
         self.tr_sa, self.tr_e, self.pos = np.empty(pairs, np.int64), np.empty(pairs), np.full(pairs, -1, np.int64)
@@ -245,7 +244,7 @@ def learn(mover: Mover, goal: int, coding: TileCoding, config: LearnerConfig, rn
     if sh.guide is not None:
         raise InvalidParameterError("the linear learner has no guide: its methods are reward terms only")
     L = _Learner(coding, mover.n_actions, config, linear, sh, rng)
-    w, (lower, width, offsets, dims, strides, per_tiling), feats, qrow = L.w, L.coding, L.feats, L.qrow
+    w, (lower, width, offsets, dims, strides, per_tiling, table), feats, qrow = L.w, L.coding, L.feats, L.qrow
     tr_sa, tr_e, pos, p, c, u, low = L.tr_sa, L.tr_e, L.pos, L.p, L.c, L.u, L.low
     bonus, traj_index, phi, paid = L.rewards
     q = mover.q
@@ -275,7 +274,7 @@ def learn(mover: Mover, goal: int, coding: TileCoding, config: LearnerConfig, rn
             steps += 1
             if c[I_U] > low:
                 L.refill()
-            a, best = _update(w, q, lower, width, offsets, dims, strides, per_tiling, feats, qrow, tr_sa, tr_e, pos,
+            a, best = _update(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa, tr_e, pos,
                               p, c, u, bonus, traj_index, phi, paid, a, label, label2, goal, best)
             if label2 == goal:
                 reached = True
