@@ -313,3 +313,52 @@ def test_hashed_tiles_generalise_two_steps_and_their_memory_does_not_grow_with_t
     r = linear.learn(arm, goal, coding, LearnerConfig(max_episodes=2, max_total_steps=2000), np.random.default_rng(0))
     assert r.episodes >= 1 and np.abs(r.episode_steps).sum() <= 2000
     assert Approximation(table_bits=16).to_json()["table_bits"] == 16 and "table_bits" not in Approximation().to_json()
+
+
+def test_both_environments_pass_check_env_and_box_moves_are_checked_along_their_line():
+    import gymnasium as gym
+    from gymnasium.utils.env_checker import check_env
+
+    from armtransfer.errors import InvalidActionError, InvalidParameterError
+    from armtransfer.ik.labels import cells_of_xy
+
+    check_env(gym.make("armtransfer/ContinuousArmRooms-v0", arm="planar3", task=1).unwrapped)
+    env = gym.make("armtransfer/ContinuousArmRoomsBox-v0", arm="planar3", task=1).unwrapped
+    check_env(env)
+    same = gym.make("armtransfer/ContinuousArmRooms-v0", arm="planar3", task=1, actions="box").unwrapped
+    assert env.action_space == same.action_space and env.action_space.shape == (3,)
+    arm = env.arm
+    env.reset(seed=0)
+    rng = np.random.default_rng(1)
+    free = arm.layout.free
+    moved = blocked = 0
+    for _ in range(150):
+        q = arm.q.copy()
+        a = rng.uniform(-1, 1, 3)
+        obs, _, terminated, _, info = env.step(a)
+        after = arm.q.copy()
+        if info["blocked"]:
+            blocked += 1
+            assert after.tobytes() == q.tobytes()
+            continue
+        moved += 1
+        assert np.allclose(after - q, a * arm.step, rtol=0, atol=1e-12)
+        assert not arm.checker.touches(after)
+        assert info["label"] == int(cells_of_xy(arm.checker.tip(after), arm.scene.cell, arm.layout))
+        for t in np.linspace(0, 1, 41):
+            cell = int(cells_of_xy(arm.checker.tip(q + t * (after - q)), arm.scene.cell, arm.layout))
+            assert cell >= 0 and free[cell]
+        arm.q[:] = after
+        assert obs.tobytes() == np.concatenate([after, arm.tool_point()]).tobytes()
+        if terminated:
+            break
+    assert moved > 50 and blocked > 0
+    for bad in ([0.5, 0.5], [2.0, 0.0, 0.0], [np.nan, 0, 0], "x", 3):
+        with pytest.raises(InvalidActionError, match=r"3 finite numbers in \[-1, 1\]") as err:
+            env.step(bad)
+        assert "\n" not in str(err.value)
+    for kwargs in (dict(actions="boxes"), dict(actions=1)):
+        with pytest.raises(InvalidParameterError, match="valid actions: discrete, box"):
+            gym.make("armtransfer/ContinuousArmRooms-v0", arm="planar3", **kwargs)
+    with pytest.raises(InvalidParameterError, match="valid actions: box"):
+        gym.make("armtransfer/ContinuousArmRoomsBox-v0", arm="planar3", actions="discrete")

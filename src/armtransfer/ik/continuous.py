@@ -206,6 +206,7 @@ class ContinuousArm:
                          for a in range(self.n_actions)]
         self._clear_noisy = [int(math.ceil(longest * reach[a // 2] / scene.cell)) + 3 for a in range(self.n_actions)]
         self._box: tuple[list[float], list[float]] = ([0.0] * self.dof, [0.0] * self.dof)
+        self._reach = np.array(reach)
         self._q0: list[float] = [0.0] * self.dof  # lists: indexing them is cheaper than numpy's
         self._n: list[int] = [0] * self.dof
         self._nlo: list[int] = [0] * self.dof
@@ -429,6 +430,69 @@ class ContinuousArm:
         elif self._always_probe and self._probe_touches(a, old):
             qpos[j] = old
             return BLOCKED
+        self._tip = (x, y, z)
+        self.label = cell
+        return cell
+
+    @property
+    def box(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lowest, highest) configuration any move may reach: the joint box about the start
+        (an unlimited joint: pi either side of it)."""
+        return np.array(self._box[0]), np.array(self._box[1])
+
+    def move_by(self, dq: np.ndarray) -> int:
+        """Turn every joint at once, joint j by ``dq[j]`` radians (times 1 + eps_j with actuation
+        noise, one draw per joint): the cell under the tool point after the move, or
+        ``BLOCKED`` (the arm has not moved) when it leaves the joint box, MuJoCo reports a
+        contact at its end, or the tool point at its end or at points along the straight line in
+        joint space (spaced so that the tip moves at most half a cell between them, by
+        ``sum_j |dq_j| * reach_j``) is over a wall or off the table; near a wall MuJoCo is also
+        asked for contacts at up to 3 of those points. It leaves the lattice: :meth:`key` names
+        such a configuration only with noise; :meth:`reset` goes back to the lattice's start."""
+        turn = np.asarray(dq, dtype=np.float64).reshape(-1)
+        if turn.shape != (self.dof,) or not np.all(np.isfinite(turn)):
+            raise ArmModelError(f"a joint move of this arm is {self.dof} finite angles, got {dq!r}")
+        if self._noisy:
+            turn = turn * (1.0 + np.array([self._next_eps() for _ in range(self.dof)]))
+        self.moves += 1
+        qpos = self._qpos
+        old = qpos.copy()
+        new = old + turn
+        if np.any(new < self._box[0]) or np.any(new > self._box[1]):
+            return BLOCKED
+        qpos[:] = new
+        m, d = self.model, self.data
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_collision(m, d)
+        if d.ncon and self.checker.touches_now():
+            qpos[:] = old
+            return BLOCKED
+        x, y, z = self._site_xpos[self._tip_id].tolist()
+        cx, cy = round(x / self._cell_size) - self._lo, round(y / self._cell_size) - self._lo
+        width = self._width
+        cell = cy * width + cx if 0 <= cx < width and 0 <= cy < width else -1
+        sweep = float(np.abs(turn) @ self._reach)  # how far the tip can go along the move (metres)
+        if cell < 0 or self._clear[cell] < int(math.ceil(sweep / self.scene.cell)) + 3 or self._always_probe:
+            if cell < 0 or not self._free[cell]:
+                qpos[:] = old
+                return BLOCKED
+            close = bool(self._near[cell])
+            n = max(1, int(math.ceil(2.0 * sweep / self.scene.cell)))
+            for k in range(1, n + 1):
+                qpos[:] = old + (k / (n + 1)) * turn
+                mujoco.mj_kinematics(m, d)
+                px, py = self._site_xpos[self._tip_id, 0], self._site_xpos[self._tip_id, 1]
+                c = int(_cell(px, py, self._cell_size, self._lo, width))
+                if c < 0 or not self._free[c]:
+                    qpos[:] = old
+                    return BLOCKED
+                close = close or bool(self._near[c])
+            if close or self._always_probe:
+                for k in np.unique(np.linspace(1, n, min(n, 3)).round().astype(int)):
+                    if self.checker.touches(old + (k / (n + 1)) * turn):
+                        qpos[:] = old
+                        return BLOCKED
+            qpos[:] = new
         self._tip = (x, y, z)
         self.label = cell
         return cell
