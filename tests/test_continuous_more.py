@@ -362,3 +362,59 @@ def test_both_environments_pass_check_env_and_box_moves_are_checked_along_their_
             gym.make("armtransfer/ContinuousArmRooms-v0", arm="planar3", **kwargs)
     with pytest.raises(InvalidParameterError, match="valid actions: box"):
         gym.make("armtransfer/ContinuousArmRoomsBox-v0", arm="planar3", actions="discrete")
+
+
+def test_the_compiled_episode_is_the_python_loop_bit_for_bit():
+    """``experiments.fastloop`` (the arm's move and the learner's update compiled together, MuJoCo
+    called from numba) gives the trial ``learn``'s own loop gives, with the pseudo reward, and
+    also when every move with a contact is handed back to Python."""
+    from armtransfer.experiments import fastloop
+    from armtransfer.ik import fastmove
+    from armtransfer.learning import cells, linear
+    from armtransfer.learning import trajectory as trajectories
+    from armtransfer.learning.config import LearnerConfig
+    from armtransfer.learning.tiles import TileCoding
+    from armtransfer.tasks.arms import robot
+
+    arm, goal = _planar3()
+    start = arm.label
+    traj = trajectories.shortest(robot("planar3:joint"), start, goal)
+    shaping = cells.cell_shaping("pseudo", arm.layout, [traj], "auto", LearnerConfig())
+    coding = TileCoding.over(*arm.bounds, 2 * arm.step, 8)
+    config = LearnerConfig(max_episodes=3, max_total_steps=5000, max_episode_steps=2000)
+    steps_by = fastloop.episode_steps(arm)
+    assert steps_by is not None
+
+    def trial(by):
+        moves = arm.moves
+        r = linear.learn(arm, goal, coding, config, np.random.default_rng(11), shaping, linear.LinearConfig(greedy_cap=300),
+                         by)
+        return (r.episode_steps.tobytes(), r.greedy_lengths.tobytes(), r.exploration_steps, arm.key(),
+                arm.q.tobytes(), arm.moves - moves)
+
+    handed = []
+    real = arm.move
+
+    def counted(a):  # the moves taken in Python: the greedy roll-outs', and those handed back
+        handed.append(a)
+        return real(a)
+
+    arm.move = counted
+    try:
+        python = trial(None)
+        before = len(handed)
+        assert trial(steps_by) == python
+        greedy = len(handed) - before  # the fast trial's Python moves: its greedy roll-outs'
+        before = len(handed)
+        state = arm._fast
+        raw = state[0]
+        arm._fast = (raw[:6] + (np.int64(0),) + raw[7:],) + state[1:]  # the contacts "moved": Python takes those
+        try:
+            assert trial(steps_by) == python
+        finally:
+            arm._fast = state
+    finally:
+        arm.move = real
+    assert len(handed) - before > greedy  # and the moves with a contact, handed back
+    assert fastloop.episode_steps(_planar3(0.1)[0]) is None  # noise: no compiled move
+    assert fastmove.PYTHON == -3

@@ -73,10 +73,13 @@ def run_method(method: str, arm, goal_cell: int, trajs: Sequence[Trajectory] | N
     coding, lin = approx.coding(arm), approx.linear()
     out = MethodResult(method)
     noise = float(getattr(arm, "noise", 0.0))
+    from armtransfer.experiments import fastloop  # MuJoCo from numba: imported when a run needs it
+
+    steps_by = fastloop.episode_steps(arm)
     for trial in range(trials):
         if noise > 0.0:  # the arm's own stream, trial by trial (the learner's is trial_rng(seed, trial))
             arm.seed_noise(trial_rng(seed, trial, stream=NOISE_STREAM))
-        out.trials.append(linear.learn(arm, goal_cell, coding, config, trial_rng(seed, trial), shaping, lin))
+        out.trials.append(linear.learn(arm, goal_cell, coding, config, trial_rng(seed, trial), shaping, lin, steps_by))
         if on_trial is not None:
             on_trial()
     out.extra["state"] = "continuous"

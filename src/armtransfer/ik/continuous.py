@@ -216,6 +216,7 @@ class ContinuousArm:
         self._start: tuple[np.ndarray, int, tuple[float, float, float]] | None = None
         self.moves = 0
         """MuJoCo kinematics + collision calls made by :meth:`move` (blocked ones too)."""
+        self._fast: tuple | None | bool = False  # False: not built yet; None: not available
 
     # ------------------------------------------------------------------ placing the arm
 
@@ -496,6 +497,64 @@ class ContinuousArm:
         self._tip = (x, y, z)
         self.label = cell
         return cell
+
+    # ------------------------------------------------------------------ the compiled move
+
+    def fast(self) -> tuple | None:
+        """The arm's arrays for ``ik.fastmove.move`` (the compiled :meth:`move`), synced with
+        the arm; None when there is no compiled move (actuation noise on, or MuJoCo's memory not
+        as ``ik.fastmove.layout`` expects). Call :meth:`fast_done` after moving with it."""
+        if self._noisy:
+            return None
+        if self._fast is False:
+            self._fast = self._build_fast()
+        if self._fast is None or not isinstance(self._fast, tuple):
+            return None
+        state = self._fast
+        state[6][:] = self._q0
+        state[7][:] = self._n
+        state[7 + 1][:] = self._nlo
+        state[7 + 2][:] = self._nhi
+        state[24][:] = self._tip
+        state[25][0] = self.label
+        state[26][0] = self.moves
+        return state
+
+    def fast_done(self) -> None:
+        """Take back the arm's state from the compiled move's arrays."""
+        state = self._fast
+        assert isinstance(state, tuple)
+        self._n = state[7].tolist()
+        tip = state[24].tolist()
+        self._tip = (tip[0], tip[1], tip[2])
+        self.label = int(state[25][0])
+        self.moves = int(state[26][0])
+
+    def _build_fast(self) -> tuple | None:
+        from armtransfer.ik import fastmove
+
+        c = self.checker
+        g = np.arange(self.model.ngeom)
+        grid1, grid2 = np.meshgrid(g, g, indexing="ij")
+        g1, g2 = grid1.ravel(), grid2.ravel()
+        counts = ((c._env[g1] & c._moving[g2]) | (c._env[g2] & c._moving[g1]) | c._own(g1, g2))
+        rng = np.random.default_rng(0)
+        lo, hi = joint_box(self.scene, self.scene.home.astype(float))
+        qs = rng.uniform(lo, hi, (400, self.dof))
+        raw = fastmove.layout(self.model, self.data, counts.reshape(self.model.ngeom, self.model.ngeom), qs)
+        if raw is None:
+            return None
+        probe = np.zeros((self.n_actions, 3))
+        n_probe = np.zeros(self.n_actions, np.int64)
+        for a, ts in enumerate(self._probe):
+            probe[a, :len(ts)] = ts
+            n_probe[a] = len(ts)
+        return (raw, self._qpos, self._site_xpos, self._xanchor, int(self._tip_id), self._jnt.astype(np.int64),
+                np.zeros(self.dof), np.zeros(self.dof, np.int64), np.zeros(self.dof, np.int64),
+                np.zeros(self.dof, np.int64), self.step, self._cell_size, self._lo, self._width, self._free,
+                self._near, np.array(self._clear, np.int64), np.array(self._clear_needed, np.int64), self._cos,
+                self._sin, self._m, probe, n_probe, bool(self._always_probe), np.zeros(3), np.zeros(1, np.int64),
+                np.zeros(1, np.int64))
 
     def _probe_touches(self, a: int, old: float) -> bool:
         """MuJoCo contact at up to 3 points along the move from ``old`` (joint a // 2)."""

@@ -35,7 +35,7 @@ nothing.
 
 from __future__ import annotations
 
-from collections.abc import Hashable
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -233,13 +233,20 @@ class _Learner:
         return _greedy(self.w, q, *self.coding, self.feats, self.qrow)
 
 
+EpisodeSteps = Callable[["_Learner", int, int, float, int, int], tuple[int, int, float, bool]]
+"""Runs an episode's steps: (learner, a, label, best, limit, goal) -> (steps, a, best, reached),
+exactly as :func:`learn`'s own loop (``experiments.fastloop``: compiled, with the arm's move)."""
+
+
 def learn(mover: Mover, goal: int, coding: TileCoding, config: LearnerConfig, rng: np.random.Generator,
-          shaping: Shaping | None = None, linear: LinearConfig = LinearConfig()) -> TrialResult:
+          shaping: Shaping | None = None, linear: LinearConfig = LinearConfig(),
+          steps_by: EpisodeSteps | None = None) -> TrialResult:
     """One trial of linear SARSA(lambda) on ``mover`` towards the goal cell ``goal``.
 
     ``shaping`` holds per-*cell* arrays (``cells.cell_shaping``; None: no transfer). ``rng``
     is the only source of randomness. The result is ``sarsa.TrialResult``'s, with the paths
-    empty (a continuous robot has no state numbers to name them by)."""
+    empty (a continuous robot has no state numbers to name them by). ``steps_by``: what runs
+    each episode's steps (the same steps, faster; None: the loop here)."""
     sh = shaping if shaping is not None else Shaping.none(1)
     if sh.guide is not None:
         raise InvalidParameterError("the linear learner has no guide: its methods are reward terms only")
@@ -267,7 +274,9 @@ def learn(mover: Mover, goal: int, coding: TileCoding, config: LearnerConfig, rn
         limit = config.max_total_steps - total
         if ep > 0 and config.max_episode_steps < limit:
             limit = config.max_episode_steps
-        while steps < limit:
+        if steps_by is not None:
+            steps, a, best, reached = steps_by(L, a, label, best, limit, goal)
+        while steps_by is None and steps < limit:
             label2 = move(a)
             if label2 < 0:
                 label2 = label
