@@ -29,6 +29,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import os
 import platform
 import statistics
 import sys
@@ -88,38 +89,74 @@ def pairs(directory: Path, fast: bool, chosen: list[str], noise: float = 0.0) ->
 # ----------------------------------------------------------------------------- (a) step rate
 
 
-def step_rate(rounds: int, steps: int, approx: runs.Approximation) -> dict:
+RATE_ARMS = ("planar3", "gen:planar:6:0")
+"""The arms whose step rate is measured: planar3 and a generated 6-joint planar arm (hashed tiles:
+its dense tiles would be 2.7e7 features)."""
+HASHED_BITS = 16
+
+
+def _arm_rates(spec: str, rounds: int, steps: int, approx: runs.Approximation) -> dict:
+    """One arm's rates, every loop in each round: bare MuJoCo, the arm alone, the arm with the
+    learner (the compiled episode, ``experiments.fastloop``, and the Python loop), the
+    Gymnasium environment."""
+    import gymnasium as gym
     import mujoco
 
-    arm = continuous_arm("planar3")
+    from armtransfer.experiments import fastloop
+    from armtransfer.tasks.continuous_env import ContinuousArmRoomsEnv
+
+    arm = continuous_arm(spec)
     start, goal = TABLE_I[1].cells(arm.layout)
     arm.place(start)
+    if arm.dof > 4 and not approx.table_bits:
+        approx = dataclasses.replace(approx, table_bits=HASHED_BITS)
     coding = approx.coding(arm)
+    fast = fastloop.episode_steps(arm)
     config = LearnerConfig(max_episodes=1_000_000, max_total_steps=steps, max_episode_steps=steps)
-    linear.learn(arm, goal, coding, LearnerConfig(max_total_steps=2000), np.random.default_rng(0))  # compile
+    for by in (fast, None):  # compile (or load) the kernels first
+        linear.learn(arm, goal, coding, LearnerConfig(max_total_steps=2000), np.random.default_rng(0), steps_by=by)
+    env = ContinuousArmRoomsEnv(continuous_arm(spec), TABLE_I[1])
     m, d = arm.model, arm.data
     acts = np.random.default_rng(0).integers(0, arm.n_actions, steps).tolist()
-    learner, bare, alone = [], [], []
+    per: dict[str, list[float]] = {k: [] for k in ("bare", "arm", "learner", "learner_python", "env")}
     for r in range(rounds):
-        moves = arm.moves
-        t = time.perf_counter()
-        linear.learn(arm, goal, coding, config, np.random.default_rng(r))
-        learner.append((arm.moves - moves) / (time.perf_counter() - t))
         t = time.perf_counter()
         for _ in range(steps):
             mujoco.mj_kinematics(m, d)
             mujoco.mj_collision(m, d)
-        bare.append(steps / (time.perf_counter() - t))
+        per["bare"].append(steps / (time.perf_counter() - t))
         arm.reset()
         move = arm.move
         t = time.perf_counter()
         for a in acts:
             move(a)
-        alone.append(steps / (time.perf_counter() - t))
-    med = {k: statistics.median(v) for k, v in (("learner", learner), ("bare", bare), ("arm", alone))}
-    return {"rounds": rounds, "steps_per_round": steps, "per_round": {"learner": learner, "bare": bare, "arm": alone},
-            "median_steps_per_s": med, "ratio_to_bare": {k: med[k] / med["bare"] for k in ("learner", "arm")},
-            "features": coding.size, "tilings": approx.tilings}
+        per["arm"].append(steps / (time.perf_counter() - t))
+        for key, by in (("learner", fast), ("learner_python", None)):
+            moves = arm.moves
+            t = time.perf_counter()
+            linear.learn(arm, goal, coding, config, np.random.default_rng(r), steps_by=by)
+            per[key].append((arm.moves - moves) / (time.perf_counter() - t))
+        env.reset(seed=r)
+        step = env.step
+        t = time.perf_counter()
+        for a in acts:
+            if step(a)[2]:
+                env.reset()
+        per["env"].append(steps / (time.perf_counter() - t))
+    med = {k: statistics.median(v) for k, v in per.items()}
+    return {"dof": arm.dof, "compiled": fast is not None, "per_round": per, "median_steps_per_s": med,
+            "ratio_to_bare": {k: med[k] / med["bare"] for k in med if k != "bare"},
+            "features": coding.size, "tilings": approx.tilings, "table_bits": approx.table_bits}
+
+
+def step_rate(rounds: int, steps: int, approx: runs.Approximation, arms=RATE_ARMS) -> dict:
+    """The step rates of each of ``arms`` (:func:`_arm_rates`), one core; also planar3's under
+    the old keys."""
+    out = {spec: _arm_rates(spec, rounds, steps, approx) for spec in arms}
+    first = out[arms[0]]
+    return {"rounds": rounds, "steps_per_round": steps, "arms": out, "per_round": first["per_round"],
+            "median_steps_per_s": first["median_steps_per_s"], "ratio_to_bare": first["ratio_to_bare"],
+            "features": first["features"], "tilings": first["tilings"]}
 
 
 # ----------------------------------------------------------------------------- (b) Table I
@@ -200,14 +237,23 @@ def _pct(x) -> str:
 def markdown(result: dict) -> str:
     rate = result["rate"]
     med = rate["median_steps_per_s"]
-    lines = [f"Command: `{result['command']}`; {result['machine']}; {result['date']}.", "",
-             "Step rate (one core, planar3, medians of "
-             f"{rate['rounds']} rounds of {rate['steps_per_round']:,} steps):", "",
-             "| loop | steps/s | ratio to bare MuJoCo |", "|---|---:|---:|",
-             f"| bare `mj_kinematics` + `mj_collision` | {_n(med['bare'])} | 1 |",
-             f"| continuous arm alone (random actions) | {_n(med['arm'])} | {rate['ratio_to_bare']['arm']:.2f} |",
-             f"| arm + linear SARSA(lambda) ({rate['tilings']} tilings, {rate['features']:,} features) | "
-             f"{_n(med['learner'])} | {rate['ratio_to_bare']['learner']:.2f} |", ""]
+    lines = [f"Command: `{result['command']}`; {result['machine']}; {result['date']}; {result.get('load', '')}.",
+             "", "Step rate (one core, Table I task 1, medians of "
+             f"{rate['rounds']} rounds of {rate['steps_per_round']:,} steps, every loop in every round):", "",
+             "| arm | loop | steps/s | ratio to bare MuJoCo |", "|---|---|---:|---:|"]
+    names = {"bare": "bare `mj_kinematics` + `mj_collision`", "arm": "continuous arm alone (random actions)",
+             "learner": "arm + linear SARSA(lambda), compiled episode",
+             "learner_python": "arm + linear SARSA(lambda), Python loop",
+             "env": "Gymnasium environment (random actions)"}
+    for spec, r in rate["arms"].items():
+        med = r["median_steps_per_s"]
+        coding = (f"{r['tilings']} tilings, " + (f"hashed, 2^{r['table_bits']}" if r["table_bits"] else "dense")
+                  + f", {r['features']:,} features")
+        for key, name in names.items():
+            ratio = "1" if key == "bare" else f"{r['ratio_to_bare'][key]:.2f}"
+            extra = f" ({coding})" if key.startswith("learner") else ""
+            lines.append(f"| {spec} ({r['dof']} joints) | {name}{extra} | {_n(med[key])} | {ratio} |")
+    lines.append("")
     cfg = result["config"]
     if not result["table_one"]:
         return "\n".join(lines) + "\n"
@@ -287,6 +333,7 @@ def _run(args) -> int:
         config = LearnerConfig(max_episodes=args.episodes, max_total_steps=args.cap,
                                max_episode_steps=args.episode_cap, patience=args.patience)
     source_config = LearnerConfig()
+    load = os.getloadavg()
     print("step rate ...", file=sys.stderr, flush=True)
     rate = step_rate(args.rounds, args.rate_steps, approx)
     table: list[dict] = []
@@ -297,6 +344,7 @@ def _run(args) -> int:
     result = {"command": " ".join(["python", "benchmarks/bench_continuous.py", *sys.argv[1:]]),
               "machine": machine(),
               "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "seeds": args.seeds,
+              "load": "load average {:.2f} {:.2f} {:.2f} at the start".format(*load),
               "config": config.to_dict(), "approximation": dataclasses.asdict(approx), "noise": noise,
               "rate": rate, "table_one": table}
     out.mkdir(parents=True, exist_ok=True)

@@ -88,10 +88,9 @@ def _stale_caches() -> None:
 
     from armtransfer.learning import jitcache, sarsa, tiles, traces
 
-    continuous = Path(fastmove.__file__).with_name("continuous.py")
-    jitcache.invalidate_stale(fastmove.__name__, [fastmove._touches_now, fastmove._touches, fastmove.move],
-                              [continuous])
-    jitcache.invalidate_stale(__name__, [_run], [fastmove.__file__, continuous, linear.__file__, tiles.__file__,
+    arcs = Path(fastmove.__file__).with_name("arcs.py")
+    jitcache.invalidate_stale(fastmove.__name__, [fastmove._touches_now, fastmove._touches, fastmove.move], [arcs])
+    jitcache.invalidate_stale(__name__, [_run], [fastmove.__file__, arcs, linear.__file__, tiles.__file__,
                                                  traces.__file__, sarsa.__file__])
 
 

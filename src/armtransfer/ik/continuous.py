@@ -40,6 +40,7 @@ import numba
 import numpy as np
 
 from armtransfer.errors import ArmModelError, InvalidCellError, UnreachableTableError
+from armtransfer.ik.arcs import _cell, _sweep, _sweep_turn
 from armtransfer.ik.compile import joint_box, near_wall_mask
 from armtransfer.ik.labels import OFF_TABLE, cells_of_xy
 from armtransfer.ik.scene import ArmScene, ContactChecker
@@ -53,61 +54,6 @@ MAX_NOISE = 0.5
 """The largest actuation noise sigma (the clip makes a larger one a uniform-like coin at the clip)."""
 NOISE_BUFFER = 1024
 """Noise draws taken from the arm's generator at a time."""
-
-
-@numba.njit(cache=True)
-def _cell(x, y, cell_size, lo, width):
-    """The cell id under (x, y) (metres), -1 off the grid: ``ik.labels.cells_of_xy``'s rule."""
-    cx = int(np.rint(x / cell_size)) - lo
-    cy = int(np.rint(y / cell_size)) - lo
-    if cx < 0 or cy < 0 or cx >= width or cy >= width:
-        return -1
-    return cy * width + cx
-
-
-@numba.njit(cache=True)
-def _sweep_turn(tx, ty, ax, ay, back, m, cell_size, lo, width, free, near):
-    """``_sweep`` for a move of any turn: the k-th of the ``m`` points of the arc (k = 1..m) is
-    the tip turned back about the anchor by (1 - k / (m + 1)) * ``back`` radians."""
-    end = _cell(tx, ty, cell_size, lo, width)
-    if end < 0 or not free[end]:
-        return -1, False
-    close = near[end]
-    dx = tx - ax
-    dy = ty - ay
-    for k in range(1, m + 1):
-        angle = (1.0 - k / (m + 1)) * back
-        c = math.cos(angle)
-        s = math.sin(angle)
-        cell = _cell(ax + c * dx - s * dy, ay + s * dx + c * dy, cell_size, lo, width)
-        if cell < 0 or not free[cell]:
-            return -1, False
-        if near[cell]:
-            close = True
-    return end, close
-
-
-@numba.njit(cache=True)
-def _sweep(tx, ty, ax, ay, cos_back, sin_back, m, cell_size, lo, width, free, near):
-    """(the end's cell or -1 when the move is blocked by a wall or the table's edge, whether any
-    point of the move is near a wall). (tx, ty): the tip at the end of the move; (ax, ay): the
-    moved joint's anchor; the k-th point of the arc is the tip turned back about the anchor by
-    the angle whose cosine and sine are cos_back[k], sin_back[k]."""
-    end = _cell(tx, ty, cell_size, lo, width)
-    if end < 0 or not free[end]:
-        return -1, False
-    close = near[end]
-    dx = tx - ax
-    dy = ty - ay
-    for k in range(m):
-        c = cos_back[k]
-        s = sin_back[k]
-        cell = _cell(ax + c * dx - s * dy, ay + s * dx + c * dy, cell_size, lo, width)
-        if cell < 0 or not free[cell]:
-            return -1, False
-        if near[cell]:
-            close = True
-    return end, close
 
 
 def clearance_cells(layout) -> np.ndarray:

@@ -29,14 +29,13 @@ import glob
 import os
 from typing import Any
 
-import mujoco
 import numba
 import numpy as np
 from llvmlite import ir
 from numba.core import types
 from numba.extending import intrinsic
 
-from armtransfer.ik.continuous import _sweep
+from armtransfer.ik.arcs import _sweep
 
 PYTHON = -3
 """What the compiled move returns when the move must be taken in Python (nothing has changed)."""
@@ -50,6 +49,8 @@ _COL: Any = None
 
 def _library():
     """``mj_kinematics`` and ``mj_collision`` of the bindings' own library, as ctypes functions."""
+    import mujoco
+
     global _KIN, _COL
     if _KIN is None:
         files = sorted(glob.glob(os.path.join(os.path.dirname(mujoco.__file__), "libmujoco.so*")))
@@ -71,6 +72,8 @@ def _int32_at(address: int, n: int) -> np.ndarray:
 def layout(model, data, counts: np.ndarray, configurations: np.ndarray) -> tuple | None:
     """The raw views the compiled move reads, checked against the bindings at ``configurations``
     (some with contacts), or None. Leaves ``data.qpos`` as it found it."""
+    import mujoco
+
     if _library() is None or not hasattr(data, "_address") or not hasattr(model, "_address"):
         return None
     q0 = data.qpos.copy()
