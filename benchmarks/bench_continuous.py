@@ -335,7 +335,7 @@ def _run(args) -> int:
     source_config = LearnerConfig()
     load = os.getloadavg()
     print("step rate ...", file=sys.stderr, flush=True)
-    rate = step_rate(args.rounds, args.rate_steps, approx)
+    rate = step_rate(args.rounds, args.rate_steps, approx, RATE_ARMS[:1] if args.fast else RATE_ARMS)
     table: list[dict] = []
     if not args.rate_only:
         print("Table I ...", file=sys.stderr, flush=True)
