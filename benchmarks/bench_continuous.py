@@ -29,6 +29,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import os
 import platform
 import statistics
 import sys
@@ -39,10 +40,11 @@ from typing import Any
 
 import numpy as np
 
-from armtransfer import script
+from armtransfer import checks, script
 from armtransfer.errors import InvalidParameterError
 from armtransfer.experiments import continuous as runs
 from armtransfer.experiments.stats import learning_metrics, metrics, survival
+from armtransfer.ik.continuous import MAX_NOISE, NOISE_CLIP
 from armtransfer.experiments.experiment import source_trajectory, trial_rng
 from armtransfer.learning import linear
 from armtransfer.learning.config import LearnerConfig
@@ -57,67 +59,104 @@ BYO = "planar5"
 (meshes in a folder, a stylus body for its tool point), mounted where that module suggests."""
 
 
-def byo_arm(directory: Path, fast: bool):
+def byo_arm(directory: Path, fast: bool, noise: float = 0.0):
     sys.path.insert(0, str(ROOT / "tests"))
     import menagerie_like  # the project's own Menagerie-style arm files (tests/)
 
     xml = menagerie_like.planar5_straight(directory)
     opts = menagerie_like.SUGGESTED[BYO]
-    return continuous_arm(None, xml_path=xml, joint_step=0.35, **opts), f"{BYO} arm file (joint step 0.35)"
+    return (continuous_arm(None, xml_path=xml, joint_step=0.35, noise=noise, **opts),
+            f"{BYO} arm file (joint step 0.35)")
 
 
 PAIRS = ("planar2:joint->planar3", "ur5e_like:cartesian->planar2", f"planar2:joint->{BYO}")
 """The pairs measured, by the names ``--pairs`` takes."""
 
 
-def pairs(directory: Path, fast: bool, chosen: list[str]) -> list[tuple[str, str, Any]]:
+def pairs(directory: Path, fast: bool, chosen: list[str], noise: float = 0.0) -> list[tuple[str, str, Any]]:
     """(source spec, target name, target arm) of each chosen pair."""
     out = []
     for name in chosen:
         source, target = name.split("->")
         if target == BYO:
-            arm, label = byo_arm(directory, fast)
+            arm, label = byo_arm(directory, fast, noise)
             out.append((source, label + " (continuous)", arm))
         else:
-            out.append((source, f"{target}:joint (continuous)", continuous_arm(target)))
+            out.append((source, f"{target}:joint (continuous)", continuous_arm(target, noise=noise)))
     return out
 
 
 # ----------------------------------------------------------------------------- (a) step rate
 
 
-def step_rate(rounds: int, steps: int, approx: runs.Approximation) -> dict:
+RATE_ARMS = ("planar3", "gen:planar:6:0")
+"""The arms whose step rate is measured: planar3 and a generated 6-joint planar arm (hashed tiles:
+its dense tiles would be 2.7e7 features)."""
+HASHED_BITS = 16
+
+
+def _arm_rates(spec: str, rounds: int, steps: int, approx: runs.Approximation) -> dict:
+    """One arm's rates, every loop in each round: bare MuJoCo, the arm alone, the arm with the
+    learner (the compiled episode, ``experiments.fastloop``, and the Python loop), the
+    Gymnasium environment."""
+    import gymnasium as gym
     import mujoco
 
-    arm = continuous_arm("planar3")
+    from armtransfer.experiments import fastloop
+    from armtransfer.tasks.continuous_env import ContinuousArmRoomsEnv
+
+    arm = continuous_arm(spec)
     start, goal = TABLE_I[1].cells(arm.layout)
     arm.place(start)
+    if arm.dof > 4 and not approx.table_bits:
+        approx = dataclasses.replace(approx, table_bits=HASHED_BITS)
     coding = approx.coding(arm)
+    fast = fastloop.episode_steps(arm)
     config = LearnerConfig(max_episodes=1_000_000, max_total_steps=steps, max_episode_steps=steps)
-    linear.learn(arm, goal, coding, LearnerConfig(max_total_steps=2000), np.random.default_rng(0))  # compile
+    for by in (fast, None):  # compile (or load) the kernels first
+        linear.learn(arm, goal, coding, LearnerConfig(max_total_steps=2000), np.random.default_rng(0), steps_by=by)
+    env = ContinuousArmRoomsEnv(continuous_arm(spec), TABLE_I[1])
     m, d = arm.model, arm.data
     acts = np.random.default_rng(0).integers(0, arm.n_actions, steps).tolist()
-    learner, bare, alone = [], [], []
+    per: dict[str, list[float]] = {k: [] for k in ("bare", "arm", "learner", "learner_python", "env")}
     for r in range(rounds):
-        moves = arm.moves
-        t = time.perf_counter()
-        linear.learn(arm, goal, coding, config, np.random.default_rng(r))
-        learner.append((arm.moves - moves) / (time.perf_counter() - t))
         t = time.perf_counter()
         for _ in range(steps):
             mujoco.mj_kinematics(m, d)
             mujoco.mj_collision(m, d)
-        bare.append(steps / (time.perf_counter() - t))
+        per["bare"].append(steps / (time.perf_counter() - t))
         arm.reset()
         move = arm.move
         t = time.perf_counter()
         for a in acts:
             move(a)
-        alone.append(steps / (time.perf_counter() - t))
-    med = {k: statistics.median(v) for k, v in (("learner", learner), ("bare", bare), ("arm", alone))}
-    return {"rounds": rounds, "steps_per_round": steps, "per_round": {"learner": learner, "bare": bare, "arm": alone},
-            "median_steps_per_s": med, "ratio_to_bare": {k: med[k] / med["bare"] for k in ("learner", "arm")},
-            "features": coding.size, "tilings": approx.tilings}
+        per["arm"].append(steps / (time.perf_counter() - t))
+        for key, by in (("learner", fast), ("learner_python", None)):
+            moves = arm.moves
+            t = time.perf_counter()
+            linear.learn(arm, goal, coding, config, np.random.default_rng(r), steps_by=by)
+            per[key].append((arm.moves - moves) / (time.perf_counter() - t))
+        env.reset(seed=r)
+        step = env.step
+        t = time.perf_counter()
+        for a in acts:
+            if step(a)[2]:
+                env.reset()
+        per["env"].append(steps / (time.perf_counter() - t))
+    med = {k: statistics.median(v) for k, v in per.items()}
+    return {"dof": arm.dof, "compiled": fast is not None, "per_round": per, "median_steps_per_s": med,
+            "ratio_to_bare": {k: med[k] / med["bare"] for k in med if k != "bare"},
+            "features": coding.size, "tilings": approx.tilings, "table_bits": approx.table_bits}
+
+
+def step_rate(rounds: int, steps: int, approx: runs.Approximation, arms=RATE_ARMS) -> dict:
+    """The step rates of each of ``arms`` (:func:`_arm_rates`), one core; also planar3's under
+    the old keys."""
+    out = {spec: _arm_rates(spec, rounds, steps, approx) for spec in arms}
+    first = out[arms[0]]
+    return {"rounds": rounds, "steps_per_round": steps, "arms": out, "per_round": first["per_round"],
+            "median_steps_per_s": first["median_steps_per_s"], "ratio_to_bare": first["ratio_to_bare"],
+            "features": first["features"], "tilings": first["tilings"]}
 
 
 # ----------------------------------------------------------------------------- (b) Table I
@@ -153,9 +192,9 @@ def method_stats(trials: list, cap: int, horizon: int) -> dict:
 
 
 def table_one(seeds: int, config: LearnerConfig, source_config: LearnerConfig, approx: runs.Approximation,
-              directory: Path, fast: bool, tasks: list[int], chosen: list[str]) -> list[dict]:
+              directory: Path, fast: bool, tasks: list[int], chosen: list[str], noise: float = 0.0) -> list[dict]:
     out = []
-    for source_spec, target_name, arm in pairs(directory, fast, chosen):
+    for source_spec, target_name, arm in pairs(directory, fast, chosen, noise):
         source = tabular_robot(source_spec)
         for task in tasks:
             start, goal = TABLE_I[task].cells(arm.layout)
@@ -198,14 +237,23 @@ def _pct(x) -> str:
 def markdown(result: dict) -> str:
     rate = result["rate"]
     med = rate["median_steps_per_s"]
-    lines = [f"Command: `{result['command']}`; {result['machine']}; {result['date']}.", "",
-             "Step rate (one core, planar3, medians of "
-             f"{rate['rounds']} rounds of {rate['steps_per_round']:,} steps):", "",
-             "| loop | steps/s | ratio to bare MuJoCo |", "|---|---:|---:|",
-             f"| bare `mj_kinematics` + `mj_collision` | {_n(med['bare'])} | 1 |",
-             f"| continuous arm alone (random actions) | {_n(med['arm'])} | {rate['ratio_to_bare']['arm']:.2f} |",
-             f"| arm + linear SARSA(lambda) ({rate['tilings']} tilings, {rate['features']:,} features) | "
-             f"{_n(med['learner'])} | {rate['ratio_to_bare']['learner']:.2f} |", ""]
+    lines = [f"Command: `{result['command']}`; {result['machine']}; {result['date']}; {result.get('load', '')}.",
+             "", "Step rate (one core, Table I task 1, medians of "
+             f"{rate['rounds']} rounds of {rate['steps_per_round']:,} steps, every loop in every round):", "",
+             "| arm | loop | steps/s | ratio to bare MuJoCo |", "|---|---|---:|---:|"]
+    names = {"bare": "bare `mj_kinematics` + `mj_collision`", "arm": "continuous arm alone (random actions)",
+             "learner": "arm + linear SARSA(lambda), compiled episode",
+             "learner_python": "arm + linear SARSA(lambda), Python loop",
+             "env": "Gymnasium environment (random actions)"}
+    for spec, r in rate["arms"].items():
+        med = r["median_steps_per_s"]
+        coding = (f"{r['tilings']} tilings, " + (f"hashed, 2^{r['table_bits']}" if r["table_bits"] else "dense")
+                  + f", {r['features']:,} features")
+        for key, name in names.items():
+            ratio = "1" if key == "bare" else f"{r['ratio_to_bare'][key]:.2f}"
+            extra = f" ({coding})" if key.startswith("learner") else ""
+            lines.append(f"| {spec} ({r['dof']} joints) | {name}{extra} | {_n(med[key])} | {ratio} |")
+    lines.append("")
     cfg = result["config"]
     if not result["table_one"]:
         return "\n".join(lines) + "\n"
@@ -270,7 +318,8 @@ def _run(args) -> int:
         raise InvalidParameterError(f"--out {str(out)!r} must be an absent or empty directory")
     if args.seeds < 1 or args.rounds < 1 or args.rate_steps < 100:
         raise InvalidParameterError("--seeds and --rounds must be positive and --rate-steps at least 100")
-    approx = runs.Approximation(tilings=args.tilings, width=args.width)
+    approx = runs.Approximation(tilings=args.tilings, width=args.width, table_bits=args.table_bits)
+    noise = checks.real(args.noise, "--noise (the actuation noise sigma)", 0.0, MAX_NOISE)
     bad = [t for t in args.tasks if t not in TABLE_I] + [p for p in args.pairs if p not in PAIRS]
     if bad:
         raise InvalidParameterError(f"unknown task or pair {bad[0]!r}; valid tasks: {', '.join(map(str, TABLE_I))}; "
@@ -284,17 +333,19 @@ def _run(args) -> int:
         config = LearnerConfig(max_episodes=args.episodes, max_total_steps=args.cap,
                                max_episode_steps=args.episode_cap, patience=args.patience)
     source_config = LearnerConfig()
+    load = os.getloadavg()
     print("step rate ...", file=sys.stderr, flush=True)
-    rate = step_rate(args.rounds, args.rate_steps, approx)
+    rate = step_rate(args.rounds, args.rate_steps, approx, RATE_ARMS[:1] if args.fast else RATE_ARMS)
     table: list[dict] = []
     if not args.rate_only:
         print("Table I ...", file=sys.stderr, flush=True)
         with tempfile.TemporaryDirectory() as tmp:
-            table = table_one(args.seeds, config, source_config, approx, Path(tmp), args.fast, tasks, chosen)
+            table = table_one(args.seeds, config, source_config, approx, Path(tmp), args.fast, tasks, chosen, noise)
     result = {"command": " ".join(["python", "benchmarks/bench_continuous.py", *sys.argv[1:]]),
               "machine": machine(),
               "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "seeds": args.seeds,
-              "config": config.to_dict(), "approximation": dataclasses.asdict(approx),
+              "load": "load average {:.2f} {:.2f} {:.2f} at the start".format(*load),
+              "config": config.to_dict(), "approximation": dataclasses.asdict(approx), "noise": noise,
               "rate": rate, "table_one": table}
     out.mkdir(parents=True, exist_ok=True)
     (out / "continuous.json").write_text(json.dumps(result, indent=1, default=float) + "\n")
@@ -319,10 +370,15 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--rate-steps", type=int, default=100_000)
     p.add_argument("--tilings", type=int, default=runs.Approximation().tilings)
     p.add_argument("--width", type=float, default=runs.Approximation().width, help="tile width in joint steps")
+    p.add_argument("--table-bits", type=int, default=0, metavar="K",
+                   help="hashed tile coding into 2**K features per action (default 0: dense tiles)")
     p.add_argument("--cap", type=int, default=150_000, help="steps per trial at most")
     p.add_argument("--episodes", type=int, default=300)
     p.add_argument("--episode-cap", type=int, default=50_000, help="steps per episode after the first at most")
     p.add_argument("--patience", type=int, default=LearnerConfig().patience)
+    p.add_argument("--noise", type=float, default=0.0, metavar="SIGMA",
+                   help="the target arm's actuation noise in Table I (each move turns delta * (1 + eps), "
+                        f"eps ~ N(0, SIGMA^2) clipped to +-{NOISE_CLIP}; default 0: none)")
     args = p.parse_args(argv)
     if args.fast:
         args.seeds, args.rounds, args.rate_steps = min(args.seeds, 2), min(args.rounds, 2), min(args.rate_steps, 3000)

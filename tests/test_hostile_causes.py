@@ -361,7 +361,7 @@ def test_a_sweep_arm_table_name_is_checked(tmp_path):
 # ---- 9. the remaining API gaps ---------------------------------------------------------
 
 @pytest.mark.parametrize("env_id", ["armtransfer/Rooms-v0", "armtransfer/ArmRooms-v0",
-                                    "armtransfer/ContinuousArmRooms-v0"])
+                                    "armtransfer/ContinuousArmRooms-v0", "armtransfer/ContinuousArmRoomsBox-v0"])
 @pytest.mark.parametrize("options,words", [({"bogus": 1}, "'bogus'"), ([1], "must be a dict")])
 def test_reset_refuses_options_it_cannot_use(env_id, options, words):
     import gymnasium as gym

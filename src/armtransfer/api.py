@@ -73,6 +73,7 @@ def transfer(
     state: str = "discrete",
     world: str | Path | Layout | None = None,
     preset: str = "default",
+    noise: float = 0.0,
     **learner_options,
 ) -> TransferResult | ContinuousResult:
     """Transfer a trajectory from ``source`` to ``target`` and learn with each method.
@@ -98,7 +99,8 @@ def transfer(
     ``"PATH.xml"``, or ``"custom"`` with ``arm_xml=``) whose state is its joint configuration,
     learned by linear SARSA(lambda) over tile coding (:data:`STATES`); the methods are those
     paid on labels alone (``learning.cells.CELL_METHODS``), no controls or mapping are run, and
-    the result is an ``experiments.continuous.ContinuousResult``.
+    the result is an ``experiments.continuous.ContinuousResult``. ``noise`` (continuous only) is
+    the arm's actuation noise sigma (``ik.continuous``: each move turns delta * (1 + eps)).
     """
     if not isinstance(state, str) or state not in STATES:
         raise InvalidParameterError(f"unknown state {state!r}; valid states: {', '.join(STATES)}")
@@ -141,6 +143,10 @@ def transfer(
 
     the_task = _task(task, start, goal, specs, layout)
     start_cell, goal_cell = the_task.cells()
+    noise = checks.real(noise, "noise (the actuation noise sigma)", 0.0, 0.5)
+    if noise and state != "continuous":
+        raise InvalidParameterError("noise (actuation noise) applies to a continuous target; a discrete one has "
+                                    "wind; valid noise: 0")
     if state == "continuous":
         if wind:
             raise InvalidParameterError("a continuous target has no wind; valid wind: 0")
@@ -148,7 +154,7 @@ def transfer(
             raise InvalidParameterError("the action sequence mapping needs a discrete target; valid methods for a "
                                         "continuous one: " + ", ".join(_cell_methods()))
         return _transfer_continuous(source, target, the_task, method_names, specs, trials, seed, K, config,
-                                    arm_xml, options, progress)
+                                    arm_xml, options, progress, noise)
     src = resolve(source, xml_path=arm_xml, layout=layout, **options)
     tgt = resolve(target, xml_path=arm_xml, layout=layout, **options)
     for robot in (src, tgt):
@@ -226,7 +232,8 @@ def _cell_methods() -> tuple[str, ...]:
 
 
 def _transfer_continuous(source, target, the_task: Task, method_names: list[str], specs, trials: int, seed: int,
-                         K, config: LearnerConfig, arm_xml, options: dict, progress) -> ContinuousResult:
+                         K, config: LearnerConfig, arm_xml, options: dict, progress,
+                         noise: float = 0.0) -> ContinuousResult:
     """``transfer`` with a continuous-state target (see its docstring)."""
     from armtransfer.experiments import continuous as runs
     from armtransfer.tasks.continuous import ARM_KEYWORDS, continuous_arm
@@ -241,10 +248,10 @@ def _transfer_continuous(source, target, the_task: Task, method_names: list[str]
     if target.partition(":")[0] == "custom":
         if arm_xml is None:
             raise InvalidParameterError("target 'custom' needs arm_xml")
-        arm = continuous_arm(None, xml_path=arm_xml, layout=the_task.layout, **options)
+        arm = continuous_arm(None, xml_path=arm_xml, layout=the_task.layout, noise=noise, **options)
     else:
         arm = continuous_arm(target, layout=the_task.layout,
-                             **{k: v for k, v in options.items() if k in ("joint_step", "cell_size")})
+                             **{k: v for k, v in options.items() if k in ("joint_step", "cell_size")}, noise=noise)
     start_cell, goal_cell = the_task.cells(arm.layout)
     arm.place(start_cell)  # the task's start must be reachable before the source learns anything
     src = resolve(source, xml_path=arm_xml, layout=the_task.layout, **options)

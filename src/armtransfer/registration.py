@@ -18,6 +18,7 @@ ENVIRONMENTS = {
     "armtransfer/Rooms-v0": "armtransfer.tasks.envs:make_rooms_env",
     "armtransfer/ArmRooms-v0": "armtransfer.tasks.envs:make_arm_rooms_env",
     "armtransfer/ContinuousArmRooms-v0": "armtransfer.tasks.continuous_env:make_continuous_arm_rooms_env",
+    "armtransfer/ContinuousArmRoomsBox-v0": "armtransfer.tasks.continuous_env:make_continuous_arm_rooms_box_env",
 }
 MAX_EPISODE_STEPS = 100_000
 

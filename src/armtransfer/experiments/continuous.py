@@ -12,15 +12,23 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import armtransfer.checks as checks
 from armtransfer.errors import InvalidParameterError
 from armtransfer.experiments.experiment import MethodResult, trial_rng
 from armtransfer.learning import cells, linear
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.learning.tiles import TileCoding
+from armtransfer.learning.tiles import MAX_TABLE_BITS, TileCoding
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.catalog import Task
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+
+NOISE_STREAM = 2
+"""``trial_rng``'s stream of a trial's actuation noise (0: the learner's, 1: the source robot's)."""
 
 
 @dataclass(frozen=True)
@@ -32,22 +40,26 @@ class Approximation:
     """A tile's width in joint steps (the arm's ``step``)."""
     traces: str = "accumulating"
     greedy_cap: int = linear.LinearConfig().greedy_cap
+    table_bits: int = 0
+    """0: dense tiles; k > 0: hashed into a table of 2**k features per action (``tiles``)."""
 
     def __post_init__(self) -> None:
         checks.whole(self.tilings, "tilings", 1, 64)
+        checks.whole(self.table_bits, "table_bits (0: dense tiles)", 0, MAX_TABLE_BITS)
         checks.real(self.width, "the tile width (joint steps)", 0.0, 1000.0, lo_open=True)
         linear.LinearConfig(self.traces, self.greedy_cap)  # its checks
 
     def coding(self, arm) -> TileCoding:
         """Tiles over the configurations the arm can reach from its start (``arm.bounds``)."""
         lo, hi = arm.bounds
-        return TileCoding.over(lo, hi, self.width * arm.step, self.tilings)
+        return TileCoding.over(lo, hi, self.width * arm.step, self.tilings, table_bits=self.table_bits)
 
     def linear(self) -> linear.LinearConfig:
         return linear.LinearConfig(self.traces, self.greedy_cap)
 
     def to_json(self) -> dict:
-        return {"tilings": self.tilings, "tile_width_steps": self.width, "traces": self.traces}
+        hashed = {"table_bits": self.table_bits} if self.table_bits else {}  # the dense runs' JSON is as it was
+        return {"tilings": self.tilings, "tile_width_steps": self.width, "traces": self.traces, **hashed}
 
 
 def run_method(method: str, arm, goal_cell: int, trajs: Sequence[Trajectory] | None, trials: int, seed: int,
@@ -60,12 +72,20 @@ def run_method(method: str, arm, goal_cell: int, trajs: Sequence[Trajectory] | N
     shaping = cells.cell_shaping(method, arm.layout, trajs, K, config)
     coding, lin = approx.coding(arm), approx.linear()
     out = MethodResult(method)
+    noise = float(getattr(arm, "noise", 0.0))
+    from armtransfer.experiments import fastloop  # MuJoCo from numba: imported when a run needs it
+
+    steps_by = fastloop.episode_steps(arm)
     for trial in range(trials):
-        out.trials.append(linear.learn(arm, goal_cell, coding, config, trial_rng(seed, trial), shaping, lin))
+        if noise > 0.0:  # the arm's own stream, trial by trial (the learner's is trial_rng(seed, trial))
+            arm.seed_noise(trial_rng(seed, trial, stream=NOISE_STREAM))
+        out.trials.append(linear.learn(arm, goal_cell, coding, config, trial_rng(seed, trial), shaping, lin, steps_by))
         if on_trial is not None:
             on_trial()
     out.extra["state"] = "continuous"
     out.extra["approximation"] = {**approx.to_json(), "features": coding.size}
+    if noise > 0.0:
+        out.extra["noise"] = noise
     if shaping is not None:
         out.extra["K"] = shaping.K
     return out
@@ -112,9 +132,62 @@ class ContinuousResult:
                 "approximation": self.approximation.to_json(),
                 "results": {m: summary[r.label] for m, r in self.methods.items()}}
 
+    def _rows(self, out: dict) -> list[list[str]]:
+        """The table of :meth:`__repr__` and :meth:`_repr_html_`: a header, then per method its
+        mean exploration steps with their 95% CI, how many trials reached the goal and
+        converged, and the improvement over ``none``."""
+        from armtransfer.experiments.reports import report
+
+        rows = [["method", "mean exploration steps [95% CI]", "reached", "converged", "improvement"]]
+        for m, e in out["results"].items():
+            imp = e.get("improvement_percent")
+            conv = e.get("converged", [])
+            rows.append([m, f"{report.fmt_mean(e)} {report.fmt_ci(e['ci95'])}", report.fmt_reached(e),
+                         f"{sum(bool(c) for c in conv)}/{len(conv)}", "" if imp is None else f"{imp:+.1f}%"])
+        return rows
+
+    def _heading(self) -> str:
+        t = self.task
+        return (f"{t.name}: {tuple(t.start)} -> {tuple(t.goal)}, {self.source} -> {self.target}, "
+                f"{self.trials} trials, seed {self.seed}")
+
     def __repr__(self) -> str:
-        lines = [f"<ContinuousResult {self.task.name}: {self.source} -> {self.target} (continuous state), "
-                 f"{self.trials} trials"]
-        for r in self.methods.values():
-            lines.append(f"  {r!r}")
-        return "\n".join(lines) + ">"
+        """A few lines: the task and robots (the target's name says it is continuous), then a
+        row per method."""
+        rows = self._rows(self.to_json())
+        widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+        lines = ["  " + "  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
+        return f"<ContinuousResult {self._heading()}\n" + "\n".join(lines) + ">"
+
+    def _repr_html_(self) -> str:
+        """What Jupyter shows: the heading and the table of :meth:`__repr__`, as HTML."""
+        from html import escape
+
+        rows = self._rows(self.to_json())
+        head = "".join(f"<th>{escape(c)}</th>" for c in rows[0])
+        body = "".join("<tr>" + "".join(f"<td>{escape(c)}</td>" for c in r) + "</tr>" for r in rows[1:])
+        return (f"<p><b>{escape(self._heading())}</b></p>"
+                f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
+
+    def to_frame(self) -> "pd.DataFrame":
+        """A tidy pandas DataFrame, as ``TransferResult.to_frame``'s: one row per trial of every
+        method (``control`` is ``"none"``: a continuous run has no controls), every per-trial
+        metric a column, then the run's settings (task, robots, seed, trajectory length, the
+        tile coding, every learner setting). A trial that never reached the goal has
+        ``reached`` False and ``exploration_steps`` missing, censored at ``step_cap``. Needs
+        pandas (``pip install 'armtransfer[frames]'``)."""
+        from armtransfer.experiments.reports import frames
+        from armtransfer.experiments.results import _per_trial
+
+        frames.pandas()
+        out = self.to_json()
+        t = self.task
+        settings = {"task": t.name, "start": list(t.start), "goal": list(t.goal), "source": self.source,
+                    "target": self.target, "state": "continuous", "seed": self.seed, "trials": self.trials,
+                    "trajectory_length": len(self.trajectories[0]) if self.trajectories else None,
+                    **{f"approximation_{k}": v for k, v in self.approximation.to_json().items()},
+                    **self.config.to_dict()}
+        rows = []
+        for m, entry in out["results"].items():
+            rows += frames.trial_rows(m, None, _per_trial(entry, self.config.max_total_steps), settings)
+        return frames.frame(rows)

@@ -16,6 +16,15 @@ The label is the cell under the tool point (``ik.labels.cells_of_xy``'s rule: th
 (x, y) divided by the cell size and rounded half to even). The configuration is kept as
 q0 + n * delta with integer n, so a move and its reverse return to the same bits.
 
+**Actuation noise** (``noise=sigma`` > 0, the arm's counterpart of the paper's wind): each
+move turns its joint by delta * (1 + eps) instead of delta, eps ~ Normal(0, sigma^2) clipped
+to [-NOISE_CLIP, NOISE_CLIP], drawn from the arm's own generator (:meth:`ContinuousArm.seed_noise`).
+The configuration then leaves the lattice: q is q's previous value plus the noisy turn, the
+limits are the same box, the arc's points are spaced for the longest turn, (1 + NOISE_CLIP) *
+delta, and :meth:`ContinuousArm.place` starts at the IK solution itself (no snapping to the
+lattice). Inside :meth:`ContinuousArm.noiseless` (a greedy path's roll-out) the moves are the
+lattice's, from the start. With sigma = 0 nothing is drawn and every move is as without noise.
+
 A planar arm's joint axes are vertical, so the points along a move's arc are the tip rotated
 about the moved joint's anchor: they are computed from MuJoCo's tip and anchor at the end of
 the move (``_sweep``), without another MuJoCo call.
@@ -31,6 +40,7 @@ import numba
 import numpy as np
 
 from armtransfer.errors import ArmModelError, InvalidCellError, UnreachableTableError
+from armtransfer.ik.arcs import _cell, _sweep, _sweep_turn
 from armtransfer.ik.compile import joint_box, near_wall_mask
 from armtransfer.ik.labels import OFF_TABLE, cells_of_xy
 from armtransfer.ik.scene import ArmScene, ContactChecker
@@ -38,39 +48,12 @@ from armtransfer.ik.solve import TipIK
 
 BLOCKED = -2
 """What :meth:`ContinuousArm.move` returns for a blocked move (``OFF_TABLE`` is -1)."""
-
-
-@numba.njit(cache=True)
-def _cell(x, y, cell_size, lo, width):
-    """The cell id under (x, y) (metres), -1 off the grid: ``ik.labels.cells_of_xy``'s rule."""
-    cx = int(np.rint(x / cell_size)) - lo
-    cy = int(np.rint(y / cell_size)) - lo
-    if cx < 0 or cy < 0 or cx >= width or cy >= width:
-        return -1
-    return cy * width + cx
-
-
-@numba.njit(cache=True)
-def _sweep(tx, ty, ax, ay, cos_back, sin_back, m, cell_size, lo, width, free, near):
-    """(the end's cell or -1 when the move is blocked by a wall or the table's edge, whether any
-    point of the move is near a wall). (tx, ty): the tip at the end of the move; (ax, ay): the
-    moved joint's anchor; the k-th point of the arc is the tip turned back about the anchor by
-    the angle whose cosine and sine are cos_back[k], sin_back[k]."""
-    end = _cell(tx, ty, cell_size, lo, width)
-    if end < 0 or not free[end]:
-        return -1, False
-    close = near[end]
-    dx = tx - ax
-    dy = ty - ay
-    for k in range(m):
-        c = cos_back[k]
-        s = sin_back[k]
-        cell = _cell(ax + c * dx - s * dy, ay + s * dx + c * dy, cell_size, lo, width)
-        if cell < 0 or not free[cell]:
-            return -1, False
-        if near[cell]:
-            close = True
-    return end, close
+NOISE_CLIP = 0.5
+"""The largest |eps| of a noisy move: it turns its joint by between 0.5 and 1.5 steps."""
+MAX_NOISE = 0.5
+"""The largest actuation noise sigma (the clip makes a larger one a uniform-like coin at the clip)."""
+NOISE_BUFFER = 1024
+"""Noise draws taken from the arm's generator at a time."""
 
 
 def clearance_cells(layout) -> np.ndarray:
@@ -100,7 +83,7 @@ class ContinuousArm:
     ``label`` the cell under the tool point, :meth:`tool_point` the point (x, y, z) in metres.
     Place the arm with :meth:`place` (over a cell, by IK) or :meth:`set_configuration`."""
 
-    def __init__(self, scene: ArmScene, step: float) -> None:
+    def __init__(self, scene: ArmScene, step: float, noise: float = 0.0) -> None:
         if not scene.planar:
             raise ArmModelError("the continuous arm moves its joints, which needs a planar arm (all joint axes "
                                 "vertical); this arm is spatial")
@@ -109,6 +92,15 @@ class ContinuousArm:
             raise ArmModelError("the continuous arm needs an arm with hinge joints only")
         if not (math.isfinite(step) and 0.0 < step <= math.pi):
             raise ArmModelError(f"the joint step must be in (0, pi] radians, got {step!r}")
+        if isinstance(noise, bool) or not isinstance(noise, (int, float, np.floating, np.integer)) \
+                or not (math.isfinite(noise) and 0.0 <= noise <= MAX_NOISE):
+            raise ArmModelError(f"the actuation noise sigma must be a number in [0, {MAX_NOISE}], got {noise!r}")
+        self.noise = float(noise)
+        """sigma of the actuation noise (0: none); see the module docstring."""
+        self._noisy = self.noise > 0.0
+        self._rng = np.random.default_rng(0)
+        self._eps: list[float] = []
+        self._k = 0
         self.scene = scene
         self.step = float(step)
         self.checker = ContactChecker(scene)
@@ -153,14 +145,24 @@ class ContinuousArm:
         lo = np.where(np.isfinite(scene.lower), scene.lower, -np.inf)
         hi = np.where(np.isfinite(scene.upper), scene.upper, np.inf)
         self._limits = (lo, hi)
+        # a noisy move's arc: points spaced for the longest turn, and the clearance it needs
+        longest = (1.0 + NOISE_CLIP) * self.step
+        self._axis_sign = axis_sign.tolist()
+        self._m_noisy = [max(1, int(math.ceil(2.0 * longest * reach[a // 2] / scene.cell)))
+                         for a in range(self.n_actions)]
+        self._clear_noisy = [int(math.ceil(longest * reach[a // 2] / scene.cell)) + 3 for a in range(self.n_actions)]
+        self._box: tuple[list[float], list[float]] = ([0.0] * self.dof, [0.0] * self.dof)
+        self._reach = np.array(reach)
         self._q0: list[float] = [0.0] * self.dof  # lists: indexing them is cheaper than numpy's
         self._n: list[int] = [0] * self.dof
         self._nlo: list[int] = [0] * self.dof
         self._nhi: list[int] = [0] * self.dof
         self.label = OFF_TABLE
-        self._start: tuple[np.ndarray, int] | None = None
+        self._tip: tuple[float, float, float] = (math.nan, math.nan, math.nan)
+        self._start: tuple[np.ndarray, int, tuple[float, float, float]] | None = None
         self.moves = 0
         """MuJoCo kinematics + collision calls made by :meth:`move` (blocked ones too)."""
+        self._fast: tuple | None | bool = False  # False: not built yet; None: not available
 
     # ------------------------------------------------------------------ placing the arm
 
@@ -177,16 +179,19 @@ class ContinuousArm:
         if self.checker.touches(q):
             raise ArmModelError("the arm touches the table, a wall or itself at this configuration")
         tip = self.data.site_xpos[self._tip_id].copy()
+        x, y, z = tip.tolist()
         cell = int(cells_of_xy(tip, self.scene.cell, self.layout))
         if cell < 0 or not self.layout.free[cell]:
             raise InvalidCellError("the arm's tool point is not over a free cell at this configuration")
         lo, hi = joint_box(self.scene, q)
+        self._box = (lo.tolist(), hi.tolist())
         self._q0 = q.tolist()
         self._n = [0] * self.dof
         self._nlo = np.ceil((lo - q) / self.step - 1e-9).astype(np.int64).tolist()
         self._nhi = np.floor((hi - q) / self.step + 1e-9).astype(np.int64).tolist()
         self._qpos[:] = q
-        self._start = (q.copy(), cell)
+        self._start = (q.copy(), cell, (x, y, z))
+        self._tip = (x, y, z)
         self.label = cell
         return cell
 
@@ -194,9 +199,10 @@ class ContinuousArm:
         """Back to the configuration last set (:meth:`set_configuration`, :meth:`place`); its label."""
         if self._start is None:
             raise ArmModelError("place the arm (place or set_configuration) before resetting it")
-        q, cell = self._start
+        q, cell, tip = self._start
         self._qpos[:] = q
         self._n = [0] * self.dof
+        self._tip = tip
         self.label = cell
         return cell
 
@@ -206,7 +212,10 @@ class ContinuousArm:
 
     @property
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """(lowest, highest) configuration the moves from the current q0 can reach."""
+        """(lowest, highest) configuration the moves from the current q0 can reach (with noise:
+        the joint box itself)."""
+        if self._noisy:
+            return np.array(self._box[0]), np.array(self._box[1])
         q0 = np.array(self._q0)
         return q0 + np.array(self._nlo) * self.step, q0 + np.array(self._nhi) * self.step
 
@@ -225,7 +234,13 @@ class ContinuousArm:
         res = ik.solve(target, self.scene.home)
         if not ik.ok(res):
             res = ik.solve_any(target, self.scene.home, np.random.default_rng(0))
-        if ik.ok(res):
+        if ik.ok(res) and self._noisy:  # no lattice to snap to
+            try:
+                if self.set_configuration(res.q) == cell:
+                    return self.q.copy()
+            except (ArmModelError, InvalidCellError):
+                pass
+        elif ik.ok(res):
             home = self.scene.home.astype(float)
             base = np.rint((res.q - home) / self.step)
             best, best_d = None, np.inf
@@ -248,15 +263,54 @@ class ContinuousArm:
         raise UnreachableTableError(f"the arm cannot place its tool point over cell {(x, y)} without touching "
                                     "anything")
 
-    def key(self) -> tuple[int, ...]:
-        """The configuration as integer steps from q0: equal keys are equal configurations."""
+    def key(self) -> tuple:
+        """The configuration as integer steps from q0 (with noise, the joint angles themselves):
+        equal keys are equal configurations."""
+        if self._noisy:
+            return tuple(self._qpos.tolist())
         return tuple(self._n)
+
+    # ------------------------------------------------------------------ actuation noise
+
+    def seed_noise(self, rng: np.random.Generator) -> None:
+        """Draw the actuation noise from ``rng`` from now on (nothing is drawn when sigma is 0)."""
+        if not isinstance(rng, np.random.Generator):
+            raise ArmModelError(f"the noise generator must be a numpy.random.Generator, got {rng!r}")
+        self._rng = rng
+        self._eps = []
+        self._k = 0
+
+    def _next_eps(self) -> float:
+        k = self._k
+        if k >= len(self._eps):
+            self._eps = np.clip(self._rng.normal(0.0, self.noise, NOISE_BUFFER), -NOISE_CLIP, NOISE_CLIP).tolist()
+            k = 0
+        self._k = k + 1
+        return self._eps[k]
+
+    class _Noiseless:
+        def __init__(self, arm: "ContinuousArm") -> None:
+            self.arm, self.was = arm, arm._noisy
+
+        def __enter__(self) -> "ContinuousArm":
+            self.arm._noisy = False
+            return self.arm
+
+        def __exit__(self, *exc: object) -> None:
+            self.arm._noisy = self.was
+
+    def noiseless(self) -> "ContinuousArm._Noiseless":
+        """A context in which the moves have no noise (a greedy path's roll-out: reset first,
+        the moves are then the lattice's from the start); no draw is taken inside it."""
+        return ContinuousArm._Noiseless(self)
 
     # ------------------------------------------------------------------ moving
 
     def move(self, a: int) -> int:
         """Take action ``a`` (0 .. 2 * dof - 1): the cell under the tool point after the move,
         or ``BLOCKED`` when the move is blocked (the arm has not moved)."""
+        if self._noisy:
+            return self._move_noisy(a)
         j = a >> 1
         n = self._n[j] + 1 - 2 * (a & 1)
         self.moves += 1
@@ -271,7 +325,7 @@ class ContinuousArm:
         if d.ncon and self.checker.touches_now():  # the kinematics and contacts just computed
             qpos[j] = old
             return BLOCKED
-        x, y, _ = self._site_xpos[self._tip_id].tolist()
+        x, y, z = self._site_xpos[self._tip_id].tolist()
         cx, cy = round(x / self._cell_size) - self._lo, round(y / self._cell_size) - self._lo
         width = self._width
         cell = cy * width + cx if 0 <= cx < width and 0 <= cy < width else -1
@@ -286,8 +340,167 @@ class ContinuousArm:
             qpos[j] = old
             return BLOCKED
         self._n[j] = n
+        self._tip = (x, y, z)
         self.label = cell
         return cell
+
+    def _move_noisy(self, a: int) -> int:
+        """:meth:`move` with actuation noise: the turn is step * (1 + eps) (one draw per move,
+        blocked moves included), from q itself."""
+        j = a >> 1
+        sign = 1.0 - 2.0 * (a & 1)
+        turn = sign * self.step * (1.0 + self._next_eps())
+        self.moves += 1
+        qpos = self._qpos
+        old = float(qpos[j])
+        new = old + turn
+        if new < self._box[0][j] or new > self._box[1][j]:
+            return BLOCKED
+        qpos[j] = new
+        m, d = self.model, self.data
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_collision(m, d)
+        if d.ncon and self.checker.touches_now():
+            qpos[j] = old
+            return BLOCKED
+        x, y, z = self._site_xpos[self._tip_id].tolist()
+        cx, cy = round(x / self._cell_size) - self._lo, round(y / self._cell_size) - self._lo
+        width = self._width
+        cell = cy * width + cx if 0 <= cx < width and 0 <= cy < width else -1
+        if cell < 0 or self._clear[cell] < self._clear_noisy[a]:
+            anchor = self._xanchor[self._jnt[j]]
+            cell, close = _sweep_turn(x, y, anchor[0], anchor[1], -turn * self._axis_sign[j], self._m_noisy[a],
+                                      self._cell_size, self._lo, width, self._free, self._near)
+            if cell < 0 or ((close or self._always_probe) and self._probe_touches(a, old)):
+                qpos[j] = old
+                return BLOCKED
+        elif self._always_probe and self._probe_touches(a, old):
+            qpos[j] = old
+            return BLOCKED
+        self._tip = (x, y, z)
+        self.label = cell
+        return cell
+
+    @property
+    def box(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lowest, highest) configuration any move may reach: the joint box about the start
+        (an unlimited joint: pi either side of it)."""
+        return np.array(self._box[0]), np.array(self._box[1])
+
+    def move_by(self, dq: np.ndarray) -> int:
+        """Turn every joint at once, joint j by ``dq[j]`` radians (times 1 + eps_j with actuation
+        noise, one draw per joint): the cell under the tool point after the move, or
+        ``BLOCKED`` (the arm has not moved) when it leaves the joint box, MuJoCo reports a
+        contact at its end, or the tool point at its end or at points along the straight line in
+        joint space (spaced so that the tip moves at most half a cell between them, by
+        ``sum_j |dq_j| * reach_j``) is over a wall or off the table; near a wall MuJoCo is also
+        asked for contacts at up to 3 of those points. It leaves the lattice: :meth:`key` names
+        such a configuration only with noise; :meth:`reset` goes back to the lattice's start."""
+        turn = np.asarray(dq, dtype=np.float64).reshape(-1)
+        if turn.shape != (self.dof,) or not np.all(np.isfinite(turn)):
+            raise ArmModelError(f"a joint move of this arm is {self.dof} finite angles, got {dq!r}")
+        if self._noisy:
+            turn = turn * (1.0 + np.array([self._next_eps() for _ in range(self.dof)]))
+        self.moves += 1
+        qpos = self._qpos
+        old = qpos.copy()
+        new = old + turn
+        if np.any(new < self._box[0]) or np.any(new > self._box[1]):
+            return BLOCKED
+        qpos[:] = new
+        m, d = self.model, self.data
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_collision(m, d)
+        if d.ncon and self.checker.touches_now():
+            qpos[:] = old
+            return BLOCKED
+        x, y, z = self._site_xpos[self._tip_id].tolist()
+        cx, cy = round(x / self._cell_size) - self._lo, round(y / self._cell_size) - self._lo
+        width = self._width
+        cell = cy * width + cx if 0 <= cx < width and 0 <= cy < width else -1
+        sweep = float(np.abs(turn) @ self._reach)  # how far the tip can go along the move (metres)
+        if cell < 0 or self._clear[cell] < int(math.ceil(sweep / self.scene.cell)) + 3 or self._always_probe:
+            if cell < 0 or not self._free[cell]:
+                qpos[:] = old
+                return BLOCKED
+            close = bool(self._near[cell])
+            n = max(1, int(math.ceil(2.0 * sweep / self.scene.cell)))
+            for k in range(1, n + 1):
+                qpos[:] = old + (k / (n + 1)) * turn
+                mujoco.mj_kinematics(m, d)
+                px, py = self._site_xpos[self._tip_id, 0], self._site_xpos[self._tip_id, 1]
+                c = int(_cell(px, py, self._cell_size, self._lo, width))
+                if c < 0 or not self._free[c]:
+                    qpos[:] = old
+                    return BLOCKED
+                close = close or bool(self._near[c])
+            if close or self._always_probe:
+                for k in np.unique(np.linspace(1, n, min(n, 3)).round().astype(int)):
+                    if self.checker.touches(old + (k / (n + 1)) * turn):
+                        qpos[:] = old
+                        return BLOCKED
+            qpos[:] = new
+        self._tip = (x, y, z)
+        self.label = cell
+        return cell
+
+    # ------------------------------------------------------------------ the compiled move
+
+    def fast(self) -> tuple | None:
+        """The arm's arrays for ``ik.fastmove.move`` (the compiled :meth:`move`), synced with
+        the arm; None when there is no compiled move (actuation noise on, or MuJoCo's memory not
+        as ``ik.fastmove.layout`` expects). Call :meth:`fast_done` after moving with it."""
+        if self._noisy:
+            return None
+        if self._fast is False:
+            self._fast = self._build_fast()
+        if self._fast is None or not isinstance(self._fast, tuple):
+            return None
+        state = self._fast
+        state[6][:] = self._q0
+        state[7][:] = self._n
+        state[7 + 1][:] = self._nlo
+        state[7 + 2][:] = self._nhi
+        state[24][:] = self._tip
+        state[25][0] = self.label
+        state[26][0] = self.moves
+        return state
+
+    def fast_done(self) -> None:
+        """Take back the arm's state from the compiled move's arrays."""
+        state = self._fast
+        assert isinstance(state, tuple)
+        self._n = state[7].tolist()
+        tip = state[24].tolist()
+        self._tip = (tip[0], tip[1], tip[2])
+        self.label = int(state[25][0])
+        self.moves = int(state[26][0])
+
+    def _build_fast(self) -> tuple | None:
+        from armtransfer.ik import fastmove
+
+        c = self.checker
+        g = np.arange(self.model.ngeom)
+        grid1, grid2 = np.meshgrid(g, g, indexing="ij")
+        g1, g2 = grid1.ravel(), grid2.ravel()
+        counts = ((c._env[g1] & c._moving[g2]) | (c._env[g2] & c._moving[g1]) | c._own(g1, g2))
+        rng = np.random.default_rng(0)
+        lo, hi = joint_box(self.scene, self.scene.home.astype(float))
+        qs = rng.uniform(lo, hi, (400, self.dof))
+        raw = fastmove.layout(self.model, self.data, counts.reshape(self.model.ngeom, self.model.ngeom), qs)
+        if raw is None:
+            return None
+        probe = np.zeros((self.n_actions, 3))
+        n_probe = np.zeros(self.n_actions, np.int64)
+        for a, ts in enumerate(self._probe):
+            probe[a, :len(ts)] = ts
+            n_probe[a] = len(ts)
+        return (raw, self._qpos, self._site_xpos, self._xanchor, int(self._tip_id), self._jnt.astype(np.int64),
+                np.zeros(self.dof), np.zeros(self.dof, np.int64), np.zeros(self.dof, np.int64),
+                np.zeros(self.dof, np.int64), self.step, self._cell_size, self._lo, self._width, self._free,
+                self._near, np.array(self._clear, np.int64), np.array(self._clear_needed, np.int64), self._cos,
+                self._sin, self._m, probe, n_probe, bool(self._always_probe), np.zeros(3), np.zeros(1, np.int64),
+                np.zeros(1, np.int64))
 
     def _probe_touches(self, a: int, old: float) -> bool:
         """MuJoCo contact at up to 3 points along the move from ``old`` (joint a // 2)."""
@@ -303,6 +516,12 @@ class ContinuousArm:
         q[j] = end
         self._qpos[:] = q  # the data's configuration is the end's again (kinematics are refreshed by the next move)
         return hit
+
+    def tip(self) -> tuple[float, float, float]:
+        """The tool point (x, y, z) at the current configuration, as the kinematics of the move
+        (or placement) that reached it computed it: no MuJoCo call. The same numbers as
+        :meth:`tool_point` (MuJoCo's kinematics are deterministic)."""
+        return self._tip
 
     def tool_point(self) -> np.ndarray:
         """The tool point at the current configuration (MuJoCo's kinematics, run now)."""

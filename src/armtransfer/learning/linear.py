@@ -24,7 +24,9 @@ the same steps, bit for bit:
 The robot is any object with the :class:`Mover` interface: ``reset()`` puts it at the
 start and returns its label, ``move(a)`` returns the label reached or a negative number when
 the move is blocked (the robot stays), ``q`` is its configuration (float64, read after every
-move), ``key()`` a hashable name of its state (equal keys: the same configuration).
+move), ``key()`` a hashable name of its state (equal keys: the same configuration). A robot
+whose moves are noisy may have ``noiseless()``, a context in which they are not: the greedy
+path is rolled out inside it (as the tabular learner's greedy path has no wind).
 
 The random stream is drawn in the tabular learner's order: one draw for epsilon-greedy and
 one more for a random action or a tie (``sarsa``'s docstring, point 2). The robot draws
@@ -33,7 +35,7 @@ nothing.
 
 from __future__ import annotations
 
-from collections.abc import Hashable
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -107,22 +109,22 @@ def _values(w, feat, n_actions, qrow):
 
 
 @numba.njit(cache=True, nogil=True)
-def _begin(w, q, lower, width, offsets, dims, strides, per_tiling, feats, qrow, tr_sa, pos, p, c, u):
+def _begin(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa, pos, p, c, u):
     """Start an episode at the configuration ``q``: traces dropped, the features of q in
     ``feats[0]``, the first action chosen (epsilon-greedy) and returned."""
     for k in range(c[I_NTR]):
         pos[tr_sa[k]] = -1
     c[I_NTR] = 0
-    _tiles.active(q, lower, width, offsets, dims, strides, per_tiling, feats[0])
+    _tiles.features(q, lower, width, offsets, dims, strides, per_tiling, table, feats[0])
     n_actions = qrow.shape[1]
     _values(w, feats[0], n_actions, qrow)
     return _egreedy(qrow, n_actions, p[P_EPS], u, c)
 
 
 @numba.njit(cache=True, nogil=True)
-def _greedy(w, q, lower, width, offsets, dims, strides, per_tiling, feats, qrow):
+def _greedy(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow):
     """argmax Q at the configuration ``q`` (lowest index on ties), as ``sarsa._greedy_path``."""
-    _tiles.active(q, lower, width, offsets, dims, strides, per_tiling, feats[1])
+    _tiles.features(q, lower, width, offsets, dims, strides, per_tiling, table, feats[1])
     n_actions = qrow.shape[1]
     _values(w, feats[1], n_actions, qrow)
     best = qrow[0, 0]
@@ -135,7 +137,7 @@ def _greedy(w, q, lower, width, offsets, dims, strides, per_tiling, feats, qrow)
 
 
 @numba.njit(cache=True, nogil=True)
-def _update(w, q, lower, width, offsets, dims, strides, per_tiling, feats, qrow, tr_sa, tr_e, pos, p, c, u,
+def _update(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa, tr_e, pos, p, c, u,
             bonus, traj_index, phi, paid_stamp, a, label, label2, goal, best):
     """One step of Algorithm 1 after action ``a`` took the robot from a state labelled
     ``label`` (features ``feats[0]``) to one labelled ``label2`` at configuration ``q``: the
@@ -157,7 +159,7 @@ def _update(w, q, lower, width, offsets, dims, strides, per_tiling, feats, qrow,
         q_next = 0.0
         a2 = 0
     else:
-        _tiles.active(q, lower, width, offsets, dims, strides, per_tiling, feat2)
+        _tiles.features(q, lower, width, offsets, dims, strides, per_tiling, table, feat2)
         _values(w, feat2, n_actions, qrow)
         a2 = _egreedy(qrow, n_actions, p[P_EPS], u, c)
         q_next = qrow[0, a2]
@@ -200,8 +202,7 @@ class _Learner:
                  shaping: Shaping, rng: np.random.Generator) -> None:
         pairs = coding.size * n_actions
         self.w = np.zeros(pairs)
-        self.coding = (coding.lower, coding.width, coding.offsets, coding.dims, coding.strides,
-                       int(coding.per_tiling))
+        self.coding = coding.kernel_args()
         self.feats = np.zeros((2, coding.tilings), np.int64)
         self.qrow = np.zeros((1, n_actions))
         self.tr_sa, self.tr_e, self.pos = np.empty(pairs, np.int64), np.empty(pairs), np.full(pairs, -1, np.int64)
@@ -232,18 +233,25 @@ class _Learner:
         return _greedy(self.w, q, *self.coding, self.feats, self.qrow)
 
 
+EpisodeSteps = Callable[["_Learner", int, int, float, int, int], tuple[int, int, float, bool]]
+"""Runs an episode's steps: (learner, a, label, best, limit, goal) -> (steps, a, best, reached),
+exactly as :func:`learn`'s own loop (``experiments.fastloop``: compiled, with the arm's move)."""
+
+
 def learn(mover: Mover, goal: int, coding: TileCoding, config: LearnerConfig, rng: np.random.Generator,
-          shaping: Shaping | None = None, linear: LinearConfig = LinearConfig()) -> TrialResult:
+          shaping: Shaping | None = None, linear: LinearConfig = LinearConfig(),
+          steps_by: EpisodeSteps | None = None) -> TrialResult:
     """One trial of linear SARSA(lambda) on ``mover`` towards the goal cell ``goal``.
 
     ``shaping`` holds per-*cell* arrays (``cells.cell_shaping``; None: no transfer). ``rng``
     is the only source of randomness. The result is ``sarsa.TrialResult``'s, with the paths
-    empty (a continuous robot has no state numbers to name them by)."""
+    empty (a continuous robot has no state numbers to name them by). ``steps_by``: what runs
+    each episode's steps (the same steps, faster; None: the loop here)."""
     sh = shaping if shaping is not None else Shaping.none(1)
     if sh.guide is not None:
         raise InvalidParameterError("the linear learner has no guide: its methods are reward terms only")
     L = _Learner(coding, mover.n_actions, config, linear, sh, rng)
-    w, (lower, width, offsets, dims, strides, per_tiling), feats, qrow = L.w, L.coding, L.feats, L.qrow
+    w, (lower, width, offsets, dims, strides, per_tiling, table), feats, qrow = L.w, L.coding, L.feats, L.qrow
     tr_sa, tr_e, pos, p, c, u, low = L.tr_sa, L.tr_e, L.pos, L.p, L.c, L.u, L.low
     bonus, traj_index, phi, paid = L.rewards
     q = mover.q
@@ -266,14 +274,16 @@ def learn(mover: Mover, goal: int, coding: TileCoding, config: LearnerConfig, rn
         limit = config.max_total_steps - total
         if ep > 0 and config.max_episode_steps < limit:
             limit = config.max_episode_steps
-        while steps < limit:
+        if steps_by is not None:
+            steps, a, best, reached = steps_by(L, a, label, best, limit, goal)
+        while steps_by is None and steps < limit:
             label2 = move(a)
             if label2 < 0:
                 label2 = label
             steps += 1
             if c[I_U] > low:
                 L.refill()
-            a, best = _update(w, q, lower, width, offsets, dims, strides, per_tiling, feats, qrow, tr_sa, tr_e, pos,
+            a, best = _update(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa, tr_e, pos,
                               p, c, u, bonus, traj_index, phi, paid, a, label, label2, goal, best)
             if label2 == goal:
                 reached = True
@@ -313,7 +323,16 @@ def learn(mover: Mover, goal: int, coding: TileCoding, config: LearnerConfig, rn
 
 def _greedy_path(mover: Mover, learner: _Learner, goal: int, cap: int) -> tuple[list, bool]:
     """The greedy path from the start: (the states' keys, whether it reached the goal). It
-    stops at the goal, at a state visited before, or after ``cap`` states."""
+    stops at the goal, at a state visited before, or after ``cap`` states (without noise, when
+    the robot has ``noiseless()``)."""
+    quiet = getattr(mover, "noiseless", None)
+    if quiet is not None:
+        with quiet():
+            return _greedy_path_of(mover, learner, goal, cap)
+    return _greedy_path_of(mover, learner, goal, cap)
+
+
+def _greedy_path_of(mover: Mover, learner: _Learner, goal: int, cap: int) -> tuple[list, bool]:
     label = mover.reset()
     key = mover.key()
     path = [key]

@@ -21,7 +21,7 @@ from armtransfer.worlds.layout import ROOMS, Layout
 
 ACTIONS = ("joint",)
 """The action models a continuous arm has."""
-ARM_KEYWORDS = ("tip_site", "tip_body", "tip_offset", "base_pos", "base_yaw", "joint_step", "cell_size")
+ARM_KEYWORDS = ("tip_site", "tip_body", "tip_offset", "base_pos", "base_yaw", "joint_step", "cell_size", "noise")
 """:func:`continuous_arm`'s keywords for the arm's tool point, mount and step (besides ``xml_path``)."""
 
 
@@ -55,12 +55,14 @@ def parse_spec(spec: str) -> tuple[str | None, str | None]:
 
 def continuous_arm(spec: str | None = None, *, xml_path=None, tip_site: str | None = None,
                    tip_body: str | None = None, tip_offset=None, base_pos=None, base_yaw: float | None = None,
-                   joint_step: float | None = None, cell_size: float | None = None, layout: Layout = ROOMS):
+                   joint_step: float | None = None, cell_size: float | None = None, layout: Layout = ROOMS,
+                   noise: float = 0.0):
     """The continuous arm of a built-in planar arm (``spec``, e.g. ``"planar3:joint"``) or of a
     planar arm file (``spec`` ``"PATH.xml"`` or ``xml_path=``) with its tool point and mount
     (a generated arm's from its sidecar; without ``base_pos`` the automatic mount), on the
-    world ``layout`` (its cell size ``ik.workspace.world_cell`` unless given)."""
-    from armtransfer.ik.continuous import ContinuousArm
+    world ``layout`` (its cell size ``ik.workspace.world_cell`` unless given); ``noise``: the
+    actuation noise sigma (``ik.continuous``; 0, the default: none)."""
+    from armtransfer.ik.continuous import MAX_NOISE, ContinuousArm
     from armtransfer.tasks.arms import arm_scene, automatic_mount, make_tool, read_sidecar
 
     name, path = parse_spec(spec) if spec is not None else (None, None)
@@ -69,11 +71,12 @@ def continuous_arm(spec: str | None = None, *, xml_path=None, tip_site: str | No
     if joint_step is not None:
         joint_step = checks.real(joint_step, "the joint step (radians)", 0.0, np.pi, lo_open=True,
                                  error=ArmModelError)
+    noise = checks.real(noise, "the actuation noise (noise, sigma)", 0.0, MAX_NOISE, error=ArmModelError)
     if path is None:
         if name is None:
             raise UnknownArmError("give a continuous arm: a built-in planar arm or an arm file")
         scene = arm_scene(name, cell_size=cell_size, layout=layout)
-        return ContinuousArm(scene, joint_step or ARMS[name].joint_step)
+        return ContinuousArm(scene, joint_step or ARMS[name].joint_step, noise)
     if tip_site is None and tip_body is None and spec is not None and spec.startswith("gen:"):
         tip_site = "tip"  # a generated arm's tool point
     generated = read_sidecar(path) if base_pos is None else None
@@ -86,7 +89,7 @@ def continuous_arm(spec: str | None = None, *, xml_path=None, tip_site: str | No
         base_pos, base_yaw = pose.pos, pose.yaw
     scene = arm_scene(None, cell_size=cell_size, xml_path=path, tip_site=tip_site, tip_body=tip_body,
                       tip_offset=tip_offset, base_pos=base_pos, base_yaw=base_yaw, layout=layout)
-    return ContinuousArm(scene, joint_step or ladder_step(scene))
+    return ContinuousArm(scene, joint_step or ladder_step(scene), noise)
 
 
 def ladder_step(scene) -> float:

@@ -4,7 +4,8 @@
 
 The observation is a ``Box``: the joint configuration q followed by the tool point (x, y, z)
 in metres; the action is ``Discrete(2 * dof)``: joint j turned by +delta (``2j``) or -delta
-(``2j+1``), as the ``joint`` action model. Every step runs MuJoCo (``ik.continuous``): a move
+(``2j+1``), as the ``joint`` action model. Every step runs MuJoCo once (``ik.continuous``; the tool point
+observed is that of the move's own kinematics, ``ContinuousArm.tip``): a move
 that is blocked leaves the arm where it was (``info["blocked"]``). Each step costs
 ``step_reward``; reaching the goal cell pays ``goal_reward`` and ends the episode.
 ``info["label"]`` is the cell under the tool point, which is what a transferred trajectory's
@@ -26,6 +27,9 @@ from armtransfer.tasks.continuous import ARM_KEYWORDS
 from armtransfer.tasks.envs import check_options, check_reset_options, rooms_task
 from armtransfer.tasks.robot import cell_robot
 
+ACTIONS = ("discrete", "box")
+"""The action spaces: ``Discrete(2 * dof)`` (one joint by +-delta) or ``Box(-1, 1, (dof,))``
+(every joint at once by a_j * delta)."""
 ARM_OPTIONS = ("xml_path", *ARM_KEYWORDS)
 """The keywords that build the arm (``tasks.continuous.continuous_arm``)."""
 REACH = 2.0
@@ -38,7 +42,10 @@ class ContinuousArmRoomsEnv(gym.Env):
     metadata = {"render_modes": ["ansi"], "render_fps": 4}
 
     def __init__(self, arm, task: Task, step_reward: float = -1.0, goal_reward: float = 0.0,
-                 render_mode: str | None = None) -> None:
+                 render_mode: str | None = None, actions: str = "discrete") -> None:
+        if not isinstance(actions, str) or actions not in ACTIONS:
+            raise InvalidParameterError(f"unknown actions {actions!r}; valid actions: {', '.join(ACTIONS)}")
+        self.actions = actions
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise InvalidParameterError(
                 f"unknown render_mode {render_mode!r}; valid: {', '.join(self.metadata['render_modes'])}")
@@ -51,16 +58,22 @@ class ContinuousArmRoomsEnv(gym.Env):
         self.start_cell, self.goal_cell = task.cells(layout)
         arm.place(self.start_cell)  # the start configuration: IK over the start cell
         self.start_q = arm.q.copy()
-        lo, hi = arm.bounds
+        lo, hi = arm.bounds if actions == "discrete" else arm.box
         self.observation_space = spaces.Box(np.concatenate([lo, [-REACH] * 3]), np.concatenate([hi, [REACH] * 3]),
                                             dtype=np.float64)
-        self.action_space = spaces.Discrete(arm.n_actions)
+        self.action_space: spaces.Space = (spaces.Discrete(arm.n_actions) if actions == "discrete" else
+                                           spaces.Box(-1.0, 1.0, (arm.dof,), dtype=np.float32))
+        self._obs_size = arm.dof + 3
         self.robot = cell_robot(layout)
         """The cells as a robot (states = cells): what ``TransferReward`` pays transfer by."""
         self.start_state = self.start_cell
 
     def _obs(self) -> np.ndarray:
-        return np.concatenate([self.arm.q, self.arm.tool_point()])
+        obs = np.empty(self._obs_size)  # q, then the tool point of the move's own kinematics (no second call)
+        dof = self.arm.dof
+        obs[:dof] = self.arm.q
+        obs[dof:] = self.arm.tip()
+        return obs
 
     def state_of(self, obs: np.ndarray, info: dict) -> int:
         """The state ``TransferReward`` pays by: the cell under the tool point."""
@@ -69,15 +82,35 @@ class ContinuousArmRoomsEnv(gym.Env):
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         check_reset_options(options)
         super().reset(seed=seed)
+        if self.arm.noise > 0.0:  # the actuation noise draws from the environment's generator
+            self.arm.seed_noise(self.np_random)
         label = self.arm.reset()
         return self._obs(), {"label": label}
 
     def step(self, action):
+        if self.actions == "box":
+            return self._step_box(action)
         if isinstance(action, (bool, np.bool_)) or not self.action_space.contains(action):
             raise InvalidActionError(
                 f"action must be an integer in 0..{self.arm.n_actions - 1} (the action space {self.action_space}), "
                 f"got {action!r}")
         moved = self.arm.move(int(action))
+        label = self.arm.label
+        terminated = label == self.goal_cell
+        reward = self.step_reward + (self.goal_reward if terminated else 0.0)
+        return self._obs(), reward, terminated, False, {"label": label, "blocked": moved < 0}
+
+    def _step_box(self, action):
+        dof = self.arm.dof
+        try:
+            a = np.asarray(action, dtype=np.float64)
+        except (TypeError, ValueError):
+            a = np.full(1, np.nan)
+        if a.shape != (dof,) or not np.all(np.isfinite(a)) or np.any(np.abs(a) > 1.0):
+            raise InvalidActionError(f"action must be {dof} finite numbers in [-1, 1] (the action space "
+                                     f"{self.action_space}: joint turns in steps of {self.arm.step:g} rad), "
+                                     f"got {action!r}")
+        moved = self.arm.move_by(a * self.arm.step)
         label = self.arm.label
         terminated = label == self.goal_cell
         reward = self.step_reward + (self.goal_reward if terminated else 0.0)
@@ -98,10 +131,21 @@ def make_continuous_arm_rooms_env(arm: str | None = "planar3", task: int | str |
     custom task; ``world=`` as the other environments'."""
     from armtransfer.tasks.continuous import continuous_arm
 
-    check_options(kwargs, ARM_OPTIONS)
+    check_options(kwargs, ARM_OPTIONS + ("actions",))
     the_task = rooms_task(task, start, goal, world)
     arm_kwargs = {k: kwargs.pop(k) for k in ARM_OPTIONS if k in kwargs}
     if kwargs.pop("wind", 0.0) != 0.0:
-        raise InvalidParameterError("the continuous arm has no wind; valid wind: 0")
+        raise InvalidParameterError("the continuous arm has no wind (its counterpart is noise=SIGMA); valid wind: 0")
     spec = None if arm_kwargs.get("xml_path") is not None else arm
     return ContinuousArmRoomsEnv(continuous_arm(spec, layout=the_task.layout, **arm_kwargs), the_task, **kwargs)
+
+
+def make_continuous_arm_rooms_box_env(arm: str | None = "planar3", task: int | str | None = 1,
+                                      start: tuple[int, int] | None = None, goal: tuple[int, int] | None = None,
+                                      world: Any = None, **kwargs: Any) -> ContinuousArmRoomsEnv:
+    """Entry point of ``armtransfer/ContinuousArmRoomsBox-v0``: ``ContinuousArmRooms-v0`` with
+    ``actions="box"``, a ``Box(-1, 1, (dof,))`` of joint turns in steps of delta."""
+    if kwargs.get("actions", "box") != "box":
+        raise InvalidParameterError("ContinuousArmRoomsBox-v0 has box actions; valid actions: box")
+    kwargs["actions"] = "box"
+    return make_continuous_arm_rooms_env(arm, task, start, goal, world, **kwargs)

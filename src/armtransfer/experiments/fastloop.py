@@ -1,0 +1,97 @@
+"""An episode of the linear learner on the continuous arm, compiled whole: the arm's move
+(``ik.fastmove.move``, MuJoCo called from numba) and the learner's update
+(``learning.linear._update``) in one loop, with no Python per step.
+
+:func:`episode_steps` gives ``learning.linear.learn`` its ``steps_by``: the same steps as
+``learn``'s own loop, in the same order, with the same draws (the uniforms are refilled from the
+trial's generator where the loop would refill them), so a trial's result is the same bytes
+(``tests/test_continuous_more.py``). The loop leaves to Python what it cannot do: a refill of
+the uniforms, and a move the compiled move hands back (``ik.fastmove.PYTHON``), which is taken
+by ``ContinuousArm.move``. An arm with actuation noise has no compiled move: None.
+"""
+
+from __future__ import annotations
+
+import numba
+
+from armtransfer.ik import fastmove
+from armtransfer.learning import linear
+
+REACHED, LIMIT, REFILL, PYTHON = range(4)
+
+
+@numba.njit(cache=True, nogil=True)
+def _run(arm, w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa, tr_e, pos, p, c, u,
+         bonus, traj_index, phi, paid, low, a, label, best, steps, limit, goal):
+    """``learn``'s loop from ``steps`` until the goal, ``limit`` steps, a refill or a move for
+    Python: (why it stopped, a, label, best, steps)."""
+    while steps < limit:
+        if c[linear.I_U] > low:
+            return REFILL, a, label, best, steps
+        label2 = fastmove.move(a, arm)
+        if label2 == fastmove.PYTHON:
+            return PYTHON, a, label, best, steps
+        if label2 < 0:
+            label2 = label
+        steps += 1
+        a, best = linear._update(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa,
+                                 tr_e, pos, p, c, u, bonus, traj_index, phi, paid, a, label, label2, goal, best)
+        if label2 == goal:
+            return REACHED, a, label2, best, steps
+        label = label2
+    return LIMIT, a, label, best, steps
+
+
+def episode_steps(arm) -> linear.EpisodeSteps | None:
+    """``learn``'s ``steps_by`` for ``arm`` (an ``ik.continuous.ContinuousArm``), or None when
+    the arm has no compiled move."""
+    if not hasattr(arm, "fast") or arm.fast() is None:
+        return None
+
+    def run(L: linear._Learner, a: int, label: int, best: float, limit: int, goal: int) -> tuple[int, int, float, bool]:
+        steps = 0
+        bonus, traj_index, phi, paid = L.rewards
+        while True:
+            state = arm.fast()
+            why, a, label, best, steps = _run(state, L.w, arm.q, *L.coding, L.feats, L.qrow, L.tr_sa, L.tr_e, L.pos,
+                                              L.p, L.c, L.u, bonus, traj_index, phi, paid, L.low, a, label, best,
+                                              steps, limit, goal)
+            arm.fast_done()
+            if why == REACHED:
+                return steps, a, best, True
+            if why == LIMIT:
+                return steps, a, best, False
+            if why == REFILL:
+                L.refill()
+                continue
+            label2 = arm.move(a)  # the move the compiled one handed back, in Python, then learn's step
+            if label2 < 0:
+                label2 = label
+            steps += 1
+            if L.c[linear.I_U] > L.low:
+                L.refill()
+            a, best = linear._update(L.w, arm.q, *L.coding, L.feats, L.qrow, L.tr_sa, L.tr_e, L.pos, L.p, L.c, L.u,
+                                     bonus, traj_index, phi, paid, a, label, label2, goal, best)
+            if label2 == goal:
+                return steps, a, best, True
+            label = label2
+            if steps >= limit:
+                return steps, a, best, False
+
+    return run
+
+
+def _stale_caches() -> None:
+    """numba keys a cached kernel on its own file only: empty these kernels' caches when a file
+    they call into changed (``learning.jitcache``)."""
+    from pathlib import Path
+
+    from armtransfer.learning import jitcache, sarsa, tiles, traces
+
+    arcs = Path(fastmove.__file__).with_name("arcs.py")
+    jitcache.invalidate_stale(fastmove.__name__, [fastmove._touches_now, fastmove._touches, fastmove.move], [arcs])
+    jitcache.invalidate_stale(__name__, [_run], [fastmove.__file__, arcs, linear.__file__, tiles.__file__,
+                                                 traces.__file__, sarsa.__file__])
+
+
+_stale_caches()
