@@ -156,8 +156,8 @@ class Replay:
                          key=lambda item: -item[1])
         limit = (f"; actuator {limited[0][0]} was at its force limit {limited[0][1]} of {len(self.time) - 1} steps"
                  if limited else "")
-        return (f"the tip ends {self.goal_offset_cells:.2f} cell from the goal cell's centre (half a cell is "
-                f"allowed) and {self.final_error_cells:.2f} cell from the last waypoint, driven by the "
+        return (f"the tip ends {self.goal_offset_cells:.2f} cell (along x or y) from the goal cell's centre "
+                f"(half a cell is allowed) and {self.final_error_cells:.2f} cell from the last waypoint, driven by the "
                 f"{'scene' if servos == 'scene' else 'file'}'s actuators{limit}")
 
     def frame_indices(self, fps: float) -> np.ndarray:
@@ -358,8 +358,8 @@ def _simulate(robot, path_states: Sequence[int], *, goal_cell: int | None, segme
             data.qfrc_applied[:] = data.qfrc_bias
             data.qfrc_applied[dof_of] += damping * vel_q[qadr_of]
         if len(tq):  # computed torque, within the motors' range
-            tau = (data.qfrc_applied[tq_dof] + tq_kp * (ctrl_q[tq_qadr] - data.qpos[tq_qadr])
-                   - tq_kv * data.qvel[tq_dof])
+            base = data.qfrc_applied[tq_dof] if feedforward else 0.0
+            tau = base + tq_kp * (ctrl_q[tq_qadr] - data.qpos[tq_qadr]) - tq_kv * data.qvel[tq_dof]
             clipped = np.clip(tau, tq_lo, tq_hi)
             at_limit[tq] += clipped != tau
             data.qfrc_applied[tq_dof] = clipped
@@ -390,8 +390,8 @@ def _simulate(robot, path_states: Sequence[int], *, goal_cell: int | None, segme
     planned_cells = _dedupe(robot.label[states].tolist())
     planned_xy = np.array([np.array(layout.xy(c), dtype=float) * scene.cell for c in planned_cells])
     settings: dict[str, Any] = {"segment_seconds": seg_steps * dt, "settle_seconds": settle_steps * dt,
-                "bandwidth_hz": bandwidth_hz, "feedforward": feedforward, "timestep": dt,
-                "servos": "scene" if own_servos else "file"}
+                                "bandwidth_hz": bandwidth_hz, "feedforward": feedforward, "timestep": dt,
+                                "servos": "scene" if own_servos else "file"}
     if motors:
         settings["torque_motors"] = {m.joint: {"actuators": list(m.actuators), "torque_range": [m.lower, m.upper],
                                                "steps_at_limit": int(at_limit[a])} for a, m in motors}
