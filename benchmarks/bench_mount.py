@@ -6,8 +6,9 @@ Each run is a fresh Python process with a fresh empty cache directory that write
 files (``tests/menagerie_like.py``) and times ``automatic_mount`` alone (imports and
 writing the files excluded): wall seconds and the process's CPU seconds (on a machine
 other jobs share, wall time grows with their load; CPU time does not). ARM is a name of
-``menagerie_like.ALL`` with its tool point from ``menagerie_like.SUGGESTED``; the default
-is every arm there. ``--baseline SRC`` also times the package at SRC (a checkout of
+``menagerie_like.ALL`` with its tool point from ``menagerie_like.SUGGESTED``, or one of
+``VARIANTS``, an arm of ``ALL`` as a test searches its mount otherwise (a held tool, wider
+cells, a joint limited so that no pose reaches the table); the default is all of them. ``--baseline SRC`` also times the package at SRC (a checkout of
 another commit: ``armtransfer`` imported from there, not the installed one) in the same
 runs, alternating.
 """
@@ -26,6 +27,15 @@ from armtransfer import script
 
 ROOT = Path(__file__).resolve().parent.parent
 
+VARIANTS = {
+    "ur5e_wide_gripper+stylus": ("ur5e_wide_gripper", {"tool": "stylus"}),  # tests/test_held_tool.py
+    "planar5_wide_pen@0.016": ("planar5_wide_pen", {"cell_size": 0.016}),   # tests/test_held_tool.py
+    "ur5e_stiff": ("ur5e", {"replace": [  # tests/test_unreachable_causes.py: no pose reaches the table
+        '<joint name="elbow_joint" class="ur5e/size3_limited"/>',
+        '<joint name="elbow_joint" class="ur5e/size3_limited" range="-0.2 0.2"/>']}),
+}
+"""Arms of ``menagerie_like.ALL`` as tests search their mount otherwise: (fixture, options)."""
+
 CHILD = r"""
 import json, os, sys, time
 from pathlib import Path
@@ -39,13 +49,20 @@ sys.path.insert(0, sys.argv[3])
 import menagerie_like as ml
 from armtransfer.errors import ArmTransferError
 from armtransfer.tasks.arms import automatic_mount, make_tool
-name = sys.argv[1]
+name, extra = sys.argv[1], json.loads(sys.argv[4])
 path = ml.ALL[name](Path(sys.argv[2]))
+if "replace" in extra:  # the test's edit of the file, written beside it
+    old, new = extra["replace"]
+    assert old in path.read_text()
+    edited = path.with_name(path.stem + "_edited.xml")
+    edited.write_text(path.read_text().replace(old, new))
+    path = edited
 tip = {k: v for k, v in ml.SUGGESTED[name].items() if k.startswith("tip")}
-tool = make_tool(tip.get("tip_site"), tip.get("tip_body"), tip.get("tip_offset"))
+held = {"tool": extra["tool"]} if "tool" in extra else {}
+tool = make_tool(tip.get("tip_site"), tip.get("tip_body"), tip.get("tip_offset"), **held)
 t0, c0 = time.perf_counter(), time.process_time()
 try:
-    pose = automatic_mount(path, tool)
+    pose = automatic_mount(path, tool, **({"cell_size": extra["cell_size"]} if "cell_size" in extra else {}))
     out = {"pose": pose.describe()}
 except ArmTransferError as err:
     out = {"error": str(err)}
@@ -56,11 +73,13 @@ print(json.dumps(out))
 
 
 def _run(name: str, source: str | None) -> dict:
+    fixture, extra = VARIANTS.get(name, (name, {}))
     with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as files:
         env = dict(os.environ, ARMTRANSFER_CACHE=cache, MUJOCO_GL=os.environ.get("MUJOCO_GL", "egl"))
         if source:
             env["BENCH_SOURCE"] = source
-        out = subprocess.run([sys.executable, "-c", CHILD, name, files, str(ROOT / "tests")], env=env,
+        out = subprocess.run([sys.executable, "-c", CHILD, fixture, files, str(ROOT / "tests"), json.dumps(extra)],
+                             env=env,
                              check=True, cwd=ROOT, capture_output=True, text=True).stdout
     return json.loads(out.strip().splitlines()[-1])
 
@@ -70,7 +89,7 @@ def main() -> None:
     import menagerie_like as ml
 
     parser = script.parser(__doc__)
-    parser.add_argument("arms", nargs="*", default=[n for n in ml.ALL if n in ml.SUGGESTED])
+    parser.add_argument("arms", nargs="*", default=[n for n in ml.ALL if n in ml.SUGGESTED] + list(VARIANTS))
     parser.add_argument("--runs", type=int, default=1)
     parser.add_argument("--baseline", default=None, help="a checkout of the baseline commit")
     args = parser.parse_args()

@@ -191,7 +191,7 @@ UR5E_HOME = (-1.5708, -1.5708, 1.5708, -1.5708, -1.5708, 0.0)
 """The UR5e's ready pose (upper arm up, forearm level, tool down) in the standard DH zero."""
 
 
-def ur5e_style(directory, *, scale: float = 1.0, gripper: bool | str = False) -> Path:
+def ur5e_style(directory, *, scale: float = 1.0, gripper: bool | str = False, motors: bool = False) -> Path:
     """A 6-joint UR5e-style arm in ``directory/universal_robots_ur5e/ur5e.xml``.
 
     UR5e standard DH geometry; classes ``ur5e``, ``ur5e/size3``, ``ur5e/size3_limited``,
@@ -210,6 +210,10 @@ def ur5e_style(directory, *, scale: float = 1.0, gripper: bool | str = False) ->
     fingertips reach ``GRIPPER_PAST`` past (see ``_gripper``). ``gripper="wide"``: the same
     with fingers as wide as a Robotiq-style pad over their whole length
     (``ur5e_wide_gripper.xml``, model ``ur5e_wide_gripper``): too wide for a 1 cm door.
+    ``motors``: torque motors only (``ur5e_motors.xml``, model ``ur5e_motors``): a ``motor``
+    actuator per joint (gear 1, control range the UR5e's joint torque limits, 150 and 28 N m)
+    and no position servo, as a file written for torque control has; ``home`` keyframe
+    without ctrl.
     """
     k = float(scale)
     model = "ur5e" if k == 1.0 else "small_ur"
@@ -256,7 +260,13 @@ def ur5e_style(directory, *, scale: float = 1.0, gripper: bool | str = False) ->
     actuators = []
     for i, (act, joint) in enumerate(zip(UR5E_ACTUATORS, UR5E_JOINTS)):
         cls = "ur5e/size1" if i >= 3 else ("ur5e/size3_limited" if i == 2 else "ur5e/size3")
-        actuators.append(f'    <general class="{cls}" name="{act}" joint="{joint}"/>')
+        if motors:
+            torque = _f((28 if i >= 3 else 150) * k ** 4)
+            actuators.append(f'    <motor class="{cls}" name="{act}" joint="{joint}" ctrlrange="-{torque} {torque}"/>')
+        else:
+            actuators.append(f'    <general class="{cls}" name="{act}" joint="{joint}"/>')
+    if motors:
+        model = "ur5e_motors"
     home = list(UR5E_HOME)
     if gripper:
         actuators += [f'    <position class="gripper/finger" name="{side}_finger" joint="{side}_finger_joint"/>'
@@ -320,7 +330,7 @@ def ur5e_style(directory, *, scale: float = 1.0, gripper: bool | str = False) ->
   </actuator>
 
   <keyframe>
-    <key name="home" qpos="{_v(home)}" ctrl="{_v(home)}"/>
+    <key name="home" qpos="{_v(home)}"{"" if motors else f' ctrl="{_v(home)}"'}/>
   </keyframe>
 </mujoco>
 """
@@ -821,6 +831,90 @@ def planar5_straight(directory, pen: bool = False, pen_radius: float = PEN_RADIU
     return _write(folder, model_name, text)
 
 
+# --------------------------------------------------------------------------- iiwa style, position servos
+
+IIWA_FRAMES = ((0.0, 0.0, 0.1575), (0.0, 0.0, 0.2025), (0.0, 0.2045, 0.0), (0.0, 0.0, 0.2155),
+               (0.0, 0.1845, 0.0), (0.0, 0.0, 0.2155), (0.0, 0.081, 0.0))
+"""Each link's origin in its parent's frame (m): a KUKA LBR iiwa 14-style chain, 1.27 m tall."""
+IIWA_TURNS = (None, "y", "y", "x", "y", "x", "y")
+"""How each link is turned from its parent: ``y`` a half turn about y then a quarter about
+x (the joint axis now along the parent's y), ``x`` a quarter turn about x back."""
+IIWA_MASSES = (5.76, 6.35, 3.5, 3.5, 3.5, 1.8, 1.2)
+IIWA_RADII = (0.07, 0.07, 0.065, 0.065, 0.055, 0.05, 0.045)
+IIWA_LIMITS = (2.96, 2.09, 2.96, 2.09, 2.96, 2.09, 3.05)
+IIWA_KP = (600, 600, 400, 400, 200, 100, 50)
+"""Position gains (N m / rad) as a file exported for another simulator gives them: far below
+what holds the arm against gravity within a cell (the UR5e-style file's are 2000 and 500);
+held at home by these servos alone, the flange sags 7.7 cm in 4 s of plain ``mj_step``."""
+IIWA_FORCE = (320, 320, 176, 176, 110, 40, 40)
+IIWA_FLANGE = 0.045
+IIWA_HOME = (0.0, 0.6, 0.0, -1.4, 0.0, 1.1, 0.0)
+
+
+def iiwa_style(directory) -> Path:
+    """A 7-joint iiwa-style arm as a file converted from another framework: ``directory/iiwa/iiwa14.xml``.
+
+    No default classes; bodies ``link1..link7`` with joints ``joint1..joint7`` (every axis z
+    in its own body, as the URDF had them), each link turned from its parent by a quaternion;
+    ``position`` actuators ``joint1_position`` ... with the ``IIWA_KP`` gains, ``kv`` a tenth
+    of them and the iiwa's torque limits as force ranges; a flange site ``attachment_site``
+    (a 0.12 m tool is ``tip_offset=(0, 0, 0.12)``); a ``home`` keyframe, elbow bent; STL
+    meshes in ``meshes/``.
+    """
+    folder = Path(directory) / "iiwa"
+    meshes = _Meshes(folder / "meshes", "stl")
+    half = math.sqrt(0.5)
+    quats = {"y": (0.0, 0.0, half, half), "x": (half, half, 0.0, 0.0)}
+    meshes.add("link_0", *prism_mesh(0.09, 0.05), named=True)
+    xml = ['    <body name="link0">',
+           '      <inertial pos="0 0 0.05" mass="5" diaginertia="0.05 0.06 0.03"/>',
+           '      <geom type="mesh" mesh="link_0" contype="0" conaffinity="0" group="2" rgba="0.4 0.4 0.4 1"/>',
+           '      <geom type="cylinder" size="0.09 0.05" pos="0 0 0.05" group="3"/>']
+    pad = "      "
+    n = len(IIWA_FRAMES)
+    for i in range(n):
+        child = np.array(IIWA_FRAMES[i + 1]) if i + 1 < n else np.array((0.0, 0.0, IIWA_FLANGE))
+        turn = IIWA_TURNS[i]
+        q = f' quat="{_v(quats[turn])}"' if turn else ""
+        r = IIWA_RADII[i]
+        start = np.array((0.0, 0.0, 0.1 - IIWA_FRAMES[0][2] + r)) if i == 0 else np.zeros(3)
+        mesh = meshes.add(f"link_{i + 1}", *box_mesh(start, child, r * 0.8), named=True)
+        end = _shorten(start, child, IIWA_RADII[i + 1] + r * 0.7 if i + 1 < n else 0.0)
+        xml += [f'{pad}<body name="link{i + 1}" pos="{_v(IIWA_FRAMES[i])}"{q}>',
+                f"{pad}  {cylinder_inertial(IIWA_MASSES[i], r * 0.8, (0, 0, 0), child)}",
+                f'{pad}  <joint name="joint{i + 1}" type="hinge" axis="0 0 1" range="{_f(-IIWA_LIMITS[i])} '
+                f'{_f(IIWA_LIMITS[i])}" damping="0.5" armature="0.1"/>',
+                f'{pad}  <geom type="mesh" mesh="{mesh}" contype="0" conaffinity="0" group="2" rgba="1 0.42 0.04 1"/>',
+                f'{pad}  <geom type="cylinder" size="{_f(r)} {_f(r * 0.8)}" group="3"/>' if i else "",
+                f'{pad}  <geom type="capsule" size="{_f(r * 0.7)}" fromto="{_v(start)} {_v(end)}" group="3"/>']
+        pad += "  "
+    xml.append(f'{pad}<site name="attachment_site" pos="0 0 {_f(IIWA_FLANGE)}"/>')
+    for _ in range(n + 1):
+        pad = pad[:-2]
+        xml.append(f"{pad}</body>")
+    actuators = [f'    <position name="joint{i + 1}_position" joint="joint{i + 1}" kp="{kp}" kv="{kp / 10:g}" '
+                 f'ctrlrange="{_f(-IIWA_LIMITS[i])} {_f(IIWA_LIMITS[i])}" forcerange="-{f} {f}"/>'
+                 for i, (kp, f) in enumerate(zip(IIWA_KP, IIWA_FORCE))]
+    text = f"""<mujoco model="iiwa14">
+  <compiler angle="radian" meshdir="meshes"/>
+  <option integrator="implicitfast"/>
+  <asset>
+{chr(10).join(meshes.assets)}
+  </asset>
+  <worldbody>
+{chr(10).join(line for line in xml if line)}
+  </worldbody>
+  <actuator>
+{chr(10).join(actuators)}
+  </actuator>
+  <keyframe>
+    <key name="home" qpos="{_v(IIWA_HOME)}" ctrl="{_v(IIWA_HOME)}"/>
+  </keyframe>
+</mujoco>
+"""
+    return _write(folder, "iiwa14", text)
+
+
 SMALL_UR_SCALE = 0.5
 """The small 6-joint arm: the UR5e-style arm at half its size (0.42 m of reach, servos 16 times weaker)."""
 
@@ -842,6 +936,8 @@ SUGGESTED = {
     "small_ur": dict(tip_site="attachment_site", tip_offset=(0.0, 0.0, 0.06)),
     "planar5_pen": dict(tip_site="pen_tip"),
     "planar5_wide_pen": dict(tip_site="pen_tip"),
+    "iiwa": dict(tip_site="attachment_site", tip_offset=(0.0, 0.0, 0.12)),
+    "ur5e_motors": dict(tip_site="attachment_site", tip_offset=(0.0, 0.0, 0.12)),
 }
 """A tip and a mount that work for each arm (cartesian, tool pointing down; planar5 also
 joint). Measured with the project's compiler on copies of these files with the classes'
@@ -855,7 +951,8 @@ ALL = {"ur5e": ur5e_style, "panda": panda_style, "panda_nohand": lambda d: panda
        "panda_tcp": lambda d: panda_style(d, tcp=True), "ur5e_gripper": lambda d: ur5e_style(d, gripper=True),
        "ur5e_wide_gripper": lambda d: ur5e_style(d, gripper="wide"),
        "small_ur": lambda d: ur5e_style(d, scale=SMALL_UR_SCALE), "planar5_pen": lambda d: planar5_straight(d, pen=True),
-       "planar5_wide_pen": lambda d: planar5_straight(d, pen=True, pen_radius=WIDE_PEN_RADIUS, scale=2.0)}
+       "planar5_wide_pen": lambda d: planar5_straight(d, pen=True, pen_radius=WIDE_PEN_RADIUS, scale=2.0),
+       "iiwa": iiwa_style, "ur5e_motors": lambda d: ur5e_style(d, motors=True)}
 """Every fixture by a short name."""
 
 

@@ -194,3 +194,24 @@ def test_planar5_is_straight_and_singular_at_qpos0(arms):
     assert not re.search(r"<key", arms["planar5"].read_text())
 
 
+
+
+def test_iiwa_style_has_seven_joints_and_position_servos_of_its_own(arms):
+    model = _model(arms["iiwa"])
+    root = ET.parse(arms["iiwa"]).getroot()
+    assert model.nq == 7 and model.nu == 7 and root.find("default") is None  # no classes
+    assert [a.tag for a in root.find("actuator")] == ["position"] * 7
+    assert np.all(model.actuator_biastype == mujoco.mjtBias.mjBIAS_AFFINE)
+    assert np.allclose(model.actuator_gainprm[:, 0], ml.IIWA_KP)
+    assert np.allclose(model.actuator_forcerange[:, 1], ml.IIWA_FORCE)
+    assert _names(model, mujoco.mjtObj.mjOBJ_SITE, model.nsite) == ["attachment_site"]
+    assert model.key_qpos.shape == (1, 7)
+
+
+def test_ur5e_motors_has_torque_motors_only(arms):
+    model = _model(arms["ur5e_motors"])
+    root = ET.parse(arms["ur5e_motors"]).getroot()
+    assert root.get("model") == "ur5e_motors" and [a.tag for a in root.find("actuator")] == ["motor"] * 6
+    assert np.all(model.actuator_biastype == mujoco.mjtBias.mjBIAS_NONE)
+    assert np.allclose(model.actuator_ctrlrange[:, 1], [150] * 3 + [28] * 3)
+    assert model.nkey == 1 and np.allclose(model.key_qpos[0], ml.UR5E_HOME)

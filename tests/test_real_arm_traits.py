@@ -2,7 +2,8 @@
 compile, solve Table I where their cells allow, take a transfer from ``planar2:joint``, and
 replay both paths to the goal; the mount search stays within 30 CPU seconds from an empty
 cache: a 7-joint arm with a TCP its fingers reach past, a 6-joint arm with finger slides, a
-small 6-joint arm with weak servos, a 5-joint arm with a jaw, a planar arm with a round pen.
+small 6-joint arm with weak servos, a 5-joint arm with a jaw, a planar arm with a round pen,
+a 7-joint arm with position servos of its own and no classes, a 6-joint arm with torque motors only.
 """
 
 import time
@@ -17,7 +18,8 @@ from armtransfer.tasks.arms import arm_robot, robot, tasks_solvable
 from armtransfer.tasks.catalog import TABLE_I
 
 LEAST_REACH = {"panda_tcp": 0.8, "ur5e_gripper": 0.8, "so100": 0.8,
-               "small_ur": 0.6, "planar5_pen": 0.6}  # under 0.5 m of reach: 60%
+               "small_ur": 0.6, "planar5_pen": 0.6,  # under 0.5 m of reach: 60%
+               "iiwa": 0.8, "ur5e_motors": 0.8}
 MOUNT_CPU_SECONDS = 30.0
 
 

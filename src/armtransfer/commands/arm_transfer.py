@@ -221,8 +221,11 @@ def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target
             own = rp.get("file_servos")
             servos = (f" (the scene's own servos: the file's tracked {own['max_tracking_error_cells']:.2f} cell off"
                       f"{'' if own['reached_goal'] else ' and missed the goal'})" if own else "")
+            motors = " (the file's torque motors, by computed torque)" if rp.get("torque_motors") else ""
             print(f"replay {label}: largest tip deviation {rp['max_deviation_cells']:.2f} cell, "
-                  f"reached the goal cell: {'yes' if rp['reached_goal'] else 'no'}{servos}")
+                  f"reached the goal cell: {'yes' if rp['reached_goal'] else 'no'}{servos}{motors}")
+            if not rp["reached_goal"]:
+                print(f"replay {label} missed the goal: {rp['shortfall']}")
     return {"json": out_json, "video": video, "paths": paths, "source": source, "target": target,
             "no_video": no_video}
 

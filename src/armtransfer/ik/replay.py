@@ -30,6 +30,17 @@ again with the scene's own servos: the same retuned position servos with no forc
 control limit. ``Replay.settings["servos"]`` says which were used (``file`` or ``scene``),
 and when it is ``scene``, ``file_servos`` says how the file's did.
 
+Torque motors. A file may drive a joint with torque motors only (``motor`` actuators, no
+position servo), as files written for torque control do. The scene keeps no such motor
+(``armtransfer.ik.scene``: it gives the joint a servo of its own), so the replay with the
+file's actuators drives that joint by computed torque instead, limited to what the file's
+motors give: ``tau = qfrc_bias + kp * (q_ref - q) + kv * (v_ref - v) + (damping + kv) * v_ref``
+with the same model-derived ``kp`` and ``kv`` (the joint's inertia from the mass matrix times
+``w**2`` and ``2 w``; ``qfrc_bias`` is gravity and Coriolis of the current state), clipped
+to the motors' torque range and applied as the joint's force; the joint's own servo does
+nothing. ``settings["torque_motors"]`` names those joints and the steps their motors were at
+their limit. When the motors cannot track the path, the scene's own servos take over as above.
+
 The report (``Replay.report()``) gives the largest distance of the tip from the polyline
 through the planned cells' centres, in cells, and whether the tip ends in the goal cell.
 """
@@ -39,13 +50,13 @@ from __future__ import annotations
 import copy
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Sequence
 
 import mujoco
 import numpy as np
 
 from armtransfer.ik.labels import OFF_TABLE, cells_of_xy
-from armtransfer.ik.scene import ArmScene, build_scene
+from armtransfer.ik.scene import PREFIX, ArmScene, build_scene, torque_motors
 from armtransfer.errors import ArmTransferError
 from armtransfer.ik.description import ArmDescription
 
@@ -129,6 +140,26 @@ class Replay:
         """Distance (cells) of the final tip from the last waypoint's compiled tip."""
         return float(np.linalg.norm(self.tip_xy[-1] - self.planned_tip[-1, :2]) / self.cell)
 
+    @property
+    def goal_offset_cells(self) -> float:
+        """Largest distance (cells), along x or y, of the final tip from the goal cell's centre:
+        at most half a cell when the tip ends over the goal cell."""
+        centre = np.array(self.scene.layout.xy(self.goal_cell), dtype=float) * self.cell
+        return float(np.abs(self.tip_xy[-1] - centre).max() / self.cell)
+
+    def shortfall(self) -> str:
+        """One line saying why the tip does not end over the goal cell, or "" when it does."""
+        if self.reached_goal:
+            return ""
+        servos = self.settings.get("servos", "file")
+        limited = sorted(((n, k) for n, k in self.settings.get("at_limit_steps", {}).items() if k),
+                         key=lambda item: -item[1])
+        limit = (f"; actuator {limited[0][0]} was at its force limit {limited[0][1]} of {len(self.time) - 1} steps"
+                 if limited else "")
+        return (f"the tip ends {self.goal_offset_cells:.2f} cell (along x or y) from the goal cell's centre "
+                f"(half a cell is allowed) and {self.final_error_cells:.2f} cell from the last waypoint, driven by the "
+                f"{'scene' if servos == 'scene' else 'file'}'s actuators{limit}")
+
     def frame_indices(self, fps: float) -> np.ndarray:
         """Sample index for each video frame at ``fps`` (frames at t = k / fps, last at the end)."""
         if not fps > 0:
@@ -159,7 +190,8 @@ class Replay:
             "final_error_cells": round(self.final_error_cells, 4),
             "seconds_simulated": round(self.duration, 4),
             "physics_steps": len(self.time) - 1,
-            **self.settings,
+            **{k: v for k, v in self.settings.items() if k != "at_limit_steps"},
+            **({} if self.reached_goal else {"shortfall": self.shortfall()}),
         }
 
 
@@ -245,6 +277,10 @@ def replay(robot, path_states: Sequence[int], *, goal_cell: int | None = None,
     second = simulate(True, first.scene)
     second.settings["file_servos"] = {"reached_goal": first.reached_goal,
                                       "max_tracking_error_cells": round(first.max_tracking_error_cells, 4)}
+    if not first.reached_goal:
+        second.settings["file_servos"]["shortfall"] = first.shortfall()
+    if "torque_motors" in first.settings:
+        second.settings["file_servos"]["torque_motors"] = first.settings["torque_motors"]
     return second
 
 
@@ -292,6 +328,17 @@ def _simulate(robot, path_states: Sequence[int], *, goal_cell: int | None, segme
     dof_of = model.jnt_dofadr[joint_of]
     qadr_of = model.jnt_qposadr[joint_of]
     damping = model.dof_damping[dof_of] + kv
+    motors = [] if own_servos else _motors_in(model, arm)
+    tq = np.array([a for a, _ in motors], dtype=np.int64)  # the actuators (scene servos) they replace
+    tq_kp, tq_kv = model.actuator_gainprm[tq, 0].copy(), kv[tq]
+    tq_lo = np.array([m.lower for _, m in motors])
+    tq_hi = np.array([m.upper for _, m in motors])
+    tq_dof, tq_qadr = dof_of[tq], qadr_of[tq]
+    model.actuator_gainprm[tq, 0] = 0.0  # the joint's own servo does nothing: the motors drive it
+    model.actuator_biasprm[tq, :3] = 0.0
+    limited = model.actuator_forcelimited.astype(bool) & ~np.isin(np.arange(model.nu), tq)
+    f_lo, f_hi = model.actuator_forcerange[limited].T
+    at_limit = np.zeros(model.nu, dtype=np.int64)
 
     dt = float(model.opt.timestep)
     seg_steps = max(1, int(round(segment_seconds / dt)))
@@ -310,7 +357,16 @@ def _simulate(robot, path_states: Sequence[int], *, goal_cell: int | None, segme
         if feedforward:
             data.qfrc_applied[:] = data.qfrc_bias
             data.qfrc_applied[dof_of] += damping * vel_q[qadr_of]
+        if len(tq):  # computed torque, within the motors' range
+            base = data.qfrc_applied[tq_dof] if feedforward else 0.0
+            tau = base + tq_kp * (ctrl_q[tq_qadr] - data.qpos[tq_qadr]) - tq_kv * data.qvel[tq_dof]
+            clipped = np.clip(tau, tq_lo, tq_hi)
+            at_limit[tq] += clipped != tau
+            data.qfrc_applied[tq_dof] = clipped
         mujoco.mj_step2(model, data)
+        if limited.any():
+            force = data.actuator_force[limited]
+            at_limit[limited] += (force <= f_lo + 1e-9 * np.abs(f_lo)) | (force >= f_hi - 1e-9 * np.abs(f_hi))
         k += 1
         qpos[k] = data.qpos
         tip[k] = data.site_xpos[tip_id]
@@ -333,12 +389,33 @@ def _simulate(robot, path_states: Sequence[int], *, goal_cell: int | None, segme
     layout = scene.layout
     planned_cells = _dedupe(robot.label[states].tolist())
     planned_xy = np.array([np.array(layout.xy(c), dtype=float) * scene.cell for c in planned_cells])
-    settings = {"segment_seconds": seg_steps * dt, "settle_seconds": settle_steps * dt,
-                "bandwidth_hz": bandwidth_hz, "feedforward": feedforward, "timestep": dt,
-                "servos": "scene" if own_servos else "file"}
+    settings: dict[str, Any] = {"segment_seconds": seg_steps * dt, "settle_seconds": settle_steps * dt,
+                                "bandwidth_hz": bandwidth_hz, "feedforward": feedforward, "timestep": dt,
+                                "servos": "scene" if own_servos else "file"}
+    if motors:
+        settings["torque_motors"] = {m.joint: {"actuators": list(m.actuators), "torque_range": [m.lower, m.upper],
+                                               "steps_at_limit": int(at_limit[a])} for a, m in motors}
+    names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_ACTUATOR, a) or f"#{a}" for a in range(model.nu)]
+    for a, m in motors:  # a joint the motors drive is named by them, not by the servo that stood in
+        names[a] = "+".join(m.actuators)
+    settings["at_limit_steps"] = {names[a].removeprefix(PREFIX): int(at_limit[a]) for a in range(model.nu)}
     return Replay(robot=robot.name, scene=scene, path_states=tuple(states), goal_cell=goal,
                   planned_xy=planned_xy, planned_tip=planned_tip, time=np.arange(k + 1) * dt,
                   qpos=qpos, tip=tip, waypoint_index=waypoint_index, settings=settings)
+
+
+def _motors_in(model: mujoco.MjModel, arm: ArmDescription) -> list:
+    """(scene actuator, file's torque motors) for each chain joint the scene gave a servo of
+    its own because the file drives it with torque motors only."""
+    own = {}
+    for a in range(model.nu):
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_ACTUATOR, a) or ""
+        if name.startswith(PREFIX + "servo_"):
+            own[name[len(PREFIX + "servo_"):]] = a
+    if not own:
+        return []
+    return [(own[m.joint], m) for m in torque_motors(Path(arm.xml_path), [j for j in arm.chain if j in own])
+            if m.joint in own]
 
 
 def _ctrl_of(model: mujoco.MjModel, q: np.ndarray) -> np.ndarray:

@@ -420,6 +420,54 @@ def _actuators(spec: mujoco.MjSpec, model: mujoco.MjModel, chain: list[int]) -> 
     return [j for j in chain if j not in keep]
 
 
+@dataclass(frozen=True)
+class TorqueMotor:
+    """A chain joint the arm file drives with torque motors only (no position servo): the
+    scene drops those motors and gives the joint a servo of its own, ``servo_<joint>``."""
+
+    joint: str
+    """The joint's name in the arm file."""
+    actuators: tuple[str, ...]
+    """The file's motors on it (names, or ``#index`` when unnamed)."""
+    lower: float
+    upper: float
+    """The joint torque (N m, or N on a slide) the motors give at most, each way: gear times
+    their gain times their control range, within their force range and the joint's
+    ``actuatorfrcrange`` (infinite where nothing limits it)."""
+
+
+def torque_motors(xml_path: Path, chain: tuple[str, ...] | list[str]) -> list[TorqueMotor]:
+    """The joints of ``chain`` (names in the arm file) that the file at ``xml_path`` drives only
+    with torque motors: actuators on the joint with no bias (``motor``, or ``general`` with no
+    ``biastype``) and no dynamics, and no position servo beside them. Empty for a file whose
+    chain joints all have a position servo (every built-in arm)."""
+    _, model = _load_arm(Path(xml_path))
+    out = []
+    for joint in chain:
+        j = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint)
+        on = [a for a in range(model.nu)
+              if model.actuator_trntype[a] == mujoco.mjtTrn.mjTRN_JOINT and int(model.actuator_trnid[a, 0]) == j]
+        if j < 0 or not on or any(model.actuator_biastype[a] != mujoco.mjtBias.mjBIAS_NONE
+                                  or model.actuator_dyntype[a] != mujoco.mjtDyn.mjDYN_NONE
+                                  or model.actuator_gaintype[a] != mujoco.mjtGain.mjGAIN_FIXED for a in on):
+            continue
+        lower = upper = 0.0
+        for a in on:
+            gain, gear = float(model.actuator_gainprm[a, 0]), float(model.actuator_gear[a, 0])
+            lo, hi = ((float(v) * gain for v in model.actuator_ctrlrange[a]) if model.actuator_ctrllimited[a]
+                      else (-math.inf, math.inf))
+            lo, hi = min(lo, hi), max(lo, hi)
+            if model.actuator_forcelimited[a]:
+                lo, hi = max(lo, float(model.actuator_forcerange[a, 0])), min(hi, float(model.actuator_forcerange[a, 1]))
+            lo, hi = sorted((gear * lo, gear * hi)) if gear and gain else (0.0, 0.0)
+            lower, upper = lower + lo, upper + hi
+        if model.jnt_actfrclimited[j]:
+            lower, upper = max(lower, float(model.jnt_actfrcrange[j, 0])), min(upper, float(model.jnt_actfrcrange[j, 1]))
+        names = tuple(_name(model, mujoco.mjtObj.mjOBJ_ACTUATOR, a) or f"#{a}" for a in on)
+        out.append(TorqueMotor(joint, names, lower, upper))
+    return out
+
+
 STYLUS = "stylus_held"
 """Name of the geom of a held :class:`~armtransfer.ik.tool.Stylus` (the pen)."""
 
