@@ -23,7 +23,9 @@ The public names below are loaded on first use, so importing any part stays chea
 
 A transfer method of one's own: ``armtransfer.potential_method`` (or ``bonus_method``), declared
 by an installed package under the entry-point group ``armtransfer.methods`` or given to
-``armtransfer.register_method`` (docs/extending.md).
+``armtransfer.register_method`` (docs/extending.md). A learner of one's own (any Gymnasium
+agent with ``learn`` and ``predict``): ``armtransfer.Learner``, declared under
+``armtransfer.learners`` or given to ``armtransfer.register_learner``.
 """
 
 from __future__ import annotations
@@ -41,6 +43,9 @@ _LAZY = {
     "METHODS": "armtransfer.learning.methods",
     "Method": "armtransfer.learning.methods",
     "register_method": "armtransfer.learning.methods",
+    "Learner": "armtransfer.learning.learners",
+    "LEARNERS": "armtransfer.learning.learners",
+    "register_learner": "armtransfer.learning.learners",
     "potential_method": "armtransfer.learning.plugins",
     "bonus_method": "armtransfer.learning.plugins",
     "resolve_robot": "armtransfer.tasks.specs",

@@ -45,6 +45,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--method", nargs="+", default=None, metavar="METHOD",
                    help="run only these methods, each beside its baselines (default: the suite's methods and "
                         "every method of an installed plugin); a method's records are the same bytes either way")
+    from armtransfer.learning.learners import LEARNERS
+
+    learned = "; ".join(f"{name}: {lr.description}" for name, lr in LEARNERS.items())
+    p.add_argument("--learner", default=None, metavar="NAME[,NAME...]",
+                   help="the learners every method runs on, each method beside the baseline the same learner runs "
+                        "(an outside learner runs none and the reward-term methods; docs/extending.md); default: the "
+                        f"suite's own (sarsa). Learners: {learned}")
     common.add_world_argument(p)
     add_executor_arguments(p)
     common.add_preset_argument(p)
@@ -74,13 +81,19 @@ def run(args: argparse.Namespace) -> int:
 
         wanted = tuple(methods.get(m).name for m in args.method)  # a typo lists the valid names
     ran, missing = benchmark.methods_to_run(wanted)
+    learners = None
+    if args.learner is not None:
+        from armtransfer.learning.learners import parse
+
+        learners = parse(args.learner)  # a typo lists the valid names
     robots = benchmark.Robots({})
-    plan = benchmark.plan(suite, args.seed, robots, ran, missing, preset=args.preset)
+    plan = benchmark.plan(suite, args.seed, robots, ran, missing, preset=args.preset, learners=learners)
     from armtransfer.learning.methods import probe_on, refuse_run_time
 
     # a plugin's fault stops the run here, in one line, before its store is opened
     probe_on(plan.methods, [robots(p.case.target) for p in plan.pairs])
     refuse_run_time(plan.methods, "a benchmark's runs")  # every case's task checked before anything is written
+    probe_learners(plan, robots)
     t0 = time.perf_counter()
     store = ResultStore.open_for(out, Sweep(plan.name, plan.spec(), ()))
     try:
@@ -98,6 +111,30 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def probe_learners(plan: benchmark.Plan, robots: benchmark.Robots) -> None:
+    """Every outside learner of ``plan`` made, learning a few steps and predicting on the first
+    case of each of its target robots (``learner_trial.probe``): a learner's fault is one line
+    now, before the store is opened; a learner registered in this process only is refused (the
+    runs go to worker processes, which cannot see it)."""
+    from armtransfer.errors import PluginError
+    from armtransfer.experiments import learner_trial
+    from armtransfer.learning.learners import BUILTIN, RUN_TIME, get
+
+    seen: set[tuple[str, str]] = set()
+    for pair in plan.pairs:
+        for name, ms in plan.entries(pair):
+            if name in BUILTIN or not ms or (name, pair.case.target) in seen:
+                continue
+            seen.add((name, pair.case.target))
+            learner = get(name)
+            if learner.origin == RUN_TIME:
+                raise PluginError(f"learner {name!r} was registered in this process (register_learner) and a "
+                                  "benchmark's runs run in other processes, which cannot see it; install it as a "
+                                  "package declaring it under the entry-point group armtransfer.learners "
+                                  "(docs/extending.md)")
+            learner_trial.probe(learner, robots(pair.case.target), list(pair.start), list(pair.goal))
+
+
 def _run_into(store: ResultStore, plan: benchmark.Plan, robots: dict, args: argparse.Namespace) -> int:
     """Run every run of ``plan`` not in ``store`` yet; a trial run that reads robot 1's path is
     released when its source run is in. Returns 1 when a run failed, else 0."""
@@ -108,7 +145,7 @@ def _run_into(store: ResultStore, plan: benchmark.Plan, robots: dict, args: argp
         if found is None:
             todo.append(src)
             waiting[src["key"]] = pair
-        runs = pair.trial_runs(plan.methods, None if found is None else found["result"])
+        runs = plan.all_trial_runs(pair, None if found is None else found["result"])
         left = [r for r in runs if not store.is_done(r["key"])]
         todo += left
         done += (found is not None) + len(runs) - len(left)
@@ -126,7 +163,7 @@ def _run_into(store: ResultStore, plan: benchmark.Plan, robots: dict, args: argp
             pair = waiting.pop(run["key"], None)
             if pair is None:
                 return []
-            released = pair.waiting_runs(plan.methods, result)
+            released = plan.waiting_runs(pair, result)
             more = [r for r in released if not store.is_done(r["key"])]
             bar.update(len(released) - len(more))  # a run done before its source's file was set aside
             return more
@@ -166,12 +203,12 @@ def write_report(store: ResultStore, plan: benchmark.Plan) -> dict:
     records = plan.records(result)
     summary = benchmark_stats.summarize(records)
     out = store.root
-    write_bytes_atomic(out / "results.json", results_bytes(plan.suite, plan.seed, list(plan.methods),
+    write_bytes_atomic(out / "results.json", results_bytes(plan.suite, plan.seed, plan.labels(),
                                                           list(plan.missing), records, summary))
     write_json_atomic(out / "timings.json", plan.timings(result, seconds))
     benchmark_report.write_figures(summary, plan.suite, out)
     write_text_atomic(out / "report.md", benchmark_report.report_markdown(
-        plan.suite, plan.seed, summary, list(plan.methods), list(plan.missing)))
+        plan.suite, plan.seed, summary, plan.labels(), list(plan.missing)))
     return summary
 
 
@@ -184,7 +221,7 @@ def plan_of(store: ResultStore) -> benchmark.Plan:
     except Exception:  # noqa: BLE001 - any malformed spec is the same one-line refusal
         raise StoreError(f"{str(store.root)!r} holds a benchmark of a suite this build does not have") from None
     plan = benchmark.plan(suite, spec["seed"], ran=spec["methods"], missing=spec["not_in_registry"],
-                          preset=spec.get("preset", "default"))
+                          preset=spec.get("preset", "default"), learners=spec.get("learners"))
     if content_key(plan.spec()) != store.meta.get("key"):
         raise StoreError(f"{str(store.root)!r} holds a benchmark of suite {suite.name!r} as another build defined "
                          "it (its version, methods or learner settings differ); rebuild it with that build")

@@ -48,20 +48,49 @@ SOURCE_CONFIG = LearnerConfig()
 robot 2's trials at."""
 
 
+AT = "@"
+"""A record of an outside learner's trials is labelled ``METHOD@LEARNER`` (``pseudo@dqn``); the
+built-in learner's keep the method's name alone, so its records are the bytes they were."""
+
+
+def label(method: str, learner: str = benchmark_runs.LEARNER) -> str:
+    """The name a record of ``method`` run by ``learner`` goes by in the records and the report."""
+    return method if learner == benchmark_runs.LEARNER else f"{method}{AT}{learner}"
+
+
+def parse_label(name: str) -> tuple[str, str]:
+    """(method, learner) of a record's name (:func:`label`)."""
+    method, _, learner = name.partition(AT)
+    return method, learner or benchmark_runs.LEARNER
+
+
 def baselines_of(name: str) -> tuple[str, ...]:
     """The methods ``name``'s gain is measured against, each sharing its learner and told less:
     the registry's ``Method.baselines`` (the no-transfer one first; empty for a method that is
     itself no transfer), or, from a registry without that field, ``none`` for every method but
-    ``none``."""
-    m = methods.get(name)
+    ``none``. ``name`` may be a record's label ``METHOD@LEARNER``: its baselines are labelled so."""
+    method, learner = parse_label(name)
+    m = methods.get(method)
     if hasattr(m, "baselines"):
-        return tuple(b for b in m.baselines if b in methods.METHODS and b != name)
-    return () if name == "none" else ("none",)
+        named = tuple(b for b in m.baselines if b in methods.METHODS and b != method)
+    else:
+        named = () if method == "none" else ("none",)
+    return tuple(label(b, learner) for b in named)
 
 
 def registered_baseline(name: str) -> bool:
     """Whether the registry itself names ``name``'s baselines (rather than the ``none`` default)."""
-    return hasattr(methods.get(name), "baselines")
+    return hasattr(methods.get(parse_label(name)[0]), "baselines")
+
+
+def learner_methods(learner: str, ran: Sequence[str]) -> list[str]:
+    """The methods of ``ran`` that ``learner`` runs: all for the built-in one; ``none`` and the
+    reward-term methods for an outside learner (``learner_trial.reward_methods``)."""
+    if learner == benchmark_runs.LEARNER:
+        return list(ran)
+    from armtransfer.experiments.learner_trial import reward_methods
+
+    return reward_methods(list(ran))
 
 
 def baseline_of(name: str) -> str | None:
@@ -193,18 +222,22 @@ class Pair:
         return benchmark_runs.source_run(self.case.source, self.case.target, list(self.start), list(self.goal),
                                          self.seed, SOURCE_CONFIG)
 
-    def trial_runs(self, names: Sequence[str], source_result: dict | None) -> list[dict]:
-        """Every trial run of the methods ``names``, in (method, trial) order; without the source
-        run's result, only those of the methods that read no trajectory."""
+    def trial_runs(self, names: Sequence[str], source_result: dict | None,
+                   learner: str = benchmark_runs.LEARNER) -> list[dict]:
+        """Every trial run of the methods ``names`` by ``learner``, in (method, trial) order;
+        without the source run's result, only those of the methods that read no trajectory."""
         return [benchmark_runs.trial_run(name, k, self.case.source, self.case.target, list(self.start),
-                                         list(self.goal), self.case.wind, self.seed, self.config, source_result)
+                                         list(self.goal), self.case.wind, self.seed, self.config, source_result,
+                                         learner=learner)
                 for name in names if source_result is not None or not benchmark_runs.needs_trajectory(name)
                 for k in range(self.section.trials)]
 
-    def waiting_runs(self, names: Sequence[str], source_result: dict) -> list[dict]:
+    def waiting_runs(self, names: Sequence[str], source_result: dict,
+                     learner: str = benchmark_runs.LEARNER) -> list[dict]:
         """The trial runs that wait for the source run: those of the methods that read the
         trajectory (the others are in :meth:`trial_runs` without it)."""
-        return [run for run in self.trial_runs(names, source_result) if benchmark_runs.needs_trajectory(run["method"])]
+        return [run for run in self.trial_runs(names, source_result, learner)
+                if benchmark_runs.needs_trajectory(run["method"])]
 
     def base(self, source_result: dict) -> dict:
         """What every record of this pair holds, before its method's."""
@@ -222,6 +255,9 @@ def record(pair: Pair, name: str, source_result: dict, trials: list[dict]) -> di
     """One record: method ``name``'s trials on ``pair`` (none when it could not run: then
     ``error`` says why, the first trial's in trial order, and every trial counts as a failure)."""
     rec = dict(pair.base(source_result), method=name, baselines=list(baselines_of(name)), error=None)
+    learner = parse_label(name)[1]
+    if learner != benchmark_runs.LEARNER:  # the built-in learner's records keep their bytes
+        rec["learner"] = learner
     n = len(trials)
     errors = [t["error"] for t in trials if t["error"] is not None]
     if errors:
@@ -248,10 +284,37 @@ class Plan:
     pairs: tuple[Pair, ...]
     preset: str = "default"
     """The learner preset robot 2 learns with (``learning.presets``)."""
+    learners: tuple[str, ...] | None = None
+    """The learners every method runs on; None: each section's own (``Section.learners``)."""
 
     @property
     def name(self) -> str:
         return f"benchmark-{self.suite.name}"
+
+    def learners_of(self, pair: Pair) -> tuple[str, ...]:
+        return self.learners if self.learners is not None else pair.section.learners
+
+    def entries(self, pair: Pair) -> list[tuple[str, list[str]]]:
+        """(learner, the methods it runs) for ``pair``, per learner."""
+        return [(lr, learner_methods(lr, self.methods)) for lr in self.learners_of(pair)]
+
+    def labels(self, pair: Pair | None = None) -> list[str]:
+        """The records' names of ``pair`` (None: of every pair, in order): per learner, its methods
+        (:func:`label`)."""
+        pairs = self.pairs if pair is None else (pair,)
+        return list(dict.fromkeys(label(m, lr) for p in pairs for lr, ms in self.entries(p) for m in ms))
+
+    def all_trial_runs(self, pair: Pair, source_result: dict | None) -> list[dict]:
+        """Every trial run of ``pair``: per learner, :meth:`Pair.trial_runs` of its methods."""
+        return [run for lr, ms in self.entries(pair) for run in pair.trial_runs(ms, source_result, lr)]
+
+    def waiting_runs(self, pair: Pair, source_result: dict) -> list[dict]:
+        """The trial runs of ``pair`` that wait for its source run, every learner's."""
+        return [run for lr, ms in self.entries(pair) for run in pair.waiting_runs(ms, source_result, lr)]
+
+    def trials_of(self, pair: Pair) -> int:
+        """Trial runs of ``pair``, every learner's."""
+        return sum(len(ms) for _, ms in self.entries(pair)) * pair.section.trials
 
     def spec(self) -> dict:
         """What the store holding this plan's runs is for (its key is a hash of it)."""
@@ -260,15 +323,18 @@ class Plan:
                 "source_config": SOURCE_CONFIG.to_dict()}
         if self.preset != "default":  # the default's store keeps the key it had before presets
             spec["preset"] = self.preset
+        if self.learners is not None:  # each section's own learners: the key it had before learners
+            spec["learners"] = list(self.learners)
         return {"benchmark": spec}
 
     def size(self) -> int:
         """Runs in all: a source run and every method's trials per pair."""
-        return sum(1 + len(self.methods) * p.section.trials for p in self.pairs)
+        return sum(1 + self.trials_of(p) for p in self.pairs)
 
     def waiting(self, pair: Pair) -> int:
         """Trial runs of ``pair`` that wait for its source run (their methods read the trajectory)."""
-        return sum(benchmark_runs.needs_trajectory(m) for m in self.methods) * pair.section.trials
+        return sum(benchmark_runs.needs_trajectory(m) for _, ms in self.entries(pair) for m in ms) \
+            * pair.section.trials
 
     def records(self, result: Lookup) -> list[dict]:
         """One record per (section, case, source seed, method), in the plan's order, from the
@@ -277,12 +343,12 @@ class Plan:
         for pair in self.pairs:
             source = result(pair.source_run())
             if source is None:
-                missing += 1 + len(self.methods) * pair.section.trials
+                missing += 1 + self.trials_of(pair)
                 continue
-            trials = [(run, result(run)) for run in pair.trial_runs(self.methods, source)]
+            trials = [(run, result(run)) for run in self.all_trial_runs(pair, source)]
             missing += sum(r is None for _, r in trials)
-            for name in self.methods:
-                mine = [r for run, r in trials if run["method"] == name]
+            for name in self.labels(pair):
+                mine = [r for run, r in trials if label(run["method"], run["learner"]) == name]
                 if all(r is not None for r in mine):
                     out.append(record(pair, name, source, cast(list, mine)))
         if missing:
@@ -297,8 +363,9 @@ class Plan:
             src = pair.source_run()
             source_seconds = seconds(src) or 0.0
             per_method: dict[str, float] = {}
-            for run in pair.trial_runs(self.methods, result(src)):
-                per_method[run["method"]] = per_method.get(run["method"], 0.0) + (seconds(run) or 0.0)
+            for run in self.all_trial_runs(pair, result(src)):
+                name = label(run["method"], run["learner"])
+                per_method[name] = per_method.get(name, 0.0) + (seconds(run) or 0.0)
             total += source_seconds + sum(per_method.values())
             rows.append({"section": pair.section.name, "case": pair.index, "source_seed": pair.source_seed,
                          "source_seconds": round(source_seconds, 3),
@@ -307,11 +374,13 @@ class Plan:
 
 
 def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
-         ran: Sequence[str] | None = None, missing: Sequence[str] = (), preset: str = "default") -> Plan:
+         ran: Sequence[str] | None = None, missing: Sequence[str] = (), preset: str = "default",
+         learners: Sequence[str] | None = None) -> Plan:
     """Every pair of ``suite`` for ``seed``, its task's cells drawn and checked for both robots
     (an error names the case before anything runs); ``ran``: the methods (default
     :func:`methods_to_run`'s); robot 2 learns with the settings of ``preset`` (robot 1 always
-    with the defaults)."""
+    with the defaults); ``learners``: the learners every method runs on (None: each section's
+    own)."""
     learner = presets.config(preset)
     if ran is None:
         ran, missing = methods_to_run()
@@ -328,23 +397,25 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
                     raise InvalidTaskError(f"{case.label}: {target.name} cannot reach the goal")
                 pairs.append(Pair(section, ci, case, j, run_seed(seed, section.name, ci, j), target.layout.xy(start),
                                   target.layout.xy(goal), len(path) - 1, learner))
-    return Plan(suite, int(seed), tuple(ran), tuple(missing), tuple(pairs), preset)
+    return Plan(suite, int(seed), tuple(ran), tuple(missing), tuple(pairs), preset,
+                None if learners is None else tuple(learners))
 
 
 def run_suite(suite: suites.Suite, seed: int = 0, tick: Callable[[], None] | None = None,
-              threads: int | None = None, preset: str = "default") -> tuple[list[dict], dict]:
+              threads: int | None = None, preset: str = "default",
+              learners: Sequence[str] | None = None) -> tuple[list[dict], dict]:
     """Every run of ``suite``, in this process: (records, one per (section, case, source seed,
     method), and the seconds of the runs, kept apart so that the records depend on ``seed``
     alone). A pair's trial runs share ``threads`` threads (None: one per CPU); ``tick`` is
     called once per trial. Robot 2 learns with the settings of ``preset`` (``learning.presets``)."""
     robots = Robots({})
-    p = plan(suite, seed, robots, preset=preset)
+    p = plan(suite, seed, robots, preset=preset, learners=learners)
     results: dict[str, dict] = {}
     seconds: dict[str, float] = {}
     for pair in p.pairs:
         src = pair.source_run()
         results[src["key"]], seconds[src["key"]] = benchmark_runs.execute(src, robots.resolved)
-        runs = pair.trial_runs(p.methods, results[src["key"]])
+        runs = p.all_trial_runs(pair, results[src["key"]])
         done = experiment.map_trials(lambda i: benchmark_runs.execute(runs[i], robots.resolved), len(runs), threads,
                                      on_trial=tick)
         for run, (result, secs) in zip(runs, done):

@@ -26,7 +26,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
-from armtransfer.errors import ArmTransferError
+from armtransfer.errors import ArmTransferError, PluginError
 from armtransfer.experiments import experiment
 from armtransfer.experiments.stats import learning_metrics
 from armtransfer.experiments.sweep import content_key
@@ -116,10 +116,20 @@ def _sarsa_trial(run: dict, target: DiscreteRobot) -> dict:
             "K": res.extra.get("K")}
 
 
+def _outside_trial(run: dict, target: DiscreteRobot) -> dict:
+    """One trial of a learner of ``armtransfer.learning.learners`` (``learner_trial``'s harness)."""
+    from armtransfer.experiments import learner_trial
+
+    traj = run.get("trajectory")
+    return learner_trial.run_trial(learner_trial.known(run["learner"]), run, target,
+                                   None if traj is None else trajectory_of(traj))
+
+
 LEARNERS: dict[str, Callable[[dict, DiscreteRobot], dict]] = {LEARNER: _sarsa_trial}
 """Learner name -> the function running one trial run on robot 2: ``(run, target) -> result``
 with the fields :func:`trial_problem` checks. It may raise an ``ArmTransferError`` (the method
-refuses the case: recorded as the run's ``error``)."""
+refuses the case: recorded as the run's ``error``). A learner not here, of
+``armtransfer.learning.learners.LEARNERS`` (a plugin's), runs through ``learner_trial``."""
 
 
 def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
@@ -143,10 +153,19 @@ def trial_result(run: dict, target: DiscreteRobot) -> dict:
     if needs_trajectory(run["method"]) and run.get("trajectory") is None:
         return {"error": f"no trajectory: {run.get('source_failure')}"}
     learner = LEARNERS.get(run["learner"])
-    if learner is None:  # a run of a learner this build does not have fails; it is no result
-        raise ArmTransferError(f"unknown learner {run['learner']!r}; valid learners: {', '.join(LEARNERS)}")
+    if learner is None:
+        from armtransfer.learning.learners import LEARNERS as OUTSIDE
+
+        if run["learner"] not in OUTSIDE:  # a run of a learner this build does not have fails; it is no result
+            valid = dict.fromkeys([*LEARNERS, *OUTSIDE])
+            raise ArmTransferError(f"unknown learner {run['learner']!r}; valid learners: {', '.join(valid)}")
+        learner = _outside_trial
     try:
         return learner(run, target)
+    except PluginError as err:  # an outside learner's fault is no refusal of the case: its run fails
+        if run["learner"] not in LEARNERS:
+            raise
+        return {"error": str(err)}
     except ArmTransferError as err:
         return {"error": str(err)}
 

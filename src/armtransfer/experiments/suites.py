@@ -59,6 +59,9 @@ class Case:
         return f"{self.source} -> {self.target}, {task}{wind}"
 
 
+DEFAULT_LEARNERS = ("sarsa",)
+
+
 @dataclass(frozen=True)
 class Section:
     name: str
@@ -69,6 +72,20 @@ class Section:
     """Trials of every method per source seed."""
     max_total_steps: int
     """A trial's step cap: a first exposure not reached by then is censored there."""
+    learners: tuple[str, ...] = ("sarsa",)
+    """The learners every method runs on (``armtransfer.learning.learners``), each method beside
+    the baseline run by the same learner; an outside learner runs ``none`` and the reward-term
+    methods."""
+
+    def to_dict(self) -> dict:
+        """The section as stored and reported; the default learners are left out, so a suite that
+        runs the built-in learner alone keeps the store key and the bytes it had before."""
+        out = asdict(self)
+        if self.learners == DEFAULT_LEARNERS:
+            del out["learners"]
+        else:
+            out["learners"] = list(self.learners)
+        return out
 
 
 @dataclass(frozen=True)
@@ -82,7 +99,7 @@ class Suite:
     def to_dict(self) -> dict:
         return {"name": self.name, "version": self.version, "held_out": self.held_out,
                 "description": self.description, "methods": list(METHODS), "budget_factor": BUDGET_FACTOR,
-                "sections": [asdict(s) for s in self.sections]}
+                "sections": [s.to_dict() for s in self.sections]}
 
 
 def _both_ways(pairs: list[tuple[str, str]], tasks: tuple[int | None, ...], wind: float = 0.0) -> tuple[Case, ...]:

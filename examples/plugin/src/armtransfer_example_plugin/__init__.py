@@ -1,1 +1,2 @@
-"""An example plugin for armtransfer: one transfer method, ``breadcrumbs`` (``method.py``)."""
+"""An example plugin for armtransfer: one transfer method, ``breadcrumbs`` (``method.py``), and one
+learner, ``tabular-q`` (``learner.py``)."""

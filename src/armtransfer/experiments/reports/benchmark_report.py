@@ -172,6 +172,8 @@ def write_figures(summary: dict, suite: suites.Suite, out: Path) -> None:
 def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str], missing: list[str]) -> str:
     from armtransfer.experiments.benchmark import baselines_of, registered_baseline
 
+    from armtransfer.experiments.benchmark import parse_label
+
     kind = ("held out: no parameter of any method was chosen on it" if suite.held_out
             else "not held out: parameters may be chosen on it")
     out = [f"# Benchmark `{suite.name}` (version {suite.version})", "",
@@ -182,7 +184,17 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
     out.append(markdown_table(["method", "baselines (the first: told nothing)", "what it is"],
                               [[m, (", ".join(baselines_of(m)) or "-") + ("" if m == "none" or registered_baseline(m)
                                                                           else " (default: the registry names none)"),
-                                methods.get(m).description] for m in ran]))
+                                describe(m, parse_label)] for m in ran]))
+    outside = sorted({parse_label(m)[1] for m in ran} - {"sarsa"})
+    if outside:
+        from armtransfer.experiments import learner_trial as lt
+
+        out += ["", f"`METHOD@LEARNER`: the method run by the outside learner {', '.join(outside)} "
+                "(docs/extending.md), on the case's Gymnasium environment with the method's reward term "
+                "(`TransferReward`). The harness counts the steps; it learns in chunks of the step cap / "
+                f"{lt.CHUNKS}, each followed by one greedy episode (capped at {lt.EVAL_CAP}x the shortest "
+                f"path); converged: {lt.EVALS} greedy episodes in a row at most {1 + lt.TOLERANCE:g}x the "
+                "shortest path, its steps those at the first of them; otherwise censored at the cap."]
     if missing:
         out += ["", f"Not in this build's method registry, so not run: {', '.join(missing)}."]
     out += ["", "## Claims", ""]
@@ -228,6 +240,18 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
             "variance of log first exposure that lies between source seeds.",
             ""]
     return "\n".join(out)
+
+
+def describe(name: str, parse_label) -> str:
+    """What a record's method is: the method's description, and its learner's when not the built-in."""
+    method, learner = parse_label(name)
+    text = methods.get(method).description
+    if learner != "sarsa":
+        from armtransfer.learning.learners import LEARNERS
+
+        found = LEARNERS.get(learner)
+        text += f"; learned by {learner}" + (f" ({found.description})" if found is not None else "")
+    return text
 
 
 def seed_effect_text(suite: suites.Suite, summary: dict) -> str:

@@ -1,0 +1,251 @@
+"""One benchmark trial of a learner from outside the package (``armtransfer.learning.learners``).
+
+The learner is handed the case's training environment: the robot's ``RobotRoomsEnv`` (what
+``armtransfer/Rooms-v0`` and ``armtransfer/ArmRooms-v0`` make) under a ``TimeLimit`` of
+``registration.MAX_EPISODE_STEPS`` steps, wrapped in ``TransferReward`` with the method when
+the method has a reward term (none for ``none``), and under it all the harness's
+:class:`Monitor`, which counts every step and episode itself and checks every action. The
+learner never reports a number.
+
+It learns in chunks, ``model.learn(chunk)`` with ``chunk = budget // CHUNKS``, until the trial's
+step budget (the section's ``max_total_steps``). After each chunk one greedy episode
+(``predict(obs, deterministic=True)``) runs on a separate environment of the same case without
+the reward term (its own wind stream), capped at :data:`EVAL_CAP` x the target's shortest path.
+**Convergence**: :data:`EVALS` consecutive greedy episodes reach the goal in at most (1 +
+:data:`TOLERANCE`) x the shortest path; the steps to convergence are the training steps at the
+first of them; a trial that does not get there within the budget is censored at it.
+From the monitored stream: the first exposure (training steps until the goal was first
+reached; None, censored, if never within the budget), the episodes' steps (an unfinished
+episode negative, as the kernel's) and the learning curve and its area
+(``learning_metrics.curve``).
+
+Seeds: ``SeedSequence([seed, 0, trial])``, as the kernel's trial ``trial``, gives the model's
+seed, the training environment's and the evaluation environment's, so trial ``trial`` of a
+method and of its baseline start from the same seeds.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from armtransfer.errors import ArmTransferError, PluginError
+from armtransfer.experiments.stats import learning_metrics
+from armtransfer.learning import learners as registry
+from armtransfer.learning import methods
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.learners import Learner
+from armtransfer.learning.trajectory import Trajectory
+from armtransfer.learning.transfer_reward import TransferReward
+from armtransfer.registration import MAX_EPISODE_STEPS
+from armtransfer.tasks.catalog import custom_task
+from armtransfer.tasks.envs import RobotRoomsEnv
+from armtransfer.tasks.robot import DiscreteRobot
+
+CHUNKS = 200
+"""Greedy evaluations per trial budget: a chunk is ``max_total_steps // CHUNKS`` training steps."""
+
+EVALS = 3
+"""Consecutive greedy episodes at (1 + TOLERANCE) x the shortest path that make a trial converged."""
+
+TOLERANCE = 0.25
+"""A greedy episode counts towards convergence when its steps are at most (1 + TOLERANCE) x the
+target's shortest path."""
+
+EVAL_CAP = 4
+"""A greedy episode stops after EVAL_CAP x the target's shortest path steps (failed)."""
+
+PROBE_STEPS = 64
+"""Steps a learner learns in its probe before a benchmark opens its store."""
+
+
+def reward_methods(names: list[str] | tuple[str, ...]) -> list[str]:
+    """Those of ``names`` an outside learner runs: ``none`` and the methods whose transfer is a
+    reward term alone (``TransferReward``); the others change how the kernel chooses actions."""
+    return [n for n in names if n == "none" or n in methods.REWARD_ONLY]
+
+
+def where(learner: Learner) -> str:
+    return f"learner {learner.name!r} ({learner.origin})"
+
+
+def action_of(raw: object, space: gym.spaces.Discrete, said: str) -> int:
+    """The action index ``raw`` stands for (a Python or numpy integer, a 0-d or one-element integer
+    array, an integral float); anything else is a one-line :class:`PluginError` starting ``said``."""
+    value = raw
+    if isinstance(value, np.ndarray):
+        if value.size != 1 or value.ndim > 1:
+            raise PluginError(f"{said} an action of shape {value.shape}; an action of this environment is one "
+                              f"integer in 0..{int(space.n) - 1}")
+        value = value.reshape(()).item()
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise PluginError(f"{said} {type(raw).__name__} {raw!r} as an action; an action of this environment is one "
+                          f"integer in 0..{int(space.n) - 1}")
+    number = float(value)
+    if not math.isfinite(number) or not number.is_integer() or not 0 <= number < int(space.n):
+        raise PluginError(f"{said} the action {value!r}, not in the action space {space} (one integer in "
+                          f"0..{int(space.n) - 1})")
+    return int(number)
+
+
+class Monitor(gym.Wrapper):
+    """What the harness knows of training: every step and episode, counted here; every action
+    checked (a learner stepping with a non-action is refused, naming it)."""
+
+    def __init__(self, env: gym.Env, said: str) -> None:
+        super().__init__(env)
+        self.said = said
+        self.total = 0
+        self.episode = 0
+        self.episode_steps: list[int] = []
+        self.first_exposure: int | None = None
+
+    def reset(self, **kwargs: Any):
+        if self.episode:  # an episode given up unfinished: negative, as the kernel's
+            self.episode_steps.append(-self.episode)
+            self.episode = 0
+        return self.env.reset(**kwargs)
+
+    def step(self, action: Any):
+        space = self.action_space
+        assert isinstance(space, gym.spaces.Discrete)
+        a = action_of(action, space, f"{self.said}: its model stepped the environment with")
+        obs, reward, terminated, truncated, info = self.env.step(a)
+        self.total += 1
+        self.episode += 1
+        if terminated:
+            if self.first_exposure is None:
+                self.first_exposure = self.total
+            self.episode_steps.append(self.episode)
+            self.episode = 0
+        elif truncated:
+            self.episode_steps.append(-self.episode)
+            self.episode = 0
+        return obs, reward, terminated, truncated, info
+
+    def stream(self) -> list[int]:
+        """Every episode's steps, the one under way last (negative)."""
+        return self.episode_steps + ([-self.episode] if self.episode else [])
+
+
+def _call(said: str, what: str, fn: Any, *args: Any, **kwargs: Any) -> Any:
+    """``fn(*args)``; whatever it raises is the learner's fault, in one line naming it."""
+    try:
+        return fn(*args, **kwargs)
+    except PluginError:
+        raise
+    except (Exception, SystemExit) as err:  # noqa: BLE001 - a plugin's bug, said in one line
+        raise PluginError(f"{said}: its {what} raised {type(err).__name__}: {err}".splitlines()[0]) from None
+
+
+def case_env(target: DiscreteRobot, start: list[int], goal: list[int], wind: float,
+             config: LearnerConfig) -> RobotRoomsEnv:
+    """The case's environment (no reward term, no time limit)."""
+    task = custom_task((int(start[0]), int(start[1])), (int(goal[0]), int(goal[1])), target.layout)
+    return RobotRoomsEnv(target, task, wind=wind, step_reward=config.step_reward, goal_reward=config.goal_reward)
+
+
+def training_env(target: DiscreteRobot, run: dict, config: LearnerConfig,
+                 trajectory: Trajectory | None) -> tuple[gym.Env, TransferReward | None]:
+    """The case's training environment: the time limit of the registered ids, and the method's
+    reward term when it has one."""
+    env: gym.Env = gym.wrappers.TimeLimit(case_env(target, run["start"], run["goal"], run["wind"], config),
+                                          max_episode_steps=MAX_EPISODE_STEPS)
+    if run["method"] == "none":
+        return env, None
+    if run["method"] not in methods.REWARD_ONLY:
+        raise ArmTransferError(f"method {run['method']!r} changes how the kernel chooses actions; an outside learner "
+                               f"runs only none and the reward-term methods ({', '.join(methods.REWARD_ONLY)})")
+    assert trajectory is not None
+    wrapped = TransferReward(env, trajectory, method=run["method"], K="auto", gamma=config.gamma)
+    return wrapped, wrapped
+
+
+def seeds(seed: int, trial: int) -> tuple[int, int, int]:
+    """(the model's, the training environment's, the evaluation environment's) seed of trial ``trial``."""
+    state = np.random.SeedSequence([int(seed), 0, int(trial)]).generate_state(3, dtype=np.uint32)
+    return int(state[0]), int(state[1]), int(state[2])
+
+
+def greedy_episode(model: Any, env: RobotRoomsEnv, cap: int, said: str) -> int | None:
+    """Steps of one greedy episode to the goal (None: not within ``cap``)."""
+    obs, _ = env.reset()
+    space = env.action_space
+    assert isinstance(space, gym.spaces.Discrete)
+    for k in range(1, cap + 1):
+        out = _call(said, "predict", model.predict, obs, deterministic=True)
+        if not isinstance(out, tuple) or len(out) != 2:
+            raise PluginError(f"{said}: its predict returned {type(out).__name__}, not (action, state)")
+        a = action_of(out[0], space, f"{said}: its predict returned")
+        obs, _, terminated, _, _ = env.step(a)
+        if terminated:
+            return k
+    return None
+
+
+def run_trial(learner: Learner, run: dict, target: DiscreteRobot, trajectory: Trajectory | None) -> dict:
+    """One trial run of ``learner``: the fields of ``benchmark_runs.trial_problem`` (and the
+    greedy evaluations, as ``[training steps, greedy steps or None]``)."""
+    said = where(learner)
+    config = LearnerConfig(**run["config"])
+    budget = int(config.max_total_steps)
+    model_seed, env_seed, eval_seed = seeds(run["seed"], run["trial"])
+    inner, term = training_env(target, run, config, trajectory)
+    env = Monitor(inner, said)
+    env.reset(seed=env_seed)
+    ev = case_env(target, run["start"], run["goal"], run["wind"], config)
+    ev.reset(seed=eval_seed)
+    path = target.shortest_path(ev.start_state, ev.goal_cell)
+    if path is None:
+        raise ArmTransferError(f"{target.name} cannot reach the goal")
+    optimal = max(len(path) - 1, 1)
+    cap, good = EVAL_CAP * optimal, (1 + TOLERANCE) * optimal
+    model = _call(said, "make", learner.make, env, model_seed)
+    chunk = max(budget // CHUNKS, 1)
+    evals: list[list[int | None]] = []
+    converged_at: int | None = None
+    greedy: int | None = None
+    while env.total < budget:
+        before = env.total
+        _call(said, "learn", model.learn, min(chunk, budget - env.total))
+        if env.total == before:
+            raise PluginError(f"{said}: its learn({min(chunk, budget - before)}) took no step of the environment")
+        steps = greedy_episode(model, ev, cap, said)
+        evals.append([env.total, steps])
+        last = evals[-EVALS:]
+        if len(last) == EVALS and all(s is not None and s <= good for _, s in last):
+            converged_at, greedy = last[0][0], last[-1][1]
+            break
+    converged = converged_at is not None and converged_at <= budget
+    first = env.first_exposure if env.first_exposure is not None and env.first_exposure <= budget else None
+    stream = env.stream()
+    curve = learning_metrics.curve(stream, greedy if converged else None)
+    return {"error": None, "first_exposure": first, "converged": converged,
+            "convergence_steps": converged_at if converged else None, "greedy_steps": greedy if converged else None,
+            "episodes": len(stream), "area": float(curve.sum()), "curve": [float(v) for v in curve],
+            "K": None if term is None else float(term.K), "evaluations": evals}
+
+
+def probe(learner: Learner, target: DiscreteRobot, start: list[int], goal: list[int]) -> None:
+    """``learner`` made on the case's environment (no reward term), learning :data:`PROBE_STEPS`
+    steps, then predicting greedily a few steps: a learner that raises or acts outside the action
+    space is refused now, in one line, before a benchmark writes anything."""
+    said = f"{where(learner)}, on robot {target.name}"
+    config = LearnerConfig()
+    env = Monitor(gym.wrappers.TimeLimit(case_env(target, start, goal, 0.0, config),
+                                         max_episode_steps=MAX_EPISODE_STEPS), said)
+    env.reset(seed=0)
+    model = _call(said, "make", learner.make, env, 0)
+    if model is None or not all(callable(getattr(model, m, None)) for m in ("learn", "predict")):
+        raise PluginError(f"{said}: its make returned {type(model).__name__}, not a model with learn and predict")
+    _call(said, "learn", model.learn, PROBE_STEPS)
+    greedy_episode(model, case_env(target, start, goal, 0.0, config), 4, said)
+
+
+def known(name: str) -> Learner:
+    """The outside learner ``name`` (an unknown one: a one-line error listing the valid ones)."""
+    return registry.get(name)

@@ -1,0 +1,175 @@
+"""Learners from outside the package: what a researcher writes, and how it is found.
+
+A learner is a :class:`Learner`: a name, a one-line description and ``make(env, seed)``, which
+returns a :class:`Model` learning on the Gymnasium environment ``env`` (the case's
+``armtransfer/Rooms-v0`` or ``armtransfer/ArmRooms-v0`` environment, wrapped in
+``armtransfer.TransferReward`` when the method has a reward term), seeded by ``seed`` alone.
+A model is what stable-baselines3 users know: ``learn(total_timesteps)`` goes on learning
+for that many *more* environment steps, ``predict(observation, deterministic=True)`` returns
+``(action, state)``. The benchmark's harness (``armtransfer.experiments.learner_trial``) counts
+the steps and episodes itself, from the environment it hands over; a learner never reports
+its own numbers.
+
+A package makes its learner known under the entry-point group ``armtransfer.learners`` (the
+entry point's name is the learner's name, its object the :class:`Learner`); it is read on the
+first use of :data:`LEARNERS`. A notebook calls :func:`register_learner` instead. A plugin that
+cannot be imported, is not a :class:`Learner`, is named otherwise than its entry point or takes
+a name already taken is refused in one line (:class:`~armtransfer.errors.PluginError`) naming
+it and the fault; one whose ``make``, ``learn`` or ``predict`` raises, or whose actions are not
+actions of the environment, is refused by the harness's probe before a benchmark writes
+anything.
+
+The built-in learner, ``sarsa``, is SARSA(lambda) (Algorithm 1) in the compiled kernel: the
+benchmark runs it directly, not through ``make``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from dataclasses import replace as with_fields
+from typing import Any, Protocol
+
+import gymnasium
+
+from armtransfer.errors import InvalidParameterError, PluginError
+from armtransfer.learning.lazy_registry import Registry
+
+GROUP = "armtransfer.learners"
+"""The entry-point group installed packages declare their learners under."""
+
+RUN_TIME = "registered at run time"
+"""``Learner.origin`` of a learner given to :func:`register_learner`."""
+
+BUILTIN_ORIGIN = "armtransfer"
+
+SARSA = "sarsa"
+"""The built-in learner's name."""
+
+
+class Model(Protocol):
+    """A model learning on one environment, as stable-baselines3 users know it."""
+
+    def learn(self, total_timesteps: int) -> object:
+        """Go on learning for ``total_timesteps`` more environment steps."""
+        ...
+
+    def predict(self, observation: Any, deterministic: bool = True) -> tuple[Any, Any]:
+        """``(action, state)`` for ``observation``; ``state`` is the model's recurrent state (None)."""
+        ...
+
+
+@dataclass(frozen=True)
+class Learner:
+    """A learner: ``make(env, seed)`` is a :class:`Model` learning on ``env``, every random draw
+    of it from ``seed``."""
+
+    name: str
+    description: str
+    make: Callable[[gymnasium.Env, int], Model]
+    origin: str = RUN_TIME
+    """Where it comes from: ``armtransfer``, an installed plugin (named), or registered at run time."""
+
+
+def _sarsa_make(env: gymnasium.Env, seed: int) -> Model:
+    raise InvalidParameterError("the built-in learner 'sarsa' runs in armtransfer's compiled kernel "
+                                "(armtransfer.transfer, the benchmark), not as a model made on an environment")
+
+
+_BUILTIN = {SARSA: Learner(SARSA, "SARSA(lambda), Algorithm 1, in the compiled kernel, with the method's shaping "
+                                  "and its own convergence test (the greedy path unchanged for `patience` episodes)",
+                           _sarsa_make, origin=BUILTIN_ORIGIN)}
+
+
+def check(learner: object, where: str) -> Learner:
+    """``learner`` if it is a whole :class:`Learner`; else a one-line :class:`PluginError`
+    beginning with ``where``."""
+    from armtransfer.learning.plugins import NAME
+
+    if not isinstance(learner, Learner):
+        raise PluginError(f"{where} is {type(learner).__name__}, not a learner; make it with "
+                          "armtransfer.Learner(name, description, make)")
+    if not isinstance(learner.name, str) or not NAME.fullmatch(learner.name):
+        raise PluginError(f"{where}: a learner's name is lower-case letters, digits, '_', '.' or '-' (at most 64), "
+                          f"got {learner.name!r}")
+    d = learner.description
+    if not isinstance(d, str) or not d.strip() or "\n" in d.strip():
+        raise PluginError(f"{where}: learner {learner.name!r}: its description must be one line of text, got {d!r}")
+    if not callable(learner.make):
+        raise PluginError(f"{where}: learner {learner.name!r}: make must be a function (env, seed) -> model, "
+                          f"got {learner.make!r}")
+    return learner
+
+
+def _describe(ep: Any) -> str:
+    dist = getattr(ep, "dist", None)
+    who = f"{dist.metadata['Name']} {dist.version}" if dist is not None else "an unnamed distribution"
+    return f"plugin {who} (entry point {ep.name} = {ep.value} in group {GROUP})"
+
+
+def load_entry_points(registry: Registry[Learner]) -> None:
+    """Add every learner installed packages declare under :data:`GROUP` to ``registry``; a bad
+    one is a :class:`PluginError` naming it, and then none is added."""
+    from importlib.metadata import entry_points
+
+    found: dict[str, Learner] = {}
+    for ep in sorted(entry_points(group=GROUP), key=lambda e: (e.name, e.value)):
+        where = _describe(ep)
+        try:
+            obj = ep.load()
+        except (Exception, SystemExit) as err:  # noqa: BLE001 - any failure to import is the plugin's, in one line
+            raise PluginError(f"{where} fails to import: {type(err).__name__}: {err}".splitlines()[0]) from None
+        learner = check(obj, where)
+        if learner.name != ep.name:
+            raise PluginError(f"{where} is a learner named {learner.name!r}; name the entry point as the learner")
+        taken = registry.peek()
+        if learner.name in taken or learner.name in found:
+            other = taken[learner.name].origin if learner.name in taken else found[learner.name].origin
+            raise PluginError(f"{where} is named {learner.name!r}, as a learner of {other} is; rename one of them")
+        found[learner.name] = with_fields(learner, origin=where)
+    for name, learner in found.items():
+        registry.add(name, learner)
+
+
+LEARNERS: Registry[Learner] = Registry(_BUILTIN, load_entry_points)
+"""Every learner, ``sarsa`` first: the built-in one, then those of installed plugins (read on
+first use) and those registered in this process."""
+
+BUILTIN = tuple(_BUILTIN)
+
+
+def register_learner(learner: Learner, replace: bool = False) -> Learner:
+    """Make ``learner`` a learner of this process (a notebook's way; an installed package
+    declares an entry point instead). ``replace``: an earlier run-time registration of the same
+    name is replaced (a notebook cell run again), never the built-in or an installed plugin's."""
+    name = getattr(learner, "name", None)
+    where = f"learner {name!r} ({RUN_TIME})"
+    if not isinstance(learner, Learner):
+        raise PluginError(f"register_learner takes an armtransfer.Learner(name, description, make), "
+                          f"got {type(learner).__name__}")
+    check(learner, where)
+    if learner.name in LEARNERS:
+        old = LEARNERS[learner.name]
+        if not (replace and old.origin == RUN_TIME):
+            raise PluginError(f"{where}: the name is taken by a learner of {old.origin}; rename it"
+                              + ("" if old.origin != RUN_TIME else ", or pass replace=True"))
+    learner = with_fields(learner, origin=RUN_TIME)
+    LEARNERS[learner.name] = learner
+    return learner
+
+
+def get(name: str) -> Learner:
+    """The learner called ``name``; an unknown name is a one-line error listing the valid ones."""
+    try:
+        return LEARNERS[name]
+    except (KeyError, TypeError):
+        raise InvalidParameterError(f"unknown learner {name!r}; valid learners: {', '.join(LEARNERS)}") from None
+
+
+def parse(names: str | list[str] | tuple[str, ...]) -> tuple[str, ...]:
+    """Learner names from ``NAME[,NAME...]`` (or a list of them), each checked, in order, once."""
+    items = names.split(",") if isinstance(names, str) else [n for part in names for n in str(part).split(",")]
+    items = [n.strip() for n in items if n.strip()]
+    if not items:
+        raise InvalidParameterError(f"no learner named; valid learners: {', '.join(LEARNERS)}")
+    return tuple(dict.fromkeys(get(n).name for n in items))
