@@ -91,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
     from armtransfer.learning.methods import probe_on, refuse_run_time
 
     # a plugin's fault stops the run here, in one line, before its store is opened
-    probe_on(plan.methods, [robots(p.case.target) for p in plan.pairs])
+    probe_on(plan.methods, [robots(p.case.target_robot) for p in plan.pairs])
     refuse_run_time(plan.methods, "a benchmark's runs")  # every case's task checked before anything is written
     probe_learners(plan, robots)
     t0 = time.perf_counter()
@@ -123,16 +123,16 @@ def probe_learners(plan: benchmark.Plan, robots: benchmark.Robots) -> None:
     seen: set[tuple[str, str]] = set()
     for pair in plan.pairs:
         for name, ms in plan.entries(pair):
-            if name in BUILTIN or not ms or (name, pair.case.target) in seen:
+            if name in BUILTIN or not ms or (name, pair.case.target_robot) in seen:
                 continue
-            seen.add((name, pair.case.target))
+            seen.add((name, pair.case.target_robot))
             learner = get(name)
             if learner.origin == RUN_TIME:
                 raise PluginError(f"learner {name!r} was registered in this process (register_learner) and a "
                                   "benchmark's runs run in other processes, which cannot see it; install it as a "
                                   "package declaring it under the entry-point group armtransfer.learners "
                                   "(docs/extending.md)")
-            learner_trial.probe(learner, robots(pair.case.target), list(pair.start), list(pair.goal))
+            learner_trial.probe(learner, robots(pair.case.target_robot), list(pair.start), list(pair.goal))
 
 
 def _run_into(store: ResultStore, plan: benchmark.Plan, robots: dict, args: argparse.Namespace) -> int:

@@ -46,6 +46,19 @@ class Case:
     limit); None: at least ``benchmark.MIN_DISTANCE``."""
     cells: str = "any"
     """Which cells a drawn task's start and goal are on (``CELLS``)."""
+    world: str | None = None
+    """The world both robots move in (a built-in world's name, ``rooms11``; ``task`` is then one
+    of its tasks); None: the paper's rooms, whose cases name none (so they keep their bytes)."""
+
+    @property
+    def source_robot(self) -> str:
+        """The source robot's key in a benchmark's runs: its spec, ``@WORLD`` after it in a world."""
+        return robot_key(self.source, self.world)
+
+    @property
+    def target_robot(self) -> str:
+        """The target robot's key in a benchmark's runs (:attr:`source_robot`)."""
+        return robot_key(self.target, self.world)
 
     @property
     def label(self) -> str:
@@ -56,7 +69,13 @@ class Case:
         if self.task is None and self.cells != "any":
             task += f" on {self.cells} cells"
         wind = f", wind {self.wind:g}" if self.wind else ""
-        return f"{self.source} -> {self.target}, {task}{wind}"
+        world = f" in {self.world}" if self.world is not None else ""
+        return f"{self.source} -> {self.target}, {task}{world}{wind}"
+
+
+def robot_key(spec: str, world: str | None) -> str:
+    """``spec`` for the paper's rooms, ``spec@world`` in another world (``benchmark.Robots``)."""
+    return spec if world is None else f"{spec}@{world}"
 
 
 DEFAULT_LEARNERS = ("sarsa",)
@@ -81,6 +100,9 @@ class Section:
         """The section as stored and reported; the default learners are left out, so a suite that
         runs the built-in learner alone keeps the store key and the bytes it had before."""
         out = asdict(self)
+        for case in out["cases"]:  # a case in the paper's rooms names no world (its old bytes)
+            if case["world"] is None:
+                del case["world"]
         if self.learners == DEFAULT_LEARNERS:
             del out["learners"]
         else:
@@ -149,6 +171,16 @@ DEV = Section(
 FAST = Section(
     "fast", "coarse -> fine task 1, two source seeds: checks the whole protocol in seconds",
     (Case("coarse", "fine", 1),), source_seeds=2, trials=2, max_total_steps=300_000)
+SMALL_LEARNERS = ("sarsa", "dqn", "ppo")
+"""The learners of ``small``: the built-in SARSA(lambda) and stable-baselines3's DQN and PPO (the
+``sb3`` extra; ``armtransfer.learning.sb3``), which run ``none`` and the reward-term methods."""
+
+SMALL = Section(
+    "small", "the small rooms worlds rooms11 and rooms15, task 2 (north-east room to south-west), coarse -> fine, "
+    "learned by SARSA(lambda) and by stable-baselines3's DQN and PPO; rooms11 task 3 was the dev case the SB3 "
+    "settings and this step cap were chosen on (source seeds 100-104 of research/sb3_small.py)",
+    (Case("coarse", "fine", 2, world="rooms11"), Case("coarse", "fine", 2, world="rooms15")),
+    source_seeds=10, trials=2, max_total_steps=30_000, learners=SMALL_LEARNERS)
 
 SUITES: dict[str, Suite] = {
     s.name: s
@@ -161,6 +193,7 @@ SUITES: dict[str, Suite] = {
               (PAPER, RANDOM, EMBODIMENT, WIND)),
         Suite("dev", 3, False, DEV.description, (DEV,)),
         Suite("fast", 2, False, FAST.description, (FAST,)),
+        Suite("small", 1, True, SMALL.description, (SMALL,)),
     )
 }
 """Every suite by name."""

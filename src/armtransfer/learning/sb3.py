@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 
 from armtransfer.errors import MissingExtraError
+from armtransfer.learning.learners import Learner
 
 EXTRA = "sb3"
 """The extra that installs stable-baselines3 and torch."""
@@ -61,13 +62,15 @@ DQN_EXPLORATION_STEPS = 10_000
 
 DQN_FINAL_EPS = 0.05
 
-PPO_N_STEPS = 512
+PPO_N_STEPS = 256
 
 PPO_KWARGS: dict[str, Any] = {
-    "learning_rate": 3e-4, "n_steps": PPO_N_STEPS, "batch_size": 64, "n_epochs": 4, "gamma": 0.99,
+    "learning_rate": 1e-3, "n_steps": PPO_N_STEPS, "batch_size": 64, "n_epochs": 4, "gamma": 0.99,
     "gae_lambda": 0.95, "ent_coef": 0.01, "policy_kwargs": {"net_arch": [64, 64]},
 }
 """PPO's settings (SB3's defaults otherwise)."""
+
+ORIGIN = "armtransfer (the sb3 extra)"
 
 _RNG_LOCK = threading.Lock()
 
@@ -172,3 +175,14 @@ def make_ppo(env: Any, seed: int) -> SB3Model:
         return PPO("MlpPolicy", env, seed=int(seed), device="cpu", verbose=0, **PPO_KWARGS)
 
     return SB3Model(build)
+
+
+_NOTE = "" if available() else f" (unavailable here: {INSTALL})"
+
+DQN = Learner("dqn", f"stable-baselines3 DQN on the CPU: an MLP (64, 64) over the one-hot state, epsilon 1 -> "
+                     f"{DQN_FINAL_EPS} over {DQN_EXPLORATION_STEPS:,} steps{_NOTE}", make_dqn, origin=ORIGIN)
+"""The ``dqn`` learner (entry point ``dqn`` of ``armtransfer.learners``)."""
+
+PPO = Learner("ppo", f"stable-baselines3 PPO on the CPU: an MLP (64, 64) over the one-hot state, rollouts of "
+                     f"{PPO_N_STEPS} steps{_NOTE}", make_ppo, origin=ORIGIN)
+"""The ``ppo`` learner (entry point ``ppo`` of ``armtransfer.learners``)."""
