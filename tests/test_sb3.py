@@ -120,11 +120,17 @@ def _entry_point_site(tmp_path: Path) -> Path:
     return site
 
 
-def _cli(tmp_path: Path, *args: str) -> subprocess.CompletedProcess:
+def _cli(tmp_path: Path, *args: str, code: str | None = None) -> subprocess.CompletedProcess:
+    """``armtransfer ARGS`` (or ``python -c code ARGS``) seeing this tree's learners' entry points."""
     installed = {ep.name for ep in entry_points(group=GROUP)}
-    path = [str(ROOT / "src")] if {"dqn", "ppo"} <= installed else [str(_entry_point_site(tmp_path)), str(ROOT / "src")]
+    path = [str(ROOT / "src")]
+    if not {"dqn", "ppo"} <= installed and not (tmp_path / "site").exists():
+        _entry_point_site(tmp_path)
+    if not {"dqn", "ppo"} <= installed:
+        path.insert(0, str(tmp_path / "site"))
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([*path, os.environ.get("PYTHONPATH", "")]))
-    return subprocess.run([sys.executable, "-m", "armtransfer", *args], cwd=tmp_path, env=env, capture_output=True,
+    head = ["-m", "armtransfer"] if code is None else ["-c", code]
+    return subprocess.run([sys.executable, *head, *args], cwd=tmp_path, env=env, capture_output=True,
                           text=True, timeout=900)
 
 
@@ -143,12 +149,16 @@ def test_the_pyproject_declares_dqn_and_ppo_and_the_sb3_extra():
 
 
 def test_without_the_extra_the_benchmark_says_what_to_install_in_one_line(tmp_path):
-    if sb3.available():
-        pytest.skip("the sb3 extra is installed here, so it cannot be missing")
-    done = _cli(tmp_path, "benchmark", "--suite", "fast", "--learner", "dqn", "--out", "runs/x")
-    assert done.returncode == 2 and "Traceback" not in done.stderr
-    assert len(done.stderr.strip().splitlines()) == 1 and "armtransfer[sb3]" in done.stderr
+    # stable-baselines3 hidden from the command's process (None in sys.modules: not found)
+    hide = ("import sys; sys.modules['stable_baselines3'] = None; sys.modules['torch'] = None; "
+            "from armtransfer.cli import main; sys.exit(main(sys.argv[1:]))")
+    done = _cli(tmp_path, "benchmark", "--suite", "fast", "--learner", "dqn", "--out", "runs/x", code=hide)
+    assert done.returncode == 2, done.stderr
+    assert "Traceback" not in done.stderr and len(done.stderr.strip().splitlines()) == 1
+    assert "learner 'dqn' needs stable-baselines3 and torch" in done.stderr and "armtransfer[sb3]" in done.stderr
     assert not (tmp_path / "runs" / "x").exists()
+    helped = _cli(tmp_path, "benchmark", "--help", code=hide)
+    assert "unavailable here: pip install 'armtransfer[sb3]'" in " ".join(helped.stdout.split())
 
 
 @needs_sb3
