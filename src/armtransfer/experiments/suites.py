@@ -178,7 +178,7 @@ SMALL_LEARNERS = ("sarsa", "dqn", "ppo")
 SMALL = Section(
     "small", "the small rooms worlds rooms11 and rooms15, task 2 (north-east room to south-west), coarse -> fine, "
     "learned by SARSA(lambda) and by stable-baselines3's DQN and PPO; rooms11 task 3 was the dev case the SB3 "
-    "settings and this step cap were chosen on (source seeds 100-104 of research/sb3_small.py)",
+    "settings and this step cap were chosen on (source seeds 100 and 101 of research/sb3_small.py)",
     (Case("coarse", "fine", 2, world="rooms11"), Case("coarse", "fine", 2, world="rooms15")),
     source_seeds=10, trials=2, max_total_steps=25_000, learners=SMALL_LEARNERS)
 

@@ -12,7 +12,7 @@ extra to install (``pip install 'armtransfer[sb3]'``, torch first from its CPU i
 machine without a GPU: docs/benchmark.md).
 
 **Settings** (chosen on the dev cases only, rooms11 task 3 coarse -> fine, source seeds
-100-104; every variant tried is in docs/research-log.md):
+100 and 101; every variant tried is in docs/research-log.md):
 
 - observations are the robot's state index (``Discrete``), which SB3 one-hot encodes, so
   the networks are small MLPs over a one-hot state;
