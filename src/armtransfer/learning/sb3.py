@@ -104,6 +104,7 @@ class SB3Model:
     predicts, with its own random states."""
 
     def __init__(self, build: Callable[[], Any]) -> None:
+        self._states: tuple[Any, Any, Any] | None = None
         with self._own_generators(fresh=True):
             self.algorithm = build()
 
@@ -117,6 +118,7 @@ class SB3Model:
             torch.set_num_threads(1)
             try:
                 if not fresh:
+                    assert self._states is not None
                     _set_global_states(self._states)
                 yield
                 self._states = _global_states()
