@@ -1,7 +1,8 @@
 """The example plugin (``examples/plugin``), installed beside armtransfer as a user installs a
 package, without touching this environment: ``pip install --target`` into a temporary folder
 put on PYTHONPATH, where importlib.metadata finds its dist-info and so its entry point. Its
-method, ``breadcrumbs``, is then a method of every command, with ``none`` as its baseline."""
+method, ``breadcrumbs``, is then a method of every command, with ``none`` as its baseline; its
+learner, ``tabular-q``, a learner of the benchmark."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 PLUGIN = ROOT / "examples" / "plugin"
 NAME = "breadcrumbs"
+LEARNER = "tabular-q"
 
 
 @pytest.fixture(scope="module")
@@ -100,3 +102,33 @@ def test_ray_workers_find_it_by_its_entry_point(site, tmp_path):
                                      f'methods = ["none", "{NAME}"]\nseeds = [0]\ntrials = 2\n')
     done = cli(site, tmp_path, "sweep", "s.toml", "--out", "sweep", "--executor", "ray", "--workers", "2")
     assert "2/2 runs in sweep; 0 failed" in done.stdout
+
+
+def test_the_installed_learner_is_in_learners_and_in_the_help(site, tmp_path):
+    code = ("import armtransfer\n"
+            f"lr = armtransfer.LEARNERS[{LEARNER!r}]\n"
+            "print(list(armtransfer.LEARNERS), lr.origin)\n")
+    out = run(site, tmp_path, sys.executable, "-c", code).stdout
+    assert out.startswith(f"['sarsa', '{LEARNER}'] plugin armtransfer-example-plugin 0.1.0 (entry point {LEARNER} = "
+                          "armtransfer_example_plugin.learner:TABULAR_Q in group armtransfer.learners)")
+    help_text = " ".join(cli(site, tmp_path, "benchmark", "--help").stdout.split())
+    assert f"{LEARNER}: example plugin:" in help_text
+
+
+@pytest.mark.slow  # the fast suite: two learners, the plugin's method and its baseline: 1-4 min
+def test_benchmark_runs_its_method_and_its_learner(site, tmp_path):
+    cli(site, tmp_path, "benchmark", "--suite", "fast", "--method", NAME, "--learner", f"sarsa,{LEARNER}",
+        "--out", "bench", "--workers", "2")
+    results = json.loads((tmp_path / "bench" / "results.json").read_text())
+    labels = [f"none@{LEARNER}", f"{NAME}@{LEARNER}"]
+    assert results["methods"] == ["none", NAME, *labels]
+    assert results["baselines"][labels[1]] == [labels[0]]
+    mine = [r for r in results["records"] if r.get("learner") == LEARNER]
+    assert {r["method"] for r in mine} == set(labels) and len(mine) == 2 * 2  # 2 source seeds
+    assert all(r["error"] is None and len(r["first_exposure"]) == 2 for r in mine)
+    assert all(n is None or 0 < n <= r["cap"] for r in mine for n in r["convergence_steps"])
+    report = (tmp_path / "bench" / "report.md").read_text()
+    assert f"`{labels[1]}` against `{labels[0]}`" in report and "outside learner tabular-q" in report
+    done = cli(site, tmp_path, "benchmark", "--suite", "fast", "--method", NAME, "--learner", f"sarsa,{LEARNER}",
+               "--out", "bench")  # every run is in: resumes to nothing
+    assert "0 to run" in done.stdout

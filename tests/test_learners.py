@@ -205,6 +205,10 @@ def test_an_outside_learner_runs_only_none_and_the_reward_term_methods():
     assert benchmark.learner_methods("sarsa", ran) == ran
     assert benchmark.learner_methods("dqn", ran) == ["none", "pseudo", "dense"]
     assert benchmark.baselines_of("pseudo@dqn") == ("none@dqn",) and benchmark.baselines_of("pseudo") == ("none",)
+    from armtransfer.experiments.reports.benchmark_report import describe
+
+    assert describe("none@dqn", benchmark.parse_label) == "no transfer; learned by dqn"
+    assert describe("none", benchmark.parse_label) == "Algorithm 1 without transfer"
 
 
 def test_the_default_learners_keep_the_suites_key_and_bytes():
@@ -372,3 +376,39 @@ def test_an_installed_learner_is_read_on_first_use_and_listed(tmp_path):
         "['sarsa', 'walker'] plugin good-learner 0.1 (entry point walker = goodlearn:L in group armtransfer.learners)"]
     helped = run_cli(tmp_path, "benchmark", "--help", path=site)
     assert "walker: steps action 0" in " ".join(helped.stdout.split())
+
+
+# -- worlds: a case carries its world, and a suite can run on a small one -------------------------
+
+def test_a_case_of_the_default_world_keeps_its_bytes_and_label():
+    case = suites.Case("coarse", "fine", 1)
+    assert case.world == "rooms" and case.label == "coarse -> fine, task 1"
+    assert "world" not in suites.FAST.to_dict()["cases"][0]
+    run = benchmark_runs.trial_run("none", 0, "coarse", "fine", [0, 0], [-8, 12], 0.0, 1, LearnerConfig(), None)
+    assert "world" not in run and benchmark_runs.robot_key("fine") == benchmark_runs.robot_key("fine", "rooms") == "fine"
+
+
+def test_a_suite_runs_on_a_small_world_with_its_tasks(registered):
+    registered(armtransfer.Learner("oracle", "wise from step 500", lambda env, seed: Oracle(env, seed, 500)))
+    small = suites.Section("rooms11", "coarse -> fine task 1 of rooms11", (suites.Case("coarse", "fine", 1,
+                                                                                        world="rooms11"),),
+                           source_seeds=1, trials=1, max_total_steps=4_000, learners=("oracle",))
+    suite = suites.Suite("rooms11", 1, False, small.description, (small,))
+    assert small.to_dict()["cases"][0]["world"] == "rooms11" and small.to_dict()["learners"] == ["oracle"]
+    robots = benchmark.Robots({})
+    plan = benchmark.plan(suite, 0, robots, ran=["none", "pseudo"])
+    pair = plan.pairs[0]
+    assert (pair.start, pair.goal) == ((0, 0), (-4, 4)) and pair.case.label.endswith(", in rooms11")
+    assert pair.source_run()["world"] == "rooms11" and set(robots.resolved) == {"coarse in rooms11", "fine in rooms11"}
+    records, _ = benchmark.run_suite(suite, 0, threads=1)
+    assert [r["method"] for r in records] == ["none@oracle", "pseudo@oracle", "dense@oracle"]
+    assert all(r["world"] == "rooms11" and r["optimal"] == pair.optimal for r in records)
+    assert records[0]["converged"] == [True] and records[0]["source_failure"] is None
+    # the built-in learner's trial of the same case runs on the same world's robot
+    source, _ = benchmark_runs.execute(pair.source_run(), robots.resolved)
+    sarsa = pair.trial_runs(["none"], source)[0]
+    result, _ = benchmark_runs.execute(sarsa, robots.resolved)
+    assert sarsa["world"] == "rooms11" and benchmark_runs.result_problem(sarsa, result) is None
+    with pytest.raises(armtransfer.ArmTransferError, match="unknown task '9' in world rooms11"):
+        benchmark.plan(suites.Suite("x", 1, False, "x", (dataclasses.replace(
+            small, cases=(suites.Case("coarse", "fine", 9, world="rooms11"),)),)), 0)

@@ -91,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
     from armtransfer.learning.methods import probe_on, refuse_run_time
 
     # a plugin's fault stops the run here, in one line, before its store is opened
-    probe_on(plan.methods, [robots(p.case.target_robot) for p in plan.pairs])
+    probe_on(plan.methods, [robots(p.case.target, p.case.world) for p in plan.pairs])
     refuse_run_time(plan.methods, "a benchmark's runs")  # every case's task checked before anything is written
     probe_learners(plan, robots)
     t0 = time.perf_counter()
@@ -120,19 +120,20 @@ def probe_learners(plan: benchmark.Plan, robots: benchmark.Robots) -> None:
     from armtransfer.experiments import learner_trial
     from armtransfer.learning.learners import BUILTIN, RUN_TIME, get
 
-    seen: set[tuple[str, str]] = set()
+    seen: set[tuple[str, str, str]] = set()
     for pair in plan.pairs:
         for name, ms in plan.entries(pair):
-            if name in BUILTIN or not ms or (name, pair.case.target_robot) in seen:
+            if name in BUILTIN or not ms or (name, pair.case.target, pair.case.world) in seen:
                 continue
-            seen.add((name, pair.case.target_robot))
+            seen.add((name, pair.case.target, pair.case.world))
             learner = get(name)
             if learner.origin == RUN_TIME:
                 raise PluginError(f"learner {name!r} was registered in this process (register_learner) and a "
                                   "benchmark's runs run in other processes, which cannot see it; install it as a "
                                   "package declaring it under the entry-point group armtransfer.learners "
                                   "(docs/extending.md)")
-            learner_trial.probe(learner, robots(pair.case.target_robot), list(pair.start), list(pair.goal))
+            target = robots(pair.case.target, pair.case.world)
+            learner_trial.probe(learner, target, list(pair.start), list(pair.goal))
 
 
 def _run_into(store: ResultStore, plan: benchmark.Plan, robots: dict, args: argparse.Namespace) -> int:

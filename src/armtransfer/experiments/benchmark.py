@@ -33,7 +33,7 @@ from armtransfer.experiments import benchmark_runs, experiment, suites
 from armtransfer.learning import methods
 from armtransfer.learning import presets
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.tasks.catalog import table_task, world_task
+from armtransfer.tasks.catalog import table_task
 from armtransfer.tasks.robot import DiscreteRobot
 
 MIN_DISTANCE = 10
@@ -161,29 +161,34 @@ def draw_task(source: DiscreteRobot, target: DiscreteRobot, rng: np.random.Gener
 
 @dataclass
 class Robots:
-    """Robots by spec, each resolved (and, for an arm, compiled or loaded) once per run; a spec
-    ``SPEC@WORLD`` (``suites.robot_key``) is the robot ``SPEC`` in the world ``WORLD``."""
+    """Robots by spec, each resolved (and, for an arm, compiled or loaded) once per run."""
 
     resolved: dict
 
-    def __call__(self, spec: str) -> DiscreteRobot:
-        if spec not in self.resolved:
+    def __call__(self, spec: str, world: str = suites.DEFAULT_WORLD) -> DiscreteRobot:
+        key = benchmark_runs.robot_key(spec, world)
+        if key not in self.resolved:
             from armtransfer.tasks.specs import resolve
 
-            robot, _, world = spec.rpartition("@") if "@" in spec else (spec, "", "")
-            if world:
-                from armtransfer.worlds.resolve import world as resolve_world
-
-                self.resolved[spec] = resolve(robot, layout=resolve_world(world))
+            if world == suites.DEFAULT_WORLD:
+                self.resolved[key] = resolve(spec)
             else:
-                self.resolved[spec] = resolve(spec)
-        return self.resolved[spec]
+                from armtransfer.worlds.resolve import world as layout_of
+
+                self.resolved[key] = resolve(spec, layout=layout_of(world))
+        return self.resolved[key]
 
 
 def case_cells(case: suites.Case, source: DiscreteRobot, target: DiscreteRobot, seed: int, section: str,
                index: int, source_seed: int) -> tuple[int, int]:
     if case.task is not None:
-        return table_task(case.task).cells() if case.world is None else world_task(source.layout, case.task).cells()
+        if case.world == suites.DEFAULT_WORLD:
+            if isinstance(case.task, bool) or not isinstance(case.task, int):
+                raise InvalidTaskError(f"{case.label}: a task of the rooms is a Table I task number")
+            return table_task(case.task).cells()
+        from armtransfer.tasks.catalog import world_task
+
+        return world_task(target.layout, case.task).cells()
     rng = np.random.default_rng(np.random.SeedSequence(
         [int(seed), section_key(section), int(index), int(source_seed), 1]))
     return draw_task(source, target, rng, case.distance, case.cells)
@@ -226,16 +231,16 @@ class Pair:
         return replace(self.learner, max_total_steps=self.section.max_total_steps)
 
     def source_run(self) -> dict:
-        return benchmark_runs.source_run(self.case.source_robot, self.case.target_robot, list(self.start), list(self.goal),
-                                         self.seed, SOURCE_CONFIG)
+        return benchmark_runs.source_run(self.case.source, self.case.target, list(self.start), list(self.goal),
+                                         self.seed, SOURCE_CONFIG, world=self.case.world)
 
     def trial_runs(self, names: Sequence[str], source_result: dict | None,
                    learner: str = benchmark_runs.LEARNER) -> list[dict]:
         """Every trial run of the methods ``names`` by ``learner``, in (method, trial) order;
         without the source run's result, only those of the methods that read no trajectory."""
-        return [benchmark_runs.trial_run(name, k, self.case.source_robot, self.case.target_robot, list(self.start),
+        return [benchmark_runs.trial_run(name, k, self.case.source, self.case.target, list(self.start),
                                          list(self.goal), self.case.wind, self.seed, self.config, source_result,
-                                         learner=learner)
+                                         learner=learner, world=self.case.world)
                 for name in names if source_result is not None or not benchmark_runs.needs_trajectory(name)
                 for k in range(self.section.trials)]
 
@@ -249,16 +254,14 @@ class Pair:
     def base(self, source_result: dict) -> dict:
         """What every record of this pair holds, before its method's."""
         traj = source_result["trajectory"]
-        out = {"section": self.section.name, "case": self.index, "label": self.case.label,
-               "source": self.case.source, "target": self.case.target, "task": self.case.task,
-               "start": list(self.start), "goal": list(self.goal), "wind": self.case.wind,
-               "source_seed": self.source_seed, "seed": self.seed,
-               "source_steps": None if traj is None else len(traj["cells"]),
-               "source_failure": source_result["failure"], "optimal": self.optimal,
-               "cap": self.section.max_total_steps, "budget": suites.BUDGET_FACTOR * self.optimal}
-        if self.case.world is not None:  # the paper's rooms' records keep their bytes
-            out["world"] = self.case.world
-        return out
+        return {"section": self.section.name, "case": self.index, "label": self.case.label,
+                "source": self.case.source, "target": self.case.target, "task": self.case.task,
+                "start": list(self.start), "goal": list(self.goal), "wind": self.case.wind,
+                "source_seed": self.source_seed, "seed": self.seed,
+                "source_steps": None if traj is None else len(traj["cells"]),
+                "source_failure": source_result["failure"], "optimal": self.optimal,
+                "cap": self.section.max_total_steps, "budget": suites.BUDGET_FACTOR * self.optimal,
+                **({} if self.case.world == suites.DEFAULT_WORLD else {"world": self.case.world})}
 
 
 def record(pair: Pair, name: str, source_result: dict, trials: list[dict]) -> dict:
@@ -398,7 +401,7 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
     pairs = []
     for section in suite.sections:
         for ci, case in enumerate(section.cases):
-            source, target = robots(case.source_robot), robots(case.target_robot)
+            source, target = robots(case.source, case.world), robots(case.target, case.world)
             for j in range(section.source_seeds):
                 start, goal = case_cells(case, source, target, seed, section.name, ci, j)
                 source.start_state(start)

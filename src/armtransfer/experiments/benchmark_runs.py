@@ -53,22 +53,41 @@ def needs_trajectory(method: str) -> bool:
     return m.shaped and getattr(m, "uses_trajectory", True)
 
 
+DEFAULT_WORLD = "rooms"
+
+
+def robot_key(spec: str, world: str | None = None) -> str:
+    """The key of robot ``spec`` in the world ``world`` in the robots handed to :func:`execute`:
+    the spec alone in the paper's rooms."""
+    return spec if world in (None, DEFAULT_WORLD) else f"{spec} in {world}"
+
+
+def _in_world(run: dict, world: str) -> dict:
+    if world != DEFAULT_WORLD:  # a run of the paper's rooms keeps the key it had before worlds
+        run["world"] = world
+    return run
+
+
 def source_run(source: str, target: str, start: list[int], goal: list[int], seed: int,
-               config: LearnerConfig) -> dict:
+               config: LearnerConfig, world: str = DEFAULT_WORLD) -> dict:
     """Robot 1 (``source``) learning the task from ``start`` to ``goal`` (x, y) with ``seed``;
-    ``target`` names the case's robot 2 (a random task is drawn for both)."""
-    return _key({"format": SOURCE_FORMAT, "learner": LEARNER, "source": source, "target": target,
-                 "start": list(start), "goal": list(goal), "seed": int(seed), "config": config.to_dict()})
+    ``target`` names the case's robot 2 (a random task is drawn for both); ``world``: the
+    world they move in."""
+    return _key(_in_world({"format": SOURCE_FORMAT, "learner": LEARNER, "source": source, "target": target,
+                           "start": list(start), "goal": list(goal), "seed": int(seed), "config": config.to_dict()},
+                          world))
 
 
 def trial_run(method: str, trial: int, source: str, target: str, start: list[int], goal: list[int], wind: float,
-              seed: int, config: LearnerConfig, source_result: dict | None, learner: str = LEARNER) -> dict:
+              seed: int, config: LearnerConfig, source_result: dict | None, learner: str = LEARNER,
+              world: str = DEFAULT_WORLD) -> dict:
     """Trial ``trial`` of ``method`` on robot 2 (``target``). A method that reads the trajectory
     is handed ``source_result``'s (the result of the case's source run: its path, or why there
     is none); the others carry neither."""
     run = {"format": TRIAL_FORMAT, "learner": learner, "method": method, "trial": int(trial), "source": source,
            "target": target, "start": list(start), "goal": list(goal), "wind": wind, "seed": int(seed),
            "config": config.to_dict()}
+    _in_world(run, world)
     if needs_trajectory(method):
         if source_result is None:
             raise ValueError(f"a trial of {method} needs its source run's result")
@@ -136,12 +155,12 @@ def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
     """(result, seconds) of one benchmark run; what a worker runs (``robots``: by spec)."""
     t0 = time.perf_counter()
     if run["format"] == SOURCE_FORMAT:
-        source = robots[run["source"]]
+        source = robots[robot_key(run["source"], run.get("world"))]
         start, goal = _cells(run, source)
         traj, why = learn_source(source, start, goal, run["seed"], LearnerConfig(**run["config"]))
         result: dict = {"trajectory": None if traj is None else trajectory_json(traj), "failure": why}
     elif run["format"] == TRIAL_FORMAT:
-        result = trial_result(run, robots[run["target"]])
+        result = trial_result(run, robots[robot_key(run["target"], run.get("world"))])
     else:
         raise ValueError(f"not a benchmark run: format {run.get('format')!r}")
     return result, time.perf_counter() - t0

@@ -34,31 +34,25 @@ cells every parameter of this package was chosen on, ``research/select_defaults.
 (at least one coordinate odd: cells no choice ever saw) or ``any``."""
 
 
+DEFAULT_WORLD = "rooms"
+
+
 @dataclass(frozen=True)
 class Case:
     source: str
     target: str
-    task: int | None
-    """A Table I task number; None: start and goal drawn per source seed over all rooms."""
+    task: int | str | None
+    """A task of the case's world (a Table I number on the rooms, a task name or number of another
+    world); None: start and goal drawn per source seed over the whole world."""
     wind: float = 0.0
     distance: tuple[int, int | None] | None = None
     """A drawn task's shortest path for the finer robot lies in [low, high) (high None: no
     limit); None: at least ``benchmark.MIN_DISTANCE``."""
     cells: str = "any"
     """Which cells a drawn task's start and goal are on (``CELLS``)."""
-    world: str | None = None
-    """The world both robots move in (a built-in world's name, ``rooms11``; ``task`` is then one
-    of its tasks); None: the paper's rooms, whose cases name none (so they keep their bytes)."""
-
-    @property
-    def source_robot(self) -> str:
-        """The source robot's key in a benchmark's runs: its spec, ``@WORLD`` after it in a world."""
-        return robot_key(self.source, self.world)
-
-    @property
-    def target_robot(self) -> str:
-        """The target robot's key in a benchmark's runs (:attr:`source_robot`)."""
-        return robot_key(self.target, self.world)
+    world: str = "rooms"
+    """The world the robots move in: a name ``armtransfer.worlds.resolve.world`` knows (``rooms``,
+    the paper's; ``rooms11``, ``rooms15``, ``generated:SEED[:SIDE]``)."""
 
     @property
     def label(self) -> str:
@@ -69,13 +63,8 @@ class Case:
         if self.task is None and self.cells != "any":
             task += f" on {self.cells} cells"
         wind = f", wind {self.wind:g}" if self.wind else ""
-        world = f" in {self.world}" if self.world is not None else ""
-        return f"{self.source} -> {self.target}, {task}{world}{wind}"
-
-
-def robot_key(spec: str, world: str | None) -> str:
-    """``spec`` for the paper's rooms, ``spec@world`` in another world (``benchmark.Robots``)."""
-    return spec if world is None else f"{spec}@{world}"
+        world = f", in {self.world}" if self.world != DEFAULT_WORLD else ""
+        return f"{self.source} -> {self.target}, {task}{wind}{world}"
 
 
 DEFAULT_LEARNERS = ("sarsa",)
@@ -100,8 +89,8 @@ class Section:
         """The section as stored and reported; the default learners are left out, so a suite that
         runs the built-in learner alone keeps the store key and the bytes it had before."""
         out = asdict(self)
-        for case in out["cases"]:  # a case in the paper's rooms names no world (its old bytes)
-            if case["world"] is None:
+        for case in out["cases"]:  # a case of the default world keeps the bytes it had before worlds
+            if case["world"] == DEFAULT_WORLD:
                 del case["world"]
         if self.learners == DEFAULT_LEARNERS:
             del out["learners"]

@@ -245,13 +245,13 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
 def describe(name: str, parse_label) -> str:
     """What a record's method is: the method's description, and its learner's when not the built-in."""
     method, learner = parse_label(name)
-    text = methods.get(method).description
-    if learner != "sarsa":
-        from armtransfer.learning.learners import LEARNERS
+    if learner == "sarsa":
+        return methods.get(method).description
+    from armtransfer.learning.learners import LEARNERS
 
-        found = LEARNERS.get(learner)
-        text += f"; learned by {learner}" + (f" ({found.description})" if found is not None else "")
-    return text
+    found = LEARNERS.get(learner)
+    text = "no transfer" if method == "none" else methods.get(method).description  # none's is Algorithm 1's
+    return text + f"; learned by {learner}" + (f" ({found.description})" if found is not None else "")
 
 
 def seed_effect_text(suite: suites.Suite, summary: dict) -> str:
