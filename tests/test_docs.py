@@ -6,7 +6,7 @@ A block runs in a fresh temporary directory that links the repository's script f
 relative paths (`scripts/...`, `examples/sweeps/...`) work and every output (`--out runs/x`,
 `runs/<timestamp>`) lands in the temporary directory. `pip install` is left out of a command
 (the package is installed already). A block whose line before the fence is `<!-- slow -->` runs
-only under `-m slow`; the block after `<!-- test-command -->` is what CI runs (`.ci/run`) and is
+only under `-m slow`, one marked `<!-- needs-sb3 -->` only where the sb3 extra is installed; the block after `<!-- test-command -->` is what CI runs (`.ci/run`) and is
 checked word for word instead of run.
 
 What a block prints, where a page shows it, is checked too: a ```text block marked
@@ -21,6 +21,7 @@ a run that prints a different number fails (`test_every_number_shown_is_compared
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import os
 import re
 import subprocess
@@ -96,8 +97,14 @@ def _all(lang: str) -> list[Block]:
     return [b for b in found if "test-command" not in b.markers]
 
 
+NO_SB3 = importlib.util.find_spec("stable_baselines3") is None
+
+
 def _param(b: Block):
-    return pytest.param(b, id=b.id, marks=[pytest.mark.slow] if "slow" in b.markers else [])
+    marks = [pytest.mark.slow] if "slow" in b.markers else []
+    if "needs-sb3" in b.markers:  # the dqn and ppo learners: only where the sb3 extra is installed
+        marks.append(pytest.mark.skipif(NO_SB3, reason="needs the sb3 extra (pip install -e '.[sb3]')"))
+    return pytest.param(b, id=b.id, marks=marks)
 
 
 def _run(argv: list[str], block: Block, cwd: Path) -> str:

@@ -62,3 +62,7 @@ class OutputError(ArmTransferError):
 class PluginError(ArmTransferError):
     """A transfer method from outside the package cannot be used: it fails to import, raises,
     returns the wrong shape or a non-finite number, or takes a name already taken."""
+
+
+class MissingExtraError(ArmTransferError):
+    """An optional dependency is not installed (the message names the extra that installs it)."""

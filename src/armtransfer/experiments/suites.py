@@ -160,6 +160,16 @@ DEV = Section(
 FAST = Section(
     "fast", "coarse -> fine task 1, two source seeds: checks the whole protocol in seconds",
     (Case("coarse", "fine", 1),), source_seeds=2, trials=2, max_total_steps=300_000)
+SMALL_LEARNERS = ("sarsa", "dqn", "ppo")
+"""The learners of ``small``: the built-in SARSA(lambda) and stable-baselines3's DQN and PPO (the
+``sb3`` extra; ``armtransfer.learning.sb3``), which run ``none`` and the reward-term methods."""
+
+SMALL = Section(
+    "small", "the small rooms worlds rooms11 and rooms15, task 2 (north-east room to south-west), coarse -> fine, "
+    "learned by SARSA(lambda) and by stable-baselines3's DQN and PPO; rooms11 task 3 was the dev case the SB3 "
+    "settings and this step cap were chosen on (source seeds 100 and 101 of research/sb3_small.py)",
+    (Case("coarse", "fine", 2, world="rooms11"), Case("coarse", "fine", 2, world="rooms15")),
+    source_seeds=10, trials=2, max_total_steps=25_000, learners=SMALL_LEARNERS)
 
 SUITES: dict[str, Suite] = {
     s.name: s
@@ -172,6 +182,7 @@ SUITES: dict[str, Suite] = {
               (PAPER, RANDOM, EMBODIMENT, WIND)),
         Suite("dev", 3, False, DEV.description, (DEV,)),
         Suite("fast", 2, False, FAST.description, (FAST,)),
+        Suite("small", 1, True, SMALL.description, (SMALL,)),
     )
 }
 """Every suite by name."""

@@ -17,7 +17,7 @@ import json
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from armtransfer.errors import ArmTransferError
+from armtransfer.errors import MissingExtraError  # noqa: F401  (kept importable from here)
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -31,10 +31,6 @@ LEAD = ("method", "control", "trial", "reached", "exploration_steps", "converged
 NO_CONTROL = "none"
 """The ``control`` of a run on the trajectory it was given (not a control's): a label, not a
 missing value, which pandas' ``groupby`` and plots would drop."""
-
-
-class MissingExtraError(ArmTransferError):
-    """An optional dependency is not installed (the message names the extra that installs it)."""
 
 
 def pandas():
