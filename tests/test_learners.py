@@ -417,3 +417,14 @@ def test_a_suite_runs_on_a_small_world_with_its_tasks(registered):
     with pytest.raises(armtransfer.ArmTransferError, match="unknown task '9' in world rooms11"):
         benchmark.plan(suites.Suite("x", 1, False, "x", (dataclasses.replace(
             small, cases=(suites.Case("coarse", "fine", 9, world="rooms11"),)),)), 0)
+
+
+def test_workers_are_sent_the_robots_of_a_cases_world():
+    """A worker looks a robot up by spec and world; the robots a pool sends must be keyed so."""
+    from armtransfer.experiments.benchmark_runs import robot_key
+    from armtransfer.parallel.executors import _robots_for
+
+    robots = {"coarse": object(), robot_key("coarse", "rooms11"): object(), robot_key("fine", "rooms11"): object(),
+              robot_key("fine", "rooms15"): object()}
+    runs = [{"source": "coarse", "target": "fine", "world": "rooms11"}, {"source": "coarse", "target": "coarse"}]
+    assert set(_robots_for(runs, robots)) == {"coarse", "coarse in rooms11", "fine in rooms11"}

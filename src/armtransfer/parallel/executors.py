@@ -75,7 +75,11 @@ def run_local(
 
 
 def _robots_for(runs: list[dict], robots: dict[str, DiscreteRobot]) -> dict[str, DiscreteRobot]:
-    needed = {r["source"] for r in runs} | {r["target"] for r in runs}
+    """The robots ``runs`` read, by the key a worker looks them up by (a spec, and its world
+    when a run names one other than the paper's rooms)."""
+    from armtransfer.experiments.benchmark_runs import robot_key
+
+    needed = {robot_key(r[side], r.get("world")) for r in runs for side in ("source", "target")}
     return {k: v for k, v in robots.items() if k in needed}
 
 
