@@ -15,7 +15,6 @@ keeps what was tried. Prints one line per trial and a summary per (learner, meth
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import statistics
@@ -107,7 +106,9 @@ def apply_sets(sets):
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    from armtransfer import script
+
+    p = script.parser(__doc__)
     p.add_argument("--world", default="rooms11")
     p.add_argument("--task", default="3")
     p.add_argument("--seeds", default="100-104")
@@ -149,4 +150,6 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    from armtransfer import script
+
+    script.exit_with(main)
