@@ -55,6 +55,27 @@ def tables(summary: dict) -> str:
     return "\n".join(out).rstrip("\n") + "\n"
 
 
+LEARNER_COLUMNS = (("pseudo", "convergence"), ("dense", "convergence"), ("pseudo", "first_exposure"),
+                   ("dense", "first_exposure"))
+"""The learner table's columns: each transfer method against its learner's own ``none``."""
+
+
+def learner_table(summary: dict) -> str:
+    """One row per learner of a suite that names several (``small``): each transfer method
+    against the ``none`` of the same learner, pooled over the suite's sections' cases."""
+    header = ("| learner | " + " | ".join(f"`{m}` vs `none`, {'whole cost' if k == 'convergence' else 'first exposure'}"
+                                         for m, k in LEARNER_COLUMNS) + " |")
+    out = [header, "|---|" + "---|" * len(LEARNER_COLUMNS)]
+    for section, pooled in summary.items():
+        learners = sorted({n.split("@")[1] for n in pooled if "@" in n})
+        for learner in ["sarsa", *learners]:
+            tag = "" if learner == "sarsa" else f"@{learner}"
+            row = [cell(pooled.get(f"{m}{tag}", {}).get(f"none{tag}", {}).get(k)) for m, k in LEARNER_COLUMNS]
+            name = learner if len(summary) == 1 else f"{section}: {learner}"
+            out.append(f"| {name} | " + " | ".join(row) + " |")
+    return "\n".join(out) + "\n"
+
+
 def pooled(path: Path) -> dict:
     data, _ = read_results(path)
     return {name: sec["pooled"] for name, sec in data["summary"].items()}
@@ -65,9 +86,11 @@ def main(argv: list[str] | None = None) -> int:
 
     p = script.parser(__doc__)
     p.add_argument("results", type=Path, help="a benchmark's results.json or results.json.gz")
+    p.add_argument("--learners", action="store_true",
+                   help="one row per learner (a suite with several, such as small) instead of one per section")
     args = p.parse_args(argv)
     try:
-        text = tables(pooled(args.results))
+        text = (learner_table if args.learners else tables)(pooled(args.results))
     except ArmTransferError as err:
         print(f"readme_table.py: error: {err}", file=sys.stderr)
         return 2

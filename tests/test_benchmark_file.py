@@ -98,3 +98,25 @@ def test_the_readme_shows_the_tables_of_the_kept_report():
     readme = (ROOT / "README.md").read_text()
     shown = readme.split("<!-- benchmark-tables -->\n", 1)[1].split("<!-- /benchmark-tables -->", 1)[0]
     assert shown == module.tables(module.pooled(KEPT))
+
+
+def test_the_learner_table_puts_each_learner_against_its_own_none():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("readme_table", ROOT / "research" / "readme_table.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+
+    def ab(f):
+        return {"factor": f, "ci95": [f / 2, f * 2], "worst": f / 3, "seeds": 10, "p_holm": 0.5, "verdicts": 4,
+                "detectable": [0.5, 2.0]}
+
+    pooled = {"small": {"pseudo": {"none": {"convergence": ab(1.5), "first_exposure": ab(2.0)}},
+                        "pseudo@dqn": {"none@dqn": {"convergence": ab(3.0), "first_exposure": ab(4.0)}},
+                        "dense@dqn": {"none@dqn": {"convergence": ab(5.0)}},
+                        "pseudo@ppo": {"none@ppo": {"first_exposure": ab(6.0)}}}}
+    rows = module.learner_table(pooled).splitlines()
+    assert [r.split(" | ")[0] for r in rows[2:]] == ["| sarsa", "| dqn", "| ppo"]
+    assert rows[3].split(" | ")[1].startswith("3×") and rows[3].split(" | ")[2].startswith("5×")
+    assert rows[4].split(" | ")[1] == "n/a" and rows[4].split(" | ")[3].startswith("6×")
+    assert "n.s." in rows[2]
