@@ -428,3 +428,5 @@ def test_workers_are_sent_the_robots_of_a_cases_world():
               robot_key("fine", "rooms15"): object()}
     runs = [{"source": "coarse", "target": "fine", "world": "rooms11"}, {"source": "coarse", "target": "coarse"}]
     assert set(_robots_for(runs, robots)) == {"coarse", "coarse in rooms11", "fine in rooms11"}
+    sweep = {"coarse": object(), "fine": object()}  # a sweep's robots, resolved in its one world
+    assert set(_robots_for(runs, sweep)) == {"coarse", "fine"}

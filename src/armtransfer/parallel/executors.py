@@ -75,11 +75,12 @@ def run_local(
 
 
 def _robots_for(runs: list[dict], robots: dict[str, DiscreteRobot]) -> dict[str, DiscreteRobot]:
-    """The robots ``runs`` read, by the key a worker looks them up by (a spec, and its world
-    when a run names one other than the paper's rooms)."""
+    """The robots ``runs`` read, by either key a worker may look them up by: the spec (a sweep's
+    robots, resolved in the sweep's one world) and the spec in the run's world (a benchmark's,
+    whose cases may each name a world)."""
     from armtransfer.experiments.benchmark_runs import robot_key
 
-    needed = {robot_key(r[side], r.get("world")) for r in runs for side in ("source", "target")}
+    needed = {key for r in runs for side in ("source", "target") for key in (r[side], robot_key(r[side], r.get("world")))}
     return {k: v for k, v in robots.items() if k in needed}
 
 
