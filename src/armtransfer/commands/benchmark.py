@@ -28,7 +28,7 @@ from armtransfer.experiments.reports import benchmark_report
 from armtransfer.experiments.stats import benchmark_stats
 from armtransfer.experiments.store import ResultStore, StoreError
 from armtransfer.experiments.sweep import Sweep, content_key
-from armtransfer.io import write_bytes_atomic, write_json_atomic, write_text_atomic
+from armtransfer.io import check_writable, write_bytes_atomic, write_json_atomic, write_text_atomic
 from armtransfer.parallel.executors import _check_reachable, _import_ray, run_local, run_ray
 
 HELP = "Compare every method with the baselines that share its learner on a fixed suite, over many source seeds."
@@ -71,6 +71,7 @@ def run(args: argparse.Namespace) -> int:
     check_executor_options(args)
     out = Path(args.out) if args.out else Path("runs") / _dt.datetime.now().strftime(
         f"benchmark-{suite.name}-%Y%m%d-%H%M%S")
+    check_writable(out / "sweep.json")  # a name too long, a file in the way: before any arm is compiled
     if args.executor == "ray":
         _import_ray()  # say how to install Ray before anything is written
         if args.address:
