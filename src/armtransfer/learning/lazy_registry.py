@@ -125,3 +125,40 @@ class Names(Sequence[str], Generic[V]):
 
     def __repr__(self) -> str:
         return repr(self._names())
+
+
+def describe_entry_point(ep: object, group: str) -> str:
+    """How an error names a plugin: its distribution, version and entry point."""
+    dist = getattr(ep, "dist", None)
+    who = f"{dist.metadata['Name']} {dist.version}" if dist is not None else "an unnamed distribution"
+    return f"plugin {who} (entry point {getattr(ep, 'name')} = {getattr(ep, 'value')} in group {group})"
+
+
+def read_entry_points(group: str, registry: Registry[V], kind: str, check: Callable[[object, str], V],
+                      named: Callable[[V], str], with_origin: Callable[[V, str], V]) -> dict[str, V]:
+    """Every entry installed packages declare under ``group``, loaded, passed through
+    ``check(obj, where)`` (which raises the plugin's one-line error) and given its origin; the
+    entry point's name must be the entry's own, and no name may be taken twice. A fault is a
+    :class:`~armtransfer.errors.PluginError` naming the plugin, and then nothing is returned, so
+    nothing is added. ``kind`` ("method", "learner") names the entries in the errors."""
+    from importlib.metadata import entry_points
+
+    from armtransfer.errors import PluginError
+
+    found: dict[str, V] = {}
+    for ep in sorted(entry_points(group=group), key=lambda e: (e.name, e.value)):
+        where = describe_entry_point(ep, group)
+        try:
+            obj = ep.load()
+        except (Exception, SystemExit) as err:  # noqa: BLE001 - any failure to import is the plugin's, in one line
+            raise PluginError(f"{where} fails to import: {type(err).__name__}: {err}".splitlines()[0]) from None
+        entry = check(obj, where)
+        name = named(entry)
+        if name != ep.name:
+            raise PluginError(f"{where} is a {kind} named {name!r}; name the entry point as the {kind}")
+        taken = registry.peek()
+        if name in taken or name in found:
+            other = getattr(taken[name] if name in taken else found[name], "origin")
+            raise PluginError(f"{where} is named {name!r}, as a {kind} of {other} is; rename one of them")
+        found[name] = with_origin(entry, where)
+    return found

@@ -33,7 +33,7 @@ from typing import Any, Protocol
 import gymnasium
 
 from armtransfer.errors import InvalidParameterError, PluginError
-from armtransfer.learning.lazy_registry import Registry
+from armtransfer.learning.lazy_registry import Registry, read_entry_points
 
 GROUP = "armtransfer.learners"
 """The entry-point group installed packages declare their learners under."""
@@ -101,32 +101,11 @@ def check(learner: object, where: str) -> Learner:
     return learner
 
 
-def _describe(ep: Any) -> str:
-    dist = getattr(ep, "dist", None)
-    who = f"{dist.metadata['Name']} {dist.version}" if dist is not None else "an unnamed distribution"
-    return f"plugin {who} (entry point {ep.name} = {ep.value} in group {GROUP})"
-
-
 def load_entry_points(registry: Registry[Learner]) -> None:
     """Add every learner installed packages declare under :data:`GROUP` to ``registry``; a bad
     one is a :class:`PluginError` naming it, and then none is added."""
-    from importlib.metadata import entry_points
-
-    found: dict[str, Learner] = {}
-    for ep in sorted(entry_points(group=GROUP), key=lambda e: (e.name, e.value)):
-        where = _describe(ep)
-        try:
-            obj = ep.load()
-        except (Exception, SystemExit) as err:  # noqa: BLE001 - any failure to import is the plugin's, in one line
-            raise PluginError(f"{where} fails to import: {type(err).__name__}: {err}".splitlines()[0]) from None
-        learner = check(obj, where)
-        if learner.name != ep.name:
-            raise PluginError(f"{where} is a learner named {learner.name!r}; name the entry point as the learner")
-        taken = registry.peek()
-        if learner.name in taken or learner.name in found:
-            other = taken[learner.name].origin if learner.name in taken else found[learner.name].origin
-            raise PluginError(f"{where} is named {learner.name!r}, as a learner of {other} is; rename one of them")
-        found[learner.name] = with_fields(learner, origin=where)
+    found = read_entry_points(GROUP, registry, "learner", check, lambda lr: lr.name,
+                              lambda lr, where: with_fields(lr, origin=where))
     for name, learner in found.items():
         registry.add(name, learner)
 

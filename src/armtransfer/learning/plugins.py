@@ -33,6 +33,7 @@ import numpy as np
 
 from armtransfer.errors import ArmTransferError, PluginError
 from armtransfer.learning import shaping as modes
+from armtransfer.learning.lazy_registry import read_entry_points
 from armtransfer.learning.method import Method
 from armtransfer.learning.shaping import Shaping
 from armtransfer.learning.trajectory import Trajectory
@@ -184,39 +185,22 @@ def probe(method: Method, where: str, robot: DiscreteRobot | None = None) -> Non
         raise PluginError(f"{where}: {said}") from None
 
 
-def _describe(ep) -> str:
-    dist = getattr(ep, "dist", None)
-    who = f"{dist.metadata['Name']} {dist.version}" if dist is not None else "an unnamed distribution"
-    return f"plugin {who} (entry point {ep.name} = {ep.value} in group {GROUP})"
-
-
 def load_entry_points(registry) -> None:
     """Add every method installed packages declare under :data:`GROUP` to ``registry`` (a
     ``lazy_registry.Registry``); a bad one is a :class:`PluginError` naming it, and then none is
     added."""
-    from importlib.metadata import entry_points
-
-    found: dict[str, Method] = {}
-    for ep in sorted(entry_points(group=GROUP), key=lambda e: (e.name, e.value)):
-        where = _describe(ep)
-        try:
-            obj = ep.load()
-        except (Exception, SystemExit) as err:  # noqa: BLE001 - any failure to import is the plugin's, in one line
-            raise PluginError(f"{where} fails to import: {type(err).__name__}: {err}".splitlines()[0]) from None
-        if not isinstance(obj, Method):
-            raise PluginError(f"{where} is {type(obj).__name__}, not a method; make it with "
-                              "armtransfer.potential_method(...) or armtransfer.bonus_method(...)")
-        if obj.name != ep.name:
-            raise PluginError(f"{where} is a method named {obj.name!r}; name the entry point as the method")
-        taken = registry.peek()
-        if obj.name in taken or obj.name in found:
-            other = taken[obj.name].origin if obj.name in taken else found[obj.name].origin
-            raise PluginError(f"{where} is named {obj.name!r}, as a method of {other} is; rename one of them")
-        found[obj.name] = _with_origin(obj, where)
+    found = read_entry_points(GROUP, registry, "method", _a_method, lambda m: m.name, _with_origin)
     for method in found.values():
         probe(method, method.origin)
     for name, method in found.items():
         registry.add(name, method)
+
+
+def _a_method(obj: object, where: str) -> Method:
+    if not isinstance(obj, Method):
+        raise PluginError(f"{where} is {type(obj).__name__}, not a method; make it with "
+                          "armtransfer.potential_method(...) or armtransfer.bonus_method(...)")
+    return obj
 
 
 def _with_origin(method: Method, origin: str) -> Method:
