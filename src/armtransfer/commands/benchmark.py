@@ -204,14 +204,21 @@ def write_report(store: ResultStore, plan: benchmark.Plan) -> dict:
 
     records = plan.records(result)
     summary = benchmark_stats.summarize(records)
-    out = store.root
-    write_bytes_atomic(out / "results.json", results_bytes(plan.suite, plan.seed, plan.labels(),
-                                                          list(plan.missing), records, summary))
-    write_json_atomic(out / "timings.json", plan.timings(result, seconds))
-    benchmark_report.write_figures(summary, plan.suite, out)
-    write_text_atomic(out / "report.md", benchmark_report.report_markdown(
-        plan.suite, plan.seed, summary, plan.labels(), list(plan.missing)))
+    write_report_files(store.root, plan.suite, plan.seed, plan.labels(), list(plan.missing), summary,
+                       results_bytes(plan.suite, plan.seed, plan.labels(), list(plan.missing), records, summary),
+                       timings=plan.timings(result, seconds))
     return summary
+
+
+def write_report_files(out: Path, suite: suites.Suite, seed: int, ran: list[str], missing: list[str], summary: dict,
+                       results: bytes, timings: dict | None = None) -> None:
+    """A benchmark's report files in ``out``: results.json (``results``, its bytes), timings.json
+    when given, the figures, and report.md last, so that it is there only when the rest is."""
+    write_bytes_atomic(out / "results.json", results)
+    if timings is not None:
+        write_json_atomic(out / "timings.json", timings)
+    benchmark_report.write_figures(summary, suite, out)
+    write_text_atomic(out / "report.md", benchmark_report.report_markdown(suite, seed, summary, ran, missing))
 
 
 def plan_of(store: ResultStore) -> benchmark.Plan:

@@ -14,9 +14,8 @@ import zlib
 from pathlib import Path
 
 from armtransfer.errors import InvalidParameterError
-from armtransfer.io import parse_json_bytes, read_input, staged_directory, write_bytes_atomic, write_text_atomic
+from armtransfer.io import parse_json_bytes, read_input, staged_directory
 from armtransfer.experiments import suites
-from armtransfer.experiments.reports import benchmark_report
 from armtransfer.experiments.stats import benchmark_stats
 
 MAX_UNPACKED_BYTES = 1 << 30
@@ -55,7 +54,7 @@ def read_results(path: Path) -> tuple[dict, bytes]:
 
 def report_from_file(path: Path, out: str | None) -> int:
     """``armtransfer summarize FILE --out DIR``."""
-    from armtransfer.commands.benchmark import results_bytes
+    from armtransfer.commands.benchmark import results_bytes, write_report_files
 
     if out is None:
         raise InvalidParameterError("a results file needs --out DIR: an absent or empty directory for its report")
@@ -76,10 +75,7 @@ def report_from_file(path: Path, out: str | None) -> int:
         raise InvalidParameterError(f"{str(path)!r}: the statistics this build recomputes from its "
                                     f"{len(data['records'])} records differ from the file's (another build wrote it)")
     with staged_directory(out) as tmp:
-        write_bytes_atomic(tmp / "results.json", again)
-        benchmark_report.write_figures(summary, suite, tmp)
-        write_text_atomic(tmp / "report.md", benchmark_report.report_markdown(
-            suite, data["seed"], summary, data["methods"], data["not_in_registry"]))
+        write_report_files(tmp, suite, data["seed"], data["methods"], data["not_in_registry"], summary, again)
     print(f"recomputed the statistics of {len(data['records'])} records: the same bytes as {str(path)!r}; "
           f"wrote {str(Path(out) / 'report.md')!r}")
     return 0
