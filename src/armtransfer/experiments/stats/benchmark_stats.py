@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 from collections import defaultdict
+from collections.abc import Callable, Iterator
 
 import numpy as np
 
@@ -193,15 +194,10 @@ def summarize(records: list[dict]) -> dict:
     for section, sec in out.items():
         names = list(dict.fromkeys(r["method"] for r in records if r["section"] == section))
         for name in names:
-            bases = list(dict.fromkeys(b for (s, _, m), recs in by_cell.items() if s == section and m == name
-                                       for b in recs[0]["baselines"]))
             pooled: dict = {}
-            for base in bases:
-                cases = [(by_cell[(section, c, name)], by_cell[(section, c, base)]) for c in sorted(sec["cases"])
-                         if (section, c, name) in by_cell and (section, c, base) in by_cell]
-                if cases:
-                    pooled[base] = dict({k: compare(cases, k) for k in METRICS}, baseline=base)
-                    verdicts += [pooled[base][k] for k in METRICS]
+            for base, cases in _pairings(section, name, by_cell):
+                pooled[base] = dict({k: compare(cases, k) for k in METRICS}, baseline=base)
+                verdicts += [pooled[base][k] for k in METRICS]
             if pooled:
                 sec["pooled"][name] = pooled
         sec["cases"] = [sec["cases"][k] for k in sorted(sec["cases"])]
@@ -220,6 +216,23 @@ def summarize(records: list[dict]) -> dict:
     return out
 
 
+def _pairings(section: str, name: str, by_cell: dict,
+              keep: Callable[[list[dict]], list[dict]] | None = None) -> Iterator[tuple[str, list]]:
+    """(baseline, [(method's records, baseline's records) per case]) for every baseline that
+    ``name``'s records name in ``section``, over the cases both ran; ``keep`` filters a case's
+    records (a case left empty on either side is left out)."""
+    case_ids = sorted({c for (s, c, _) in by_cell if s == section})
+    bases = dict.fromkeys(b for (s, _, m), recs in by_cell.items() if s == section and m == name
+                          for b in recs[0]["baselines"])
+    for base in bases:
+        cases = [(by_cell[(section, c, name)], by_cell[(section, c, base)]) for c in case_ids
+                 if (section, c, name) in by_cell and (section, c, base) in by_cell]
+        if keep is not None:
+            cases = [(a, b) for a, b in ((keep(m), keep(bl)) for m, bl in cases) if a and b]
+        if cases:
+            yield base, cases
+
+
 def with_trajectory(section: str, by_cell: dict) -> dict:
     """The stratum of a section's (case, source seed) pairs on which robot 1 converged and
     handed a trajectory over: ``{"pairs", "of", "pooled": {name: {baseline: {metric: factor}}}}``.
@@ -230,18 +243,11 @@ def with_trajectory(section: str, by_cell: dict) -> dict:
         return [r for r in recs if r["source_failure"] is None]
 
     names = list(dict.fromkeys(m for (s, _, m) in by_cell if s == section))
-    case_ids = sorted({c for (s, c, _) in by_cell if s == section})
     pooled: dict = {}
     for name in names:
-        bases = list(dict.fromkeys(b for (s, _, m), recs in by_cell.items() if s == section and m == name
-                                   for b in recs[0]["baselines"]))
-        for base in bases:
-            cases = [(kept(by_cell[(section, c, name)]), kept(by_cell[(section, c, base)]))
-                     for c in case_ids if (section, c, name) in by_cell and (section, c, base) in by_cell]
-            cases = [(a, b) for a, b in cases if a and b]
-            if cases:
-                pooled.setdefault(name, {})[base] = dict(
-                    {k: dict(compare(cases, k), p_holm=None, verdicts=0) for k in METRICS}, baseline=base)
+        for base, cases in _pairings(section, name, by_cell, kept):
+            pooled.setdefault(name, {})[base] = dict(
+                {k: dict(compare(cases, k), p_holm=None, verdicts=0) for k in METRICS}, baseline=base)
     pairs = {(c, r["source_seed"]): r["source_failure"] is None for (s, c, _), recs in by_cell.items()
              if s == section for r in recs}
     return {"pairs": sum(pairs.values()), "of": len(pairs), "pooled": pooled}
