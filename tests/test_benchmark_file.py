@@ -79,6 +79,12 @@ def test_a_results_file_needs_an_out_directory(results, capsys):
 KEPT = ROOT / "docs" / "benchmark-standard" / "results.json.gz"
 
 
+def test_an_absent_results_file_is_named_as_absent(tmp_path, capsys):
+    err = _refused(["summarize", str(tmp_path / "results.json.gz"), "--out", str(tmp_path / "o")], capsys)
+    assert "does not exist" in err and "results.json.gz" in err
+    assert not (tmp_path / "o").exists()
+
+
 @pytest.mark.slow
 @pytest.mark.skipif(not KEPT.exists(), reason="no standard report kept in docs/")
 def test_the_kept_standard_report_comes_back_from_its_records(tmp_path, capsys):

@@ -35,7 +35,7 @@ ROOT = Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 PYTHON_PAGES = ("README.md", "docs/api.md", "docs/extending.md")
 """Pages whose ```python blocks stand alone and are run too."""
-LINKED = ("scripts", "research", "benchmarks", "examples", "dev", "tests")
+LINKED = ("scripts", "research", "benchmarks", "examples", "dev", "tests", "docs")
 """Repository folders a block may name by a relative path."""
 TIMEOUT = 300
 """Seconds a default-run block may take at most (each takes seconds on an idle machine)."""

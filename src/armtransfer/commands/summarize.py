@@ -30,6 +30,8 @@ def run(args: argparse.Namespace) -> int:
         from armtransfer.commands.benchmark_file import report_from_file
 
         return report_from_file(Path(args.dir), args.out)
+    if not Path(args.dir).exists():
+        raise InvalidParameterError(f"{args.dir!r} does not exist (expected a result store or a results file)")
     if args.out is not None:
         raise InvalidParameterError("--out is for a results file; a store's summary is written into the store")
     store = ResultStore.open_existing(args.dir)
