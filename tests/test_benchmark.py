@@ -311,6 +311,8 @@ def test_drawn_tasks_are_deterministic_and_long_enough():
 
 
 def test_a_source_that_does_not_converge_is_counted_not_dropped(monkeypatch):
+    """Robot 1 hands nothing over: the pair is kept, and every method that reads a trajectory
+    learns as its baseline told nothing, byte for byte that baseline's trials."""
     from dataclasses import replace
 
     from armtransfer.experiments import experiment
@@ -323,14 +325,30 @@ def test_a_source_that_does_not_converge_is_counted_not_dropped(monkeypatch):
     records, _ = benchmark.run_suite(suites.Suite("t", 1, False, "", (section,)), threads=1)
     by = {r["method"]: r for r in records}
     assert set(by) == set(benchmark.methods_to_run()[0])
+    fields = ("first_exposure", "converged", "convergence_steps", "greedy_steps", "episodes", "area", "curves")
+    told = 0
     for name, rec in by.items():
         m = methods.get(name)
+        assert rec["error"] is None and rec["episodes"][0] > 0
+        assert rec["source_failure"].startswith("robot 1 (coarse) did not converge")
         if m.shaped and getattr(m, "uses_trajectory", True):
-            assert rec["error"].startswith("no trajectory: robot 1 (coarse) did not converge")
-            assert rec["first_exposure"] == [None]
-        else:  # none (and a baseline that reads no trajectory) still runs
-            assert rec["error"] is None and rec["episodes"][0] > 0
+            told += 1
+            base = by[rec["told_nothing"]]
+            assert rec["told_nothing"] == m.baselines[0] and "told_nothing" not in base
+            assert [rec[f] for f in fields] == [base[f] for f in fields], name
+        else:  # none (and a baseline that reads no trajectory) runs as always
+            assert "told_nothing" not in rec
+    assert told >= 3
     summary = benchmark_stats.summarize(records)["fast"]
-    stats = summary["cases"][0]["methods"]
-    assert stats["pseudo"]["failure_rate"] == 1.0 and stats["pseudo"]["errors"]
     assert summary["cases"][0]["source_failures"] == 1
+    assert summary["with_trajectory"]["told_nothing"] and summary["with_trajectory"]["pairs"] == 0
+    pseudo = summary["cases"][0]["methods"]["pseudo"]
+    assert pseudo["errors"] == [] and pseudo["failure_rate"] == summary["cases"][0]["methods"]["none"]["failure_rate"]
+
+
+def test_a_run_written_before_told_nothing_keeps_its_error():
+    """A stored trial run from before the rule (no ``told_nothing``) is an error, as it was."""
+    from armtransfer.experiments import benchmark_runs
+
+    run = {"method": "pseudo", "trajectory": None, "source_failure": "robot 1 did not converge"}
+    assert benchmark_runs.trial_result(run, None) == {"error": "no trajectory: robot 1 did not converge"}

@@ -268,7 +268,9 @@ def record(pair: Pair, name: str, source_result: dict, trials: list[dict]) -> di
     """One record: method ``name``'s trials on ``pair`` (none when it could not run: then
     ``error`` says why, the first trial's in trial order, and every trial counts as a failure)."""
     rec = dict(pair.base(source_result), method=name, baselines=list(baselines_of(name)), error=None)
-    learner = parse_label(name)[1]
+    method, learner = parse_label(name)
+    if source_result["trajectory"] is None and benchmark_runs.needs_trajectory(method):
+        rec["told_nothing"] = benchmark_runs.told_nothing(method)
     if learner != benchmark_runs.LEARNER:  # the built-in learner's records keep their bytes
         rec["learner"] = learner
     n = len(trials)

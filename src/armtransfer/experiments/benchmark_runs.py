@@ -83,7 +83,8 @@ def trial_run(method: str, trial: int, source: str, target: str, start: list[int
               world: str = DEFAULT_WORLD) -> dict:
     """Trial ``trial`` of ``method`` on robot 2 (``target``). A method that reads the trajectory
     is handed ``source_result``'s (the result of the case's source run: its path, or why there
-    is none); the others carry neither."""
+    is none); the others carry neither. Where robot 1 handed nothing over, the run also names
+    ``told_nothing``: the method's baseline, which the trial then runs (:func:`trial_result`)."""
     run = {"format": TRIAL_FORMAT, "learner": learner, "method": method, "trial": int(trial), "source": source,
            "target": target, "start": list(start), "goal": list(goal), "wind": wind, "seed": int(seed),
            "config": config.to_dict()}
@@ -93,7 +94,19 @@ def trial_run(method: str, trial: int, source: str, target: str, start: list[int
             raise ValueError(f"a trial of {method} needs its source run's result")
         run["trajectory"] = source_result["trajectory"]
         run["source_failure"] = source_result["failure"]
+        if source_result["trajectory"] is None:
+            run["told_nothing"] = told_nothing(method)
     return _key(run)
+
+
+def told_nothing(method: str) -> str:
+    """What a trial of ``method`` runs when robot 1 handed no trajectory over: the baseline that
+    shares its learner and is told nothing (a robot 2 with nothing to read learns as it would
+    without transfer)."""
+    base = methods.get(method).baseline
+    if base is None or needs_trajectory(base):
+        raise ValueError(f"{method} has no baseline told nothing to learn as without a trajectory")
+    return base
 
 
 def trajectory_json(traj: Trajectory) -> dict:
@@ -168,9 +181,14 @@ def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
 
 def trial_result(run: dict, target: DiscreteRobot) -> dict:
     """A trial run's result: its learner's numbers, or ``error`` (and nothing else) when the
-    method cannot run: no trajectory to hand over, or a refusal of the case."""
+    method cannot run: a refusal of the case. With no trajectory to hand over, the trial is its
+    baseline's (``told_nothing``): the same learner, seeds and case, byte for byte. A run written
+    before that rule (no ``told_nothing``) keeps its result: an error."""
     if needs_trajectory(run["method"]) and run.get("trajectory") is None:
-        return {"error": f"no trajectory: {run.get('source_failure')}"}
+        if "told_nothing" not in run:
+            return {"error": f"no trajectory: {run.get('source_failure')}"}
+        skip = ("key", "trajectory", "source_failure", "told_nothing")
+        return trial_result(dict({k: v for k, v in run.items() if k not in skip}, method=run["told_nothing"]), target)
     learner = LEARNERS.get(run["learner"])
     if learner is None:
         from armtransfer.learning.learners import LEARNERS as OUTSIDE

@@ -133,9 +133,12 @@ def stratum_text(where: str, stratum: dict) -> str:
              f"{_factor(ab['convergence']['worst'])}), first exposure {_factor_ci(ab['first_exposure'])} (worst seed "
              f"{_factor(ab['first_exposure']['worst'])})"
              for name, against in stratum["pooled"].items() for base, ab in against.items()]
+    there = ("every method that needs a trajectory learned there as its baseline told nothing, the same learner "
+             "on the same seeds, and the claims above count those pairs" if stratum.get("told_nothing") else
+             "the claims above count every method that needs a trajectory as failed there")
     return (f"{where}, where robot 1 handed a trajectory over ({stratum['pairs']} of {stratum['of']} case x source "
-            "seed pairs; on the others it did not converge, and the claims above count every method that needs a "
-            "trajectory as failed there). A description of that stratum, with no verdict: " + "; ".join(parts) + ".")
+            f"seed pairs; on the others it did not converge, and {there}). A description of that stratum, with no "
+            "verdict: " + "; ".join(parts) + ".")
 
 
 def _against(e: dict, key: str) -> str:
@@ -237,6 +240,10 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
             errors = {m: e["errors"] for m, e in case["methods"].items() if e["errors"]}
             for m, errs in errors.items():
                 out.append(f"\n`{m}` could not run on some source seeds (counted as failed): {'; '.join(errs)}")
+            if case.get("source_failures") and sec.get("with_trajectory", {}).get("told_nothing"):
+                out.append(f"\nRobot 1 did not converge on {case['source_failures']} of "
+                           f"{len(case['optimal_per_seed'])} source seeds: there every method that needs a "
+                           "trajectory learned as its baseline told nothing.")
     out += ["", "## How to read this report", "",
             "- Every claim states, in this order: the whole cost (steps until the greedy path settled, "
             "restricted to the step cap), the first exposure (steps until the goal was first reached) and the "
@@ -272,7 +279,7 @@ def describe(name: str, parse_label) -> str:
 
 def seed_effect_text(suite: suites.Suite, summary: dict) -> str:
     """How much of the spread is the source seeds' (one line), and the seeds whose robot 1 did
-    not converge (kept, and every method that needs a trajectory failed on them)."""
+    not converge (kept, and every method that needs a trajectory learned there as its baseline)."""
     shares = [e["seed_share"] for s in suite.sections for c in summary[s.name]["cases"]
               for e in c["methods"].values() if e.get("seed_share") is not None]
     failed = [(s.name, c["label"], c.get("source_failures", 0)) for s in suite.sections
@@ -282,7 +289,10 @@ def seed_effect_text(suite: suites.Suite, summary: dict) -> str:
                f"{len(shares)} case x method cells." if shares else "could not be estimated (too few trials per seed)."))
     seeds = sum(s.source_seeds * len(s.cases) for s in suite.sections)
     n_failed = sum(k for _, _, k in failed)
+    told = any(summary[s.name].get("with_trajectory", {}).get("told_nothing") for s in suite.sections)
     text += (f" Robot 1 did not converge for {n_failed} of {seeds} (case, source seed) pairs; they are kept and "
-             "every method that needs a trajectory counts as failed on them"
+             + ("every method that needs a trajectory learned on them as its baseline told nothing (with nothing "
+                "handed over, robot 2 learns as it would without transfer)" if told else
+                "every method that needs a trajectory counts as failed on them")
              + (": " + "; ".join(f"{sec} {label}: {k}" for sec, label, k in failed) if failed else "") + ".")
     return text

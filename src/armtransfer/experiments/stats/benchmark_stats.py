@@ -206,6 +206,8 @@ def summarize(records: list[dict]) -> dict:
     for section, sec in out.items():
         if any(case["source_failures"] for case in sec["cases"]):
             sec["with_trajectory"] = with_trajectory(section, by_cell)
+            if any(r.get("told_nothing") for r in records if r["section"] == section):
+                sec["with_trajectory"]["told_nothing"] = True
     tested = [v for v in verdicts if v["p"] is not None]
     for v, adj in zip(tested, multiplicity.holm([v["p"] for v in tested])):
         v["p_holm"] = adj
@@ -235,9 +237,11 @@ def _pairings(section: str, name: str, by_cell: dict,
 
 def with_trajectory(section: str, by_cell: dict) -> dict:
     """The stratum of a section's (case, source seed) pairs on which robot 1 converged and
-    handed a trajectory over: ``{"pairs", "of", "pooled": {name: {baseline: {metric: factor}}}}``.
-    On the other pairs every method that needs a trajectory counts as failed (the claims keep
-    them); this says what the methods did where there was something to transfer. It is a
+    handed a trajectory over: ``{"pairs", "of", "pooled": {name: {baseline: {metric: factor}}}}``
+    (and ``told_nothing``, set by the caller, when the records ran their baselines there).
+    On the other pairs every method that needs a trajectory learned as its baseline told nothing
+    (records written before that rule: counted as failed); the claims keep them, and this says
+    what the methods did where there was something to transfer. It is a
     description: its comparisons carry no verdict and do not enter Holm's correction."""
     def kept(recs: list[dict]) -> list[dict]:
         return [r for r in recs if r["source_failure"] is None]
