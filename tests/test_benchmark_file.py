@@ -106,6 +106,28 @@ def test_the_readme_shows_the_tables_of_the_kept_report():
     assert shown == module.tables(module.pooled(KEPT))
 
 
+SMALL = ROOT / "docs" / "benchmark-small" / "results.json.gz"
+
+
+def _readme_table_module():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("readme_table", ROOT / "research" / "readme_table.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_readme_shows_the_learner_table_of_the_kept_small_report():
+    """README's learner table (SARSA, DQN, PPO each against its own ``none``) is
+    research/readme_table.py --learners on the kept small-suite results, character for character."""
+    module = _readme_table_module()
+    readme = (ROOT / "README.md").read_text()
+    shown = readme.split("<!-- learner-table -->\n", 1)[1].split("<!-- /learner-table -->", 1)[0]
+    assert shown == module.learner_table(module.pooled(SMALL))
+    assert [r.split(" | ")[0] for r in shown.splitlines()[2:]] == ["| sarsa", "| dqn", "| ppo"]
+
+
 def test_the_learner_table_puts_each_learner_against_its_own_none():
     import importlib.util
 

@@ -289,6 +289,8 @@ def seed_effect_text(suite: suites.Suite, summary: dict) -> str:
                f"{len(shares)} case x method cells." if shares else "could not be estimated (too few trials per seed)."))
     seeds = sum(s.source_seeds * len(s.cases) for s in suite.sections)
     n_failed = sum(k for _, _, k in failed)
+    if not n_failed:
+        return text + f" Robot 1 converged and handed a trajectory over on all {seeds} (case, source seed) pairs."
     told = any(summary[s.name].get("with_trajectory", {}).get("told_nothing") for s in suite.sections)
     text += (f" Robot 1 did not converge for {n_failed} of {seeds} (case, source seed) pairs; they are kept and "
              + ("every method that needs a trajectory learned on them as its baseline told nothing (with nothing "
