@@ -1,0 +1,87 @@
+"""Spatial arms in their own joint space over the 3D workspace (``worlds.voxels``, ``ik.voxels``)."""
+
+from __future__ import annotations
+
+import hashlib
+
+import numpy as np
+import pytest
+
+from armtransfer.ik.labels import Labeller
+from armtransfer.ik.scene import ContactChecker
+from armtransfer.ik.voxels import voxels_of_points, workspace_voxels
+from armtransfer.tasks.arms import arm_robot, arm_scene, is_spatial_joint, parse_robot_spec
+from armtransfer.worlds.resolve import world
+from armtransfer.worlds.voxels import Voxels
+
+SMALL = world("rooms11")
+STEP = 0.08
+
+
+@pytest.fixture(scope="module")
+def ur5e_joint():
+    return arm_robot("ur5e_like", "joint", layout=SMALL, joint_step=STEP)
+
+
+def test_level_0_voxels_are_the_plans_cells_and_walls_are_solid_up_to_their_height():
+    rooms = world("rooms")
+    assert workspace_voxels(rooms, 0.01).wall_levels == 2  # 2 cm walls, 1 cm levels
+    vox = workspace_voxels(SMALL, 0.51 / 11)
+    assert (vox.levels, vox.wall_levels) == (3, 1)
+    cells = np.arange(SMALL.n_cells)
+    assert np.array_equal(vox.ids(cells, np.zeros_like(cells)), cells)
+    assert np.array_equal(vox.free[:SMALL.n_cells], SMALL.free)  # walls solid at level 0, doors open
+    assert vox.free[SMALL.n_cells:].all()  # over the low walls
+    wall = int(np.flatnonzero(~SMALL.free)[0])
+    up = int(vox.ids(np.array(wall), np.array(1)))
+    assert vox.xyk(up) == (*SMALL.xy(wall), 1) and vox.cell_of(up) == wall and vox.level_of(up) == 1
+    two, rw = Voxels(rooms, 3, 2), int(np.flatnonzero(~rooms.free)[0])
+    assert not two.free[rooms.n_cells + rw] and two.free[2 * rooms.n_cells + rw]
+    cell = 0.01
+    x, y = SMALL.xy(5)
+    p = np.array([[x * cell, y * cell, 0.5 * cell], [x * cell, y * cell, 2.5 * cell],
+                  [x * cell, y * cell, 3.2 * cell], [x * cell, y * cell, -0.1 * cell]])
+    assert voxels_of_points(p, cell, Voxels(SMALL)).tolist() == [5, 2 * SMALL.n_cells + 5, -1, -1]
+
+
+def test_a_spatial_arms_joint_spec_parses_and_a_planar_arms_joint_robot_is_as_before():
+    assert parse_robot_spec("ur5e_like:joint") == ("ur5e_like", "joint")
+    assert parse_robot_spec("panda_like:joint") == ("panda_like", "joint")
+    planar = arm_robot("planar2", "joint", layout=SMALL)
+    assert not is_spatial_joint(planar) and planar.arm is not None and planar.arm.levels == 0
+    # the key and arrays main had before the 3D workspace (2026-12-04, commit 5659c26)
+    assert planar.arm.key == "4b97d797d4735209560e6e55817e1e5fcb0dcf93a695035661c9660ccf3f3124"
+    digest = hashlib.sha256(planar.next_state.tobytes() + planar.label.tobytes()).hexdigest()
+    assert digest == "249b2316c04bea610561ca6b773cb2fa2dc8a3e61c4ee0d3a198625414bb47aa"
+
+
+def test_every_state_is_labelled_with_the_voxel_of_its_tool_point_by_mink(ur5e_joint):
+    robot = ur5e_joint
+    arm = robot.arm
+    assert arm is not None and is_spatial_joint(robot) and arm.levels == 3
+    assert arm.moved == (0, 1, 2) and robot.action_names == ("q1+", "q1-", "q2+", "q2-", "q3+", "q3-")
+    scene = arm_scene("ur5e_like", layout=SMALL)
+    vox = workspace_voxels(SMALL, scene.cell)
+    mink = Labeller(scene)
+    contact = ContactChecker(scene)
+    rng = np.random.default_rng(0)
+    sample = rng.choice(robot.n_states, size=60, replace=False)
+    for s in sample:
+        tip = mink.tip(arm.qpos[s])
+        assert np.allclose(tip, arm.tip[s], atol=1e-9)
+        assert int(voxels_of_points(tip, scene.cell, vox)) == int(robot.label[s])
+        assert not contact.touches(arm.qpos[s])
+    assert vox.free[robot.label].all() and set(np.unique(robot.label // SMALL.n_cells)) == {0, 1, 2}
+    held = [j for j in range(arm.dof) if j not in arm.moved]
+    assert np.ptp(arm.qpos[:, held], axis=0).max() == 0.0  # the wrist is held
+    for s in sample:  # each action moves its joint by +-delta, or is blocked
+        for a in range(robot.n_actions):
+            t = int(robot.next_state[s, a])
+            if t == s:
+                continue
+            dq = arm.qpos[t] - arm.qpos[s]
+            j, sign = arm.moved[a // 2], 1 if a % 2 == 0 else -1
+            expect = np.zeros(arm.dof)
+            expect[j] = sign * STEP
+            assert np.allclose(dq, expect, atol=1e-12)
+    assert robot.label[robot.start_state(SMALL.cell(0, 0))] == SMALL.cell(0, 0)  # a task cell starts at level 0
