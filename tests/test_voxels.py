@@ -85,3 +85,30 @@ def test_every_state_is_labelled_with_the_voxel_of_its_tool_point_by_mink(ur5e_j
             expect[j] = sign * STEP
             assert np.allclose(dq, expect, atol=1e-12)
     assert robot.label[robot.start_state(SMALL.cell(0, 0))] == SMALL.cell(0, 0)  # a task cell starts at level 0
+
+
+def test_a_planar_arms_cell_path_transfers_to_a_spatial_arm_in_joint_space(ur5e_joint):
+    """planar2:joint -> ur5e_like:joint via the API: the source's 2D cells are the target's
+    level-0 voxels, so the pseudo reward pays the 3D robot for reaching them."""
+    import armtransfer
+
+    r = armtransfer.transfer("planar2:joint", ur5e_joint, world=SMALL, task="2", methods=["none", "pseudo"],
+                             trials=2, controls=False)
+    traj = r.trajectories[0]
+    assert all(0 <= c < SMALL.n_cells for c in traj.cells)  # a 2D path: level 0
+    on_path = np.isin(ur5e_joint.label, traj.cells)
+    assert on_path.any() and (ur5e_joint.label[on_path] < SMALL.n_cells).all()
+    assert set(traj.cells) & set(ur5e_joint.label.tolist())
+    for m in ("none", "pseudo"):
+        steps = r.methods[m].column("exploration_steps")
+        assert len(steps) == 2 and all(s is not None for s in steps)  # every trial reached the goal
+    assert r.distance == ur5e_joint.distance(ur5e_joint.start_state(r.start_cell), r.goal_cell)
+
+
+def test_a_lattice_too_large_is_one_line_naming_the_remedy(monkeypatch):
+    from armtransfer.errors import ArmModelError
+    from armtransfer.ik import voxels
+
+    monkeypatch.setattr(voxels, "MAX_STATES", 40)
+    with pytest.raises(ArmModelError, match=r"more than 40 states over the 3D workspace; give a coarser joint step"):
+        arm_robot("ur5e_like", "joint", layout=SMALL, joint_step=STEP, cache=False)

@@ -206,7 +206,7 @@ def compile_spatial_joint(scene: ArmScene, step: float | None, progress: bool = 
             if len(qs) > MAX_STATES:
                 raise ArmModelError(
                     f"the joint lattice of this arm at a step of {step:g} rad has more than {MAX_STATES:,} states "
-                    "over the 3D workspace; give a coarser joint step (--joint-step) or a smaller world")
+                    "over the 3D workspace; give a coarser joint step (joint_step=, e.g. 0.08) or a smaller world")
     n = len(qs)
     _progress(progress, f"  3D lattice: joints {[m + 1 for m in moved]} at {step:g} rad, {n} states")
     next_state = np.repeat(np.arange(n, dtype=np.int32)[:, None], 2 * k, axis=1)
