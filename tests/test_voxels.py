@@ -112,3 +112,26 @@ def test_a_lattice_too_large_is_one_line_naming_the_remedy(monkeypatch):
     monkeypatch.setattr(voxels, "MAX_STATES", 40)
     with pytest.raises(ArmModelError, match=r"more than 40 states over the 3D workspace; give a coarser joint step"):
         arm_robot("ur5e_like", "joint", layout=SMALL, joint_step=STEP, cache=False)
+
+
+@pytest.mark.slow
+@pytest.mark.rendering
+def test_armtransfer_arms_planar_to_spatial_joint_with_a_replay_video(tmp_path):
+    """The command end to end, planar2:joint -> ur5e_like:joint on rooms11, with the physics
+    replay of both arms (about 10 s with the arms compiled, 2026-12-04)."""
+    import json
+
+    import imageio.v3 as iio
+
+    from armtransfer.cli import main
+
+    out = tmp_path / "run"
+    assert main(["arms", "--source", "planar2:joint", "--target", "ur5e_like:joint", "--world", "rooms11",
+                 "--task", "2", "--fast", "--method", "none", "pseudo", "--out", str(out)]) == 0
+    data = json.loads((out / "results.json").read_text())
+    assert data["target"] == "ur5e_like:joint" and set(data["results"]) == {"none", "pseudo"}
+    assert all(len(r["exploration_steps"]) == 2 for r in data["results"].values())
+    rollout = data["rollout"]
+    assert rollout["panels"] == 2 and len(iio.imread(out / "rollout.mp4")) == rollout["frames"] > 10
+    for rp in rollout["replays"]:
+        assert rp["reached_goal"] and rp["max_deviation_cells"] < 1.0
