@@ -135,3 +135,37 @@ def test_armtransfer_arms_planar_to_spatial_joint_with_a_replay_video(tmp_path):
     assert rollout["panels"] == 2 and len(iio.imread(out / "rollout.mp4")) == rollout["frames"] > 10
     for rp in rollout["replays"]:
         assert rp["reached_goal"] and rp["max_deviation_cells"] < 1.0
+
+
+def test_a_voxel_path_round_trips_through_the_trajectory_json():
+    from armtransfer.errors import InvalidTrajectoryError
+    from armtransfer.learning import trajectory as trajectories
+
+    n = SMALL.n_cells
+    cells = (SMALL.cell(2, 2), n + SMALL.cell(2, 3), 2 * n + SMALL.cell(3, 3), SMALL.cell(3, 4))
+    traj = trajectories.Trajectory(cells, (0, 1, 2, 3), SMALL.cell(4, 4), source="ur5e_like:joint")
+    data = traj.to_json(SMALL)
+    assert [s["cell"] for s in data["steps"]] == [[2, 2], [2, 3, 1], [3, 3, 2], [3, 4]]
+    back = trajectories.parse(data, SMALL)
+    assert back.cells == cells and back.goal == traj.goal and back.actions == traj.actions
+    data["steps"][1]["cell"] = [2, 3, 3]
+    with pytest.raises(InvalidTrajectoryError, match=r"step 1 cell level 3 is outside 0..2"):
+        trajectories.parse(data, SMALL)
+
+
+def test_a_spatial_arms_voxel_path_transfers_to_another_spatial_arm(ur5e_joint):
+    """ur5e_like:joint -> panda_like:joint via the API: the source's path climbs off the
+    table (voxels above level 0) and the target is paid for the same voxels."""
+    import armtransfer
+
+    panda = arm_robot("panda_like", "joint", layout=SMALL, joint_step=STEP)
+    assert panda.arm is not None and panda.arm.moved == (0, 1, 3)  # shoulder, upper arm, elbow
+    r = armtransfer.transfer(ur5e_joint, panda, world=SMALL, task="2", methods=["none", "pseudo"], trials=2,
+                             controls=False)
+    traj = r.trajectories[0]
+    assert traj.source == "ur5e_like:joint" and set(traj.cells) <= set(ur5e_joint.label.tolist())
+    assert any(c >= SMALL.n_cells for c in traj.cells)  # it leaves level 0 on the way
+    assert set(traj.cells) & set(panda.label[panda.label >= SMALL.n_cells].tolist())  # voxels both arms reach
+    for m in ("none", "pseudo"):
+        steps = r.methods[m].column("exploration_steps")
+        assert len(steps) == 2 and all(s is not None for s in steps)

@@ -248,7 +248,8 @@ def _paths(out_json: dict, source: DiscreteRobot, target: DiscreteRobot) -> dict
     start = layout.cell(*out_json["task"]["start"])
     goal = layout.cell(*out_json["task"]["goal"])
     steps = out_json["trajectory"]["steps"] if out_json["trajectory"] else []
-    traj_cells = [layout.cell(*s["cell"]) for s in steps]
+    traj_cells = [layout.cell(*s["cell"][:2]) + (s["cell"][2] * layout.n_cells if len(s["cell"]) == 3 else 0)
+                  for s in steps]  # [x, y, level]: a voxel above the table
     if steps:
         traj = Trajectory(tuple(traj_cells), tuple(s["action"] for s in steps), goal, source=source.name)
         source_states = trajectories.states_along(source, traj)
