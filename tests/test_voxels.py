@@ -105,13 +105,20 @@ def test_a_planar_arms_cell_path_transfers_to_a_spatial_arm_in_joint_space(ur5e_
     assert r.distance == ur5e_joint.distance(ur5e_joint.start_state(r.start_cell), r.goal_cell)
 
 
-def test_a_lattice_too_large_is_one_line_naming_the_remedy(monkeypatch):
+def test_a_lattice_too_large_is_one_line_naming_the_remedy(monkeypatch, tmp_path, capsys):
+    from armtransfer.cli import main
     from armtransfer.errors import ArmModelError
     from armtransfer.ik import voxels
 
     monkeypatch.setattr(voxels, "MAX_STATES", 40)
     with pytest.raises(ArmModelError, match=r"more than 40 states over the 3D workspace; give a coarser joint step"):
         arm_robot("ur5e_like", "joint", layout=SMALL, joint_step=STEP, cache=False)
+    out = tmp_path / "out"
+    assert main(["arms", "--source", "planar2:joint", "--target", "ur5e_like:joint", "--world", "rooms11", "--fast",
+                 "--no-video", "--no-cache", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "more than 40 states" in err and "coarser joint step" in err
+    assert not out.exists()
 
 
 @pytest.mark.slow

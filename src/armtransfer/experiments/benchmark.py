@@ -138,7 +138,7 @@ def draw_task(source: DiscreteRobot, target: DiscreteRobot, rng: np.random.Gener
     and goal on ``cells`` (``suites.CELLS``: even, both coordinates even; odd, not both)."""
     low, high = distance if distance is not None else (MIN_DISTANCE, None)
     common = np.intersect1d(np.unique(source.label), np.unique(target.label))
-    common = common[common >= 0]
+    common = common[(common >= 0) & (common < source.layout.n_cells)]  # tasks are on the table: level 0 of voxels
     if cells != "any":
         even = np.all(source.layout.xy_of(common) % 2 == 0, axis=-1)
         common = common[even if cells == "even" else ~even]

@@ -665,7 +665,7 @@ def walls_cause(robot: DiscreteRobot) -> str:
         return ""
     scene = _scene(arm.xml_path, arm.tool, arm.mount, arm.yaw, arm.cell_size, arm.layout)
     reached = np.zeros(arm.layout.n_cells, dtype=bool)
-    reached[np.unique(robot.label)] = True
+    reached[np.unique(robot.label % arm.layout.n_cells)] = True  # a voxel label: the cell under it
     return _walls.wall_cause(scene, not scene.planar, reached)
 
 
