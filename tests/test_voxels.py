@@ -194,3 +194,19 @@ def test_the_voxels_suite_runs_on_one_source_seed():
                                                                  (1, "pseudo")]
     for r in records:
         assert r["error"] is None and r["first_exposure"][0] is not None, r
+
+
+def test_a_bring_your_own_6_joint_file_gets_the_same_3d_joint_robot(ur5e_joint):
+    """custom:joint on a spatial arm file: the built-in ur5e_like's file, mounted as it is, gives
+    the built-in's 3D robot state for state."""
+    import math
+
+    from armtransfer.models import ARMS
+
+    info = ARMS["ur5e_like"]
+    mine = arm_robot(None, "joint", xml_path=info.xml_path, arm_name="my_ur5e", base_pos=info.mount_pos,
+                     base_yaw=-math.pi / 2, layout=SMALL, joint_step=STEP)
+    assert mine.name == "my_ur5e:joint" and is_spatial_joint(mine) and mine.action_names == ur5e_joint.action_names
+    for a, b in ((mine.label, ur5e_joint.label), (mine.next_state, ur5e_joint.next_state),
+                 (mine.arm.qpos, ur5e_joint.arm.qpos)):
+        assert np.array_equal(a, b)
