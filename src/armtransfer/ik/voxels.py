@@ -50,7 +50,7 @@ MAX_STATES = 200_000
 SPATIAL_STEPS = (0.01, 0.015, 0.02, 0.03, 0.05, 0.08, 0.12)
 """Lattice steps (rad) a spatial arm's step is chosen from when not given: the coarsest whose
 largest tool move per step is at most ``STEP_CELLS`` of a cell at the origin."""
-STEP_CELLS = 0.6
+STEP_CELLS = 1.0
 
 
 def workspace_voxels(layout, cell: float) -> Voxels:

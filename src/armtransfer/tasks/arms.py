@@ -242,7 +242,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
             mount, source = cast(tuple[float, float, float], tuple(float(v) for v in base_pos)), "given"
         yaw = info.mount_yaw if base_pos is None else float(base_yaw or 0.0)
         kind, tip_down = info.kind, info.tip_down
-        step = joint_step or info.joint_step
+        step = joint_step or (info.joint_step if info.kind == "planar" else None)  # spatial: ik.voxels chooses
     parts = {
         "version": 6, "arm_xml": _sha(xml_bytes), "assets": _assets_sha(path), "tool": tool.key(),
         "mount": mount, "yaw": yaw, "actions": model.name, "cells": model.cells, "tip_down": tip_down,
