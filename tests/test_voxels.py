@@ -210,3 +210,15 @@ def test_a_bring_your_own_6_joint_file_gets_the_same_3d_joint_robot(ur5e_joint):
     for a, b in ((mine.label, ur5e_joint.label), (mine.next_state, ur5e_joint.next_state),
                  (mine.arm.qpos, ur5e_joint.arm.qpos)):
         assert np.array_equal(a, b)
+
+
+def test_a_task_cell_out_of_reach_at_the_table_level_names_the_remedy(ur5e_joint):
+    from armtransfer.errors import InvalidCellError
+
+    level0 = set(ur5e_joint.label[ur5e_joint.label < SMALL.n_cells].tolist())
+    missing = [c for c in np.flatnonzero(SMALL.free) if int(c) not in level0]
+    assert missing  # at 0.08 rad the tool skips a few cells' table level
+    x, y = SMALL.xy(int(missing[0]))
+    with pytest.raises(InvalidCellError, match=rf"cannot reach the goal cell \({x}, {y}\) with its tool at the table "
+                                               r"level \(level 0 of the 3D workspace\); give a finer joint step"):
+        ur5e_joint.start_state(int(missing[0]), what="goal")
