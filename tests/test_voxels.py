@@ -85,6 +85,9 @@ def test_every_state_is_labelled_with_the_voxel_of_its_tool_point_by_mink(ur5e_j
             expect[j] = sign * STEP
             assert np.allclose(dq, expect, atol=1e-12)
     assert robot.label[robot.start_state(SMALL.cell(0, 0))] == SMALL.cell(0, 0)  # a task cell starts at level 0
+    blown = robot.wind_state != np.arange(robot.n_states)  # wind: one cell towards +x at the same level
+    assert blown.any() and np.array_equal(robot.label[robot.wind_state[blown]], robot.label[blown] + 1)
+    assert all(int(robot.wind_state[s]) in robot.next_state[s] for s in np.flatnonzero(blown)[:200])
 
 
 def test_a_planar_arms_cell_path_transfers_to_a_spatial_arm_in_joint_space(ur5e_joint):
