@@ -68,7 +68,7 @@ def test_the_demo_script_has_a_fast_mode(tmp_path):
 
 BAD = [
     (["--source", "octopus:joint"], "unknown arm 'octopus'; valid arms:"),
-    (["--target", "ur5e_like:joint"], "has no action model 'joint'"),
+    (["--target", "ur5e_like:polar"], "unknown action model 'polar'"),
     (["--source", "custom"], "needs --arm-xml"),
     (["--start", "20,-20", "--goal", "0,0"], "cannot reach the start cell"),  # planar2:joint misses room 4
     (["--render", "video.avi"], "format"),

@@ -131,7 +131,8 @@ def test_robot_specs_parse_and_reject_unknown_names():
     assert parse_robot_spec("ur5e_like") == ("ur5e_like", "cartesian")
     with pytest.raises(UnknownArmError, match="valid arms: planar2, planar3"):
         parse_robot_spec("puma:joint")
-    with pytest.raises(UnknownArmError, match="valid action models: cartesian, cartesian2"):
-        parse_robot_spec("panda_like:joint")
+    assert parse_robot_spec("panda_like:joint") == ("panda_like", "joint")  # over the 3D workspace
+    with pytest.raises(UnknownArmError, match="valid action models: joint, cartesian, cartesian2"):
+        parse_robot_spec("panda_like:polar")
     with pytest.raises(ArmTransferError, match="valid action models"):
         parse_robot_spec("planar2:polar")

@@ -204,7 +204,7 @@ def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target
                             greedy=greedy)
     paths = _paths(out_json, source, target)
     layout = target.layout
-    traj_xy = [list(layout.xy(c)) for c in paths["trajectory_cells"]] + [list(out_json["task"]["goal"])]
+    traj_xy = [list(layout.xy(c % layout.n_cells)) for c in paths["trajectory_cells"]] + [list(out_json["task"]["goal"])]
     figures.mapping_paths(layout.wall_mask, layout.lo, traj_xy, paths["target_xy"] or traj_xy, [],
                           f"{source.name} (dashed) -> {target.name} (solid)", tmp / "map.png")
     video, no_video = None, None
@@ -248,7 +248,8 @@ def _paths(out_json: dict, source: DiscreteRobot, target: DiscreteRobot) -> dict
     start = layout.cell(*out_json["task"]["start"])
     goal = layout.cell(*out_json["task"]["goal"])
     steps = out_json["trajectory"]["steps"] if out_json["trajectory"] else []
-    traj_cells = [layout.cell(*s["cell"]) for s in steps]
+    traj_cells = [layout.cell(*s["cell"][:2]) + (s["cell"][2] * layout.n_cells if len(s["cell"]) == 3 else 0)
+                  for s in steps]  # [x, y, level]: a voxel above the table
     if steps:
         traj = Trajectory(tuple(traj_cells), tuple(s["action"] for s in steps), goal, source=source.name)
         source_states = trajectories.states_along(source, traj)
@@ -273,7 +274,7 @@ def _paths(out_json: dict, source: DiscreteRobot, target: DiscreteRobot) -> dict
         "source_states": source_states,
         "target_states": target_states,
         "target_method": target_method,
-        "target_xy": [list(layout.xy(int(target.label[s]))) for s in target_states],
+        "target_xy": [list(layout.xy(int(target.label[s]) % layout.n_cells)) for s in target_states],
     }
 
 

@@ -138,7 +138,7 @@ def draw_task(source: DiscreteRobot, target: DiscreteRobot, rng: np.random.Gener
     and goal on ``cells`` (``suites.CELLS``: even, both coordinates even; odd, not both)."""
     low, high = distance if distance is not None else (MIN_DISTANCE, None)
     common = np.intersect1d(np.unique(source.label), np.unique(target.label))
-    common = common[common >= 0]
+    common = common[(common >= 0) & (common < source.layout.n_cells)]  # tasks are on the table: level 0 of voxels
     if cells != "any":
         even = np.all(source.layout.xy_of(common) % 2 == 0, axis=-1)
         common = common[even if cells == "even" else ~even]
@@ -310,8 +310,13 @@ class Plan:
         return self.learners if self.learners is not None else pair.section.learners
 
     def entries(self, pair: Pair) -> list[tuple[str, list[str]]]:
-        """(learner, the methods it runs) for ``pair``, per learner."""
-        return [(lr, learner_methods(lr, self.methods)) for lr in self.learners_of(pair)]
+        """(learner, the methods it runs) for ``pair``, per learner: of the plan's methods, those
+        of the pair's section (``Section.methods``, with their baselines) when it names some."""
+        ran = list(self.methods)
+        if pair.section.methods is not None:
+            keep = methods_to_run(pair.section.methods)[0]
+            ran = [m for m in ran if m in keep]
+        return [(lr, learner_methods(lr, ran)) for lr in self.learners_of(pair)]
 
     def labels(self, pair: Pair | None = None) -> list[str]:
         """The records' names of ``pair`` (None: of every pair, in order): per learner, its methods

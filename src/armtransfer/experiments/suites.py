@@ -84,6 +84,9 @@ class Section:
     """The learners every method runs on (``armtransfer.learning.learners``), each method beside
     the baseline run by the same learner; an outside learner runs ``none`` and the reward-term
     methods."""
+    methods: tuple[str, ...] | None = None
+    """The methods this section runs (each with its baselines), of those the benchmark runs;
+    None: all of them."""
 
     def to_dict(self) -> dict:
         """The section as stored and reported; the default learners are left out, so a suite that
@@ -96,6 +99,10 @@ class Section:
             del out["learners"]
         else:
             out["learners"] = list(self.learners)
+        if self.methods is None:  # every method: the bytes a section had before sections chose
+            del out["methods"]
+        else:
+            out["methods"] = list(self.methods)
         return out
 
 
@@ -171,6 +178,14 @@ SMALL = Section(
     (Case("coarse", "fine", 2, world="rooms11"), Case("coarse", "fine", 2, world="rooms15")),
     source_seeds=10, trials=2, max_total_steps=25_000, learners=SMALL_LEARNERS)
 
+VOXELS = Section(
+    "voxels", "arms moving their joints with the tool off the table, over the 3D workspace of rooms11 (3 levels, "
+    "walls 1 level high), task 2: planar2:joint -> ur5e_like:joint (a 2D path, paid at level 0) and "
+    "ur5e_like:joint -> panda_like:joint (a path of voxels); none and pseudo",
+    (Case("planar2:joint", "ur5e_like:joint", 2, world="rooms11"),
+     Case("ur5e_like:joint", "panda_like:joint", 2, world="rooms11")),
+    source_seeds=10, trials=ARM_TRIALS, max_total_steps=1_000_000, methods=("none", "pseudo"))
+
 SUITES: dict[str, Suite] = {
     s.name: s
     for s in (
@@ -183,6 +198,7 @@ SUITES: dict[str, Suite] = {
         Suite("dev", 3, False, DEV.description, (DEV,)),
         Suite("fast", 2, False, FAST.description, (FAST,)),
         Suite("small", 1, True, SMALL.description, (SMALL,)),
+        Suite("voxels", 1, True, VOXELS.description, (VOXELS,)),
     )
 }
 """Every suite by name."""

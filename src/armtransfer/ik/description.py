@@ -63,6 +63,11 @@ class ArmDescription:
     point rides that much higher than ``ik.solve.TIP_HEIGHT``, cells are read at the point."""
     clearance_geom: str = ""
     """The geom that reaches farthest past the point ("" when none does)."""
+    levels: int = 0
+    """0 for a robot on the table plane; for a spatial arm's ``joint`` robot, the levels of the
+    3D workspace its labels (voxel ids, ``worlds.voxels``) number."""
+    moved: tuple[int, ...] = ()
+    """A spatial ``joint`` robot's moved joints (indices into ``chain``); the rest are held."""
 
     def clearance_note(self) -> str:
         """One line when the tool's geometry reaches past the tool point, else ""."""

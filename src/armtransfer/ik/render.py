@@ -315,7 +315,7 @@ def _markers(panel: RolloutPanel) -> list[Marker]:
     thin = cell * 0.05
 
     def centre(c: int, z: float) -> np.ndarray:
-        x, y = layout.xy(int(c))
+        x, y = layout.xy(int(c) % layout.n_cells)  # a voxel: the cell under it
         return np.array([x * cell, y * cell, z])
 
     box = int(mujoco.mjtGeom.mjGEOM_BOX)

@@ -144,7 +144,7 @@ class Replay:
     def goal_offset_cells(self) -> float:
         """Largest distance (cells), along x or y, of the final tip from the goal cell's centre:
         at most half a cell when the tip ends over the goal cell."""
-        centre = np.array(self.scene.layout.xy(self.goal_cell), dtype=float) * self.cell
+        centre = np.array(self.scene.layout.xy(self.goal_cell % self.scene.layout.n_cells), dtype=float) * self.cell
         return float(np.abs(self.tip_xy[-1] - centre).max() / self.cell)
 
     def shortfall(self) -> str:
@@ -181,7 +181,7 @@ class Replay:
         return {
             "robot": self.robot,
             "waypoints": len(self.path_states),
-            "goal_cell": list(self.scene.layout.xy(self.goal_cell)),
+            "goal_cell": list(self.scene.layout.xy(self.goal_cell % self.scene.layout.n_cells)),
             "final_cell": (list(self.scene.layout.xy(self.final_cell))
                            if self.final_cell != OFF_TABLE else None),
             "reached_goal": self.reached_goal,
@@ -388,7 +388,7 @@ def _simulate(robot, path_states: Sequence[int], *, goal_cell: int | None, segme
 
     layout = scene.layout
     planned_cells = _dedupe(robot.label[states].tolist())
-    planned_xy = np.array([np.array(layout.xy(c), dtype=float) * scene.cell for c in planned_cells])
+    planned_xy = np.array([np.array(layout.xy(c % layout.n_cells), dtype=float) * scene.cell for c in planned_cells])
     settings: dict[str, Any] = {"segment_seconds": seg_steps * dt, "settle_seconds": settle_steps * dt,
                                 "bandwidth_hz": bandwidth_hz, "feedforward": feedforward, "timestep": dt,
                                 "servos": "scene" if own_servos else "file"}

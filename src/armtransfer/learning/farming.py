@@ -363,7 +363,7 @@ def check_self_loops(method: str, robot: DiscreteRobot, goal_cell: int, shaping:
     bad = (term > 0.0) & (config.step_reward + term >= 0.0)
     if bad.any():
         k = int(np.argmax(np.where(bad, term, -np.inf)))
-        x, y = robot.layout.xy(int(robot.label[states[k]]))
+        x, y = robot.layout.xy(int(robot.label[states[k]]) % robot.layout.n_cells)
         raise InvalidParameterError(
             f"method {method!r} pays a learner for a move that leaves its state unchanged at {int(bad.sum())} "
             f"states (at cell ({x},{y}): step reward {config.step_reward:g} + shaping {term[k]:.4g} >= 0); "

@@ -90,12 +90,12 @@ def _check_definition(name: object, description: object, fn: object, what: str, 
 
 def trajectory_xy(traj: Trajectory, robot: DiscreteRobot) -> np.ndarray:
     """The (m, 2) int64 (x, y) of ``traj``'s cells in order, its goal last."""
-    return robot.layout.xy_of(np.array([*traj.cells, traj.goal], dtype=np.int64))
+    return robot.layout.xy_of(np.array([*traj.cells, traj.goal], dtype=np.int64) % robot.layout.n_cells)
 
 
 def _values(name: str, fn: CellFunction, robot: DiscreteRobot, trajs: list[Trajectory], what: str) -> np.ndarray:
     """``fn`` over the robot's states for each trajectory, the largest per state, checked."""
-    cells = robot.layout.xy_of(robot.label)
+    cells = robot.layout.xy_of(robot.label % robot.layout.n_cells)  # a voxel label: the cell under it
     n = robot.n_states
     out = None
     for traj in trajs:

@@ -80,7 +80,7 @@ def bounded(phi: np.ndarray, gamma: float, step_reward: float, margin: float = L
 
 
 def _label_xy(robot: DiscreteRobot, layout: Layout) -> np.ndarray:
-    return layout.xy_of(robot.label).astype(np.float64)
+    return layout.xy_of(robot.label % layout.n_cells).astype(np.float64)  # a voxel label: the cell under it
 
 
 def dense(
@@ -93,7 +93,7 @@ def dense(
     """The ``dense`` potential of every robot state (float64 [n_states])."""
     layout = layout or robot.layout
     p = _label_xy(robot, layout)
-    t = np.array([layout.xy(c) for c in traj.cells], dtype=np.float64)
+    t = np.array([layout.xy(c % layout.n_cells) for c in traj.cells], dtype=np.float64)
     n = len(t) - 1
     best_d = np.full(len(p), np.inf)
     best_i = np.zeros(len(p))

@@ -67,7 +67,7 @@ class TransferTerm:
             raise InvalidTrajectoryError(f"a trajectory is a Trajectory or a trajectory JSON file, got {t!r}")
         layout = self.robot.layout
         traj = t if isinstance(t, Trajectory) else trajectories.load(t, layout)
-        n_cells = layout.n_cells
+        n_cells = layout.n_cells * max(1, self.robot.arm.levels if self.robot.arm is not None else 1)  # voxels: 3D
         if any(not 0 <= c < n_cells for c in (*traj.cells, traj.goal)):
             raise InvalidTrajectoryError(f"the trajectory names cells outside this robot's layout (0..{n_cells - 1})")
         if self.robot.arm is not None and traj.source in GRID_ROBOTS:

@@ -23,6 +23,7 @@ from pathlib import Path
 
 from armtransfer.errors import InvalidTrajectoryError
 from armtransfer.worlds.layout import ROOMS, Layout
+from armtransfer.worlds.voxels import LEVELS
 from armtransfer.tasks.robot import DiscreteRobot
 
 FORMAT = "armtransfer-trajectory/1"
@@ -63,12 +64,13 @@ class Trajectory:
         return [layout.xy(c) for c in self.cells]
 
     def to_json(self, layout: Layout = ROOMS) -> dict:
+        """Cells as [x, y]; a voxel above the table (a spatial ``joint`` robot's) as [x, y, level]."""
         return {
             "format": FORMAT,
             "source": self.source,
-            "goal": list(layout.xy(self.goal)),
+            "goal": _cell_json(self.goal, layout),
             "steps": [
-                {"cell": list(layout.xy(c)), "action": int(a)}
+                {"cell": _cell_json(c, layout), "action": int(a)}
                 for c, a in zip(self.cells, self.actions)
             ],
         }
@@ -77,6 +79,11 @@ class Trajectory:
         from armtransfer.io import write_json_atomic
 
         write_json_atomic(path, self.to_json(layout))
+
+
+def _cell_json(label: int, layout: Layout) -> list[int]:
+    level, cell = divmod(int(label), layout.n_cells)
+    return [*layout.xy(cell), level] if level else list(layout.xy(cell))
 
 
 def from_path(robot: DiscreteRobot, path: list[tuple[int, int]]) -> Trajectory:
@@ -127,11 +134,19 @@ def parse(data: object, layout: Layout = ROOMS, where: str = "trajectory") -> Tr
     def cell_of(value: object, what: str) -> int:
         if (
             not isinstance(value, (list, tuple))
-            or len(value) != 2
+            or len(value) not in (2, 3)
             or not all(isinstance(v, int) and not isinstance(v, bool) for v in value)
         ):
-            raise InvalidTrajectoryError(f"{where}: {what} must be [x, y] integers, got {value!r}")
-        x, y = value
+            raise InvalidTrajectoryError(f"{where}: {what} must be [x, y] (or [x, y, level]) integers, got {value!r}")
+        x, y = value[0], value[1]
+        if len(value) == 3:  # a voxel of the 3D workspace: whether it is in a wall is the robot's to say
+            level = value[2]
+            if not 0 <= level < LEVELS:
+                raise InvalidTrajectoryError(f"{where}: {what} level {level} is outside 0..{LEVELS - 1}")
+            if not layout.in_grid(x, y):
+                raise InvalidTrajectoryError(f"{where}: {what} ({x},{y}) is off the grid [{layout.lo}, {layout.hi}]")
+            if level:
+                return level * layout.n_cells + layout.cell(x, y)
         if not layout.in_grid(x, y):
             raise InvalidTrajectoryError(
                 f"{where}: {what} ({x},{y}) is off the grid [{layout.lo}, {layout.hi}]"

@@ -61,14 +61,31 @@ def check_actions(arm: str, actions: str) -> None:
 
 
 def _allowed_actions(kind: str) -> tuple[str, ...]:
+    """Every action model of an arm of this kind: all of them; a spatial arm's ``joint``
+    acts over the 3D workspace (``ik.voxels``)."""
+    return tuple(ACTION_MODELS)
+
+
+def _listed_actions(kind: str) -> tuple[str, ...]:
     if kind == "planar":
         return tuple(ACTION_MODELS)
     return tuple(a for a in ACTION_MODELS if ACTION_MODELS[a].kind == "cartesian")
 
 
 def robot_specs() -> list[str]:
-    """Every built-in robot name, ``ARM:ACTIONS``."""
-    return [f"{arm}:{a}" for arm, info in ARMS.items() for a in _allowed_actions(info.kind)]
+    """Every built-in robot name on the table plane, ``ARM:ACTIONS`` (a spatial arm's
+    ``joint`` robot, over the 3D workspace, is left out: see :func:`spatial_joint_specs`)."""
+    return [f"{arm}:{a}" for arm, info in ARMS.items() for a in _listed_actions(info.kind)]
+
+
+def spatial_joint_specs() -> list[str]:
+    """The built-in robots that act in joint space over the 3D workspace."""
+    return [f"{arm}:joint" for arm, info in ARMS.items() if info.kind != "planar"]
+
+
+def is_spatial_joint(robot: DiscreteRobot) -> bool:
+    """Whether the robot's labels are voxels of the 3D workspace (``worlds.voxels``)."""
+    return robot.arm is not None and robot.arm.levels > 0
 
 
 def robot(spec: str, **kwargs) -> DiscreteRobot:
@@ -225,13 +242,20 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
             mount, source = cast(tuple[float, float, float], tuple(float(v) for v in base_pos)), "given"
         yaw = info.mount_yaw if base_pos is None else float(base_yaw or 0.0)
         kind, tip_down = info.kind, info.tip_down
-        step = joint_step or info.joint_step
+        step = joint_step or (info.joint_step if info.kind == "planar" else None)  # spatial: ik.voxels chooses
     parts = {
         "version": 6, "arm_xml": _sha(xml_bytes), "assets": _assets_sha(path), "tool": tool.key(),
         "mount": mount, "yaw": yaw, "actions": model.name, "cells": model.cells, "tip_down": tip_down,
         "joint_step": step if model.kind == "joint" else None, "cell": cell_size,
         "wall_height": WALL_HEIGHT, "layout": _layout_data(layout),
     }
+    spatial = model.kind == "joint" and kind != "planar" and not _is_planar_file(path, tool, mount, yaw, cell_size,
+                                                                                 layout, kind)
+    if spatial:  # over the 3D workspace: its own key (the 2D robots' keys are as they were)
+        from armtransfer.ik.voxels import LEVELS, MAX_STATES, MOVED, SPATIAL_STEPS, STEP_CELLS
+
+        parts["workspace"] = {"levels": LEVELS, "moved": MOVED, "max_states": MAX_STATES,
+                              "steps": list(SPATIAL_STEPS), "step_cells": STEP_CELLS, "version": 1}
     key = _cache.cache_key(parts)
     robot_name = f"{name}:{model.name}"
     status = "off"
@@ -240,13 +264,13 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
     def build() -> dict[str, np.ndarray]:
         if progress:
             print(f"compiling {robot_name} ...", file=sys.stderr, flush=True)
-        return _compile(_scene(path, tool, mount, yaw, cell_size, layout), model, tip_down, step, progress)
+        return _compile(_scene(path, tool, mount, yaw, cell_size, layout), model, tip_down, step, progress, spatial)
 
     if not cache:
         arrays = build()
     else:
         _check_cache_dir()
-        check = _arrays_check(layout)
+        check = _arrays_check(layout, _levels(spatial))
         loaded, status = _cache.load(robot_name, key, check)
         if loaded is not None:
             arrays = loaded
@@ -263,7 +287,13 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
     if "joint_step" in arrays:
         step = float(arrays["joint_step"])
     label = arrays["label"]
-    reach = float(len(np.unique(label)) / layout.free.sum())
+    levels = int(arrays["levels"]) if "levels" in arrays else 0
+    if levels:
+        from armtransfer.ik.voxels import workspace_voxels
+
+        reach = float(len(np.unique(label)) / workspace_voxels(layout, cell_size).free.sum())
+    else:
+        reach = float(len(np.unique(label)) / layout.free.sum())
     chain, held = _chain_of(arrays)
     clearance = float(arrays.get("clearance", 0.0))
     clearance_geom = str(arrays.get("clearance_geom", ""))
@@ -273,14 +303,17 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
         mount=mount, yaw=yaw, xml_path=str(path), tool=tool,
         joint_step=step if model.kind == "joint" else None, layout=layout,
         lattice=arrays.get("lattice"), mount_source=source, chain=chain, held=held,
-        clearance=clearance, clearance_geom=clearance_geom,
+        clearance=clearance, clearance_geom=clearance_geom, levels=levels,
+        moved=tuple(int(j) for j in arrays["moved"]) if "moved" in arrays else (),
     )
+    names = (tuple(f"q{j + 1}{sign}" for j in description.moved for sign in ("+", "-")) if levels
+             else model.action_names(dof))
     return DiscreteRobot(
         name=robot_name,
         next_state=arrays["next_state"],
         wind_state=arrays["wind_state"],
         label=label,
-        action_names=model.action_names(dof),
+        action_names=names,
         cell_step=model.cells,
         canonical=arrays["canonical"],
         layout=layout,
@@ -288,9 +321,25 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
     )
 
 
-def _arrays_check(layout: Layout):
-    """Whether a cache entry's arrays make a robot on ``layout``: every array there with
-    its shape, states and cells in range, positions finite."""
+def _is_planar_file(path, tool: Tool, mount, yaw: float, cell: float, layout: Layout, kind: str) -> bool:
+    """Whether the arm moves its tool in a plane (all joint axes vertical): a built-in arm's
+    kind says; a bring-your-own arm's scene is built to see."""
+    if kind != "custom":
+        return kind == "planar"
+    return bool(_scene(path, tool, mount, yaw, cell, layout).planar)
+
+
+def _levels(spatial: bool) -> int:
+    from armtransfer.ik.voxels import LEVELS
+
+    return LEVELS if spatial else 0
+
+
+def _arrays_check(layout: Layout, levels: int = 0):
+    """Whether a cache entry's arrays make a robot on ``layout`` (its voxels at ``levels``
+    levels when not 0): every array there with its shape, states and cells in range,
+    positions finite."""
+    n_labels = layout.n_cells * max(levels, 1)
     def check(arrays: dict[str, np.ndarray]) -> bool:
         nxt, wind, label, qpos, tip = (arrays[k] for k in ("next_state", "wind_state", "label", "qpos", "tip"))
         canonical = arrays["canonical"]
@@ -298,9 +347,11 @@ def _arrays_check(layout: Layout):
         ints = all(np.issubdtype(a.dtype, np.integer) for a in (nxt, wind, label, canonical))
         return (ints and n > 0 and nxt.ndim == 2 and nxt.shape[0] == n and nxt.shape[1] > 0
                 and wind.shape == (n,) and label.shape == (n,) and qpos.ndim == 2 and qpos.shape[0] == n
-                and tip.shape == (n, 3) and canonical.shape == (layout.n_cells,)
+                and tip.shape == (n, 3) and canonical.shape == (n_labels,)
+                and (not levels or ("moved" in arrays and int(arrays.get("levels", 0)) == levels
+                                    and arrays["moved"].shape == (nxt.shape[1] // 2,)))
                 and bool(np.all((nxt >= 0) & (nxt < n))) and bool(np.all((wind >= 0) & (wind < n)))
-                and bool(np.all((label >= 0) & (label < layout.n_cells)))
+                and bool(np.all((label >= 0) & (label < n_labels)))
                 and bool(np.all((canonical >= -1) & (canonical < n)))
                 and bool(np.all(np.isfinite(qpos))) and bool(np.all(np.isfinite(tip))))
 
@@ -614,7 +665,7 @@ def walls_cause(robot: DiscreteRobot) -> str:
         return ""
     scene = _scene(arm.xml_path, arm.tool, arm.mount, arm.yaw, arm.cell_size, arm.layout)
     reached = np.zeros(arm.layout.n_cells, dtype=bool)
-    reached[np.unique(robot.label)] = True
+    reached[np.unique(robot.label % arm.layout.n_cells)] = True  # a voxel label: the cell under it
     return _walls.wall_cause(scene, not scene.planar, reached)
 
 
@@ -624,10 +675,14 @@ def _scene(path, tool: Tool, mount, yaw, cell, layout):
     return build_scene(Path(path), tool, mount, yaw, cell, layout=layout)
 
 
-def _compile(scene, model, tip_down, step, progress) -> dict:
+def _compile(scene, model, tip_down, step, progress, spatial: bool = False) -> dict:
     from armtransfer.ik.compile import compile_cartesian, compile_joint
 
-    if model.kind == "joint":
+    if spatial:
+        from armtransfer.ik.voxels import compile_spatial_joint
+
+        arrays = compile_spatial_joint(scene, step, progress)
+    elif model.kind == "joint":
         arrays = compile_joint(scene, step, progress)
     else:
         arrays = compile_cartesian(scene, (not scene.planar) if tip_down is None else tip_down, model.cells,
@@ -639,5 +694,5 @@ def _compile(scene, model, tip_down, step, progress) -> dict:
     return arrays
 
 
-__all__ = ["walls_cause", "arm_robot", "arm_scene", "automatic_mount", "make_tool", "compile_order", "mount_search", "parse_robot_spec", "robot", "robot_specs",
+__all__ = ["is_spatial_joint", "spatial_joint_specs", "walls_cause", "arm_robot", "arm_scene", "automatic_mount", "make_tool", "compile_order", "mount_search", "parse_robot_spec", "robot", "robot_specs",
            "tasks_solvable"]

@@ -86,6 +86,10 @@ class DiscreteRobot:
         states = self.states_at(cell)
         if len(states) == 0:
             where = self.layout.xy(cell) if 0 <= cell < self.layout.n_cells else cell
+            if self.canonical is not None and len(self.canonical) > self.layout.n_cells:  # voxels: a 3D robot
+                raise InvalidCellError(f"robot {self.name} cannot reach the {what} cell {where} with its tool at the "
+                                       "table level (level 0 of the 3D workspace); give a finer joint step "
+                                       "(joint_step=) or another cell")
             raise InvalidCellError(f"robot {self.name} cannot reach the {what} cell {where}")
         return int(states[0])
 

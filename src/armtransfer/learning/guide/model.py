@@ -88,7 +88,7 @@ def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW,
     if fill is not None and not (np.isfinite(fill) and fill >= 0):
         raise InvalidParameterError(f"fill must be a non-negative number of cells, got {fill}")
     layout = robot.layout
-    lxy = layout.xy_of(robot.label).astype(np.float64).reshape(-1, 2)
+    lxy = layout.xy_of(robot.label % layout.n_cells).astype(np.float64).reshape(-1, 2)  # voxels: their cells
     if robot.arm is not None:
         feat = np.asarray(robot.arm.qpos, dtype=np.float64).reshape(robot.n_states, -1)
     else:
@@ -96,7 +96,7 @@ def build(robot: DiscreteRobot, trajs: list[Trajectory], window: float = WINDOW,
     xs, ys, rem, starts = [], [], [], [0]
     for t in trajs:
         cells = [*t.cells, t.goal]  # s_t0 .. s_tn and the goal s_tg
-        c = np.array([layout.xy(int(cell)) for cell in cells], dtype=np.float64).reshape(-1, 2)
+        c = np.array([layout.xy(int(cell) % layout.n_cells) for cell in cells], dtype=np.float64).reshape(-1, 2)
         seg = np.sqrt(((c[1:] - c[:-1]) ** 2).sum(axis=1))
         r = np.concatenate([np.cumsum(seg[::-1])[::-1], [0.0]]) if len(seg) else np.zeros(1)
         xs.append(c[:, 0])
