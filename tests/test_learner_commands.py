@@ -229,7 +229,7 @@ def cli(site: Path, cwd: Path, *args: str) -> subprocess.CompletedProcess:
                           text=True, timeout=300)
 
 
-def test_sweep_and_matrix_run_an_installed_learner_beside_its_none(tmp_path):
+def test_a_sweep_runs_an_installed_learner_beside_its_none(tmp_path):
     site = install(tmp_path / "site")
     (tmp_path / "s.toml").write_text(SWEEP + 'learner = "tiny-q"\nmax_total_steps = 2000\n')
     done = cli(site, tmp_path, "sweep", "s.toml", "--out", "store", "--workers", "1")
@@ -239,6 +239,10 @@ def test_sweep_and_matrix_run_an_installed_learner_beside_its_none(tmp_path):
     assert all(len(r["result"]["exploration_steps"]) == 2 for r in runs)
     summary = cli(site, tmp_path, "summarize", "store")
     assert "| pseudo@tiny-q " in summary.stdout and "| none@tiny-q " in summary.stdout, summary.stderr
+
+
+def test_the_matrix_runs_an_installed_learner_beside_its_none(tmp_path):
+    site = install(tmp_path / "site")
     done = cli(site, tmp_path, "matrix", "--robots", "coarse,fine", "--world", "rooms11", "--tasks", "1", "--methods",
                "pseudo", "--trials", "2", "--trajectory", "optimal", "--learner", "tiny-q", "--max-total-steps",
                "2000", "--out", "m", "--workers", "1")
