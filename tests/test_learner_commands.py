@@ -141,6 +141,8 @@ def test_a_learner_typo_a_method_it_cannot_run_and_a_learner_that_raises_are_one
     err = one_line_error(capsys, main([*base, "--learner", "tiny-q", "--method", "none", "plan"]))
     assert ("learner 'tiny-q' (registered at run time) cannot run method 'plan': an outside learner runs none and "
             "the reward-term methods; valid methods: none, pseudo,") in err
+    err = one_line_error(capsys, main([*base, "--learner", "tiny-q", "--method", "none", "pseudo", "--K", "10"]))
+    assert "K=10 can be farmed on this task" in err  # checked as for the kernel
     err = one_line_error(capsys, main([*base, "--learner", "broken-q", "--method", "none", "pseudo"]))
     assert "learner 'broken-q' (registered at run time), on robot fine: its learn raised RuntimeError: the table " \
            "is on fire" in err

@@ -269,8 +269,15 @@ def _transfer_outside(learner, src: DiscreteRobot, tgt: DiscreteRobot, the_task:
     learner_trial.probe(learner, tgt, start, goal)  # a learner that raises: one line, before anything is learned
     shaped = any(registry.get(m).shaped and registry.get(m).uses_trajectory for m in method_names)
     trajs = resolve_trajectories(specs, src, the_task, config, seed) if shaped else []
+    start_cell, goal_cell = the_task.cells()
+    verified: dict[str, float] = {}
+    for m in method_names:  # a K that can be farmed is refused in one line, and 'auto' verified, as for the kernel
+        made = experiment.method_shaping(m, tgt, tgt.start_state(start_cell), goal_cell, trajs, K, config, wind,
+                                         potentials.DENSE_BETA if beta is None else beta)
+        if made is not None:
+            verified[m] = made.K
     runs = learner_transfer.run_all(learner, src, tgt, start, goal, method_names, trajs, trials, seed, config,
-                                    wind=wind, K=K, beta=beta, tick=progress)
+                                    wind=wind, K=verified, beta=beta, tick=progress)
     by_method = {r.method: r for r in runs if r.control is None}
     by_control: dict[str, dict] = {}
     for r in runs:
