@@ -135,3 +135,18 @@ def test_benchmark_runs_its_method_and_its_learner(site, tmp_path):
     done = cli(site, tmp_path, "benchmark", "--suite", "fast", "--method", NAME, "--learner", f"sarsa,{LEARNER}",
                "--out", "bench")  # every run is in: resumes to nothing
     assert "0 to run" in done.stdout
+
+
+@pytest.mark.slow  # pip-installs the plugin (module fixture), then learns on rooms11: 10-60 s
+def test_rooms_and_arms_run_the_installed_learner_and_list_it(site, tmp_path):
+    for command in ("rooms", "arms"):
+        help_text = " ".join(cli(site, tmp_path, command, "--help").stdout.split())
+        assert f"{LEARNER}: example plugin: one-step Q-learning" in help_text
+    small = ["--world", "rooms11", "--learner", LEARNER, "--method", "none", "pseudo", "--trials", "2",
+             "--max-total-steps", "4000", "--trajectory", "optimal"]
+    done = cli(site, tmp_path, "rooms", *small, "--json", "r.json")
+    assert f"learner {LEARNER}" in done.stdout and "| pseudo | none " in done.stdout
+    data = json.loads((tmp_path / "r.json").read_text())
+    assert data["learner"] == LEARNER and list(data["results"]) == ["none", "pseudo"]
+    cli(site, tmp_path, "arms", "--source", "coarse", "--target", "fine", *small, "--no-video", "--out", "arms")
+    assert json.loads((tmp_path / "arms" / "results.json").read_text())["learner"] == LEARNER

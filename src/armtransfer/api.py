@@ -74,6 +74,7 @@ def transfer(
     world: str | Path | Layout | None = None,
     preset: str = "default",
     noise: float = 0.0,
+    learner: str = "sarsa",
     **learner_options,
 ) -> TransferResult | ContinuousResult:
     """Transfer a trajectory from ``source`` to ``target`` and learn with each method.
@@ -101,6 +102,16 @@ def transfer(
     paid on labels alone (``learning.cells.CELL_METHODS``), no controls or mapping are run, and
     the result is an ``experiments.continuous.ContinuousResult``. ``noise`` (continuous only) is
     the arm's actuation noise sigma (``ik.continuous``: each move turns delta * (1 + eps)).
+
+    ``learner`` is who learns on the target: ``sarsa`` (the default), the compiled SARSA(lambda)
+    kernel, or a learner of ``armtransfer.LEARNERS`` from outside the package (an installed
+    plugin's, or one given to ``armtransfer.register_learner``). An outside learner runs each
+    method through the benchmark's harness (``experiments.learner_transfer``) on the same case
+    and seeds, ``none`` (run by it too) its baseline, within ``max_total_steps`` steps a trial;
+    it runs ``none`` and the reward-term methods (another is refused in one line listing them)
+    and no controls (a control trajectory ends elsewhere than the task's goal, which the harness's
+    reward term refuses), and is made, learns a few steps and predicts once before anything else is learned, so a
+    learner that raises is refused in one line naming it.
     """
     if not isinstance(state, str) or state not in STATES:
         raise InvalidParameterError(f"unknown state {state!r}; valid states: {', '.join(STATES)}")
@@ -108,6 +119,14 @@ def transfer(
     method_names = [registry.get(m).name for m in _as_sequence(methods, "methods")]
     if not method_names:
         raise InvalidParameterError(f"give at least one method; valid methods: {', '.join(registry.METHODS)}")
+    outside = _outside_learner(learner)
+    if outside is not None:
+        from armtransfer.experiments.learner_trial import refuse_methods
+
+        if state != "discrete":
+            raise InvalidParameterError(f"learner {outside.name!r} learns on a discrete target; valid learners for a "
+                                        "continuous one: sarsa")
+        refuse_methods(outside, method_names)
     if state == "continuous":  # the methods asked for, before their baselines join them
         from armtransfer.learning.cells import check_method
 
@@ -171,6 +190,9 @@ def transfer(
                 f"robot {robot.name} cannot reach the goal {the_task.goal} from {the_task.start}", robot))
         paths[robot.name] = found
     path = paths[tgt.name]
+    if outside is not None:
+        return _transfer_outside(outside, src, tgt, the_task, method_names, specs, trials, seed, wind, K, beta,
+                                 config, controls, progress, len(path) - 1)
 
     mapping_obj, mapping_path = None, None
     if uses_mapping:
@@ -223,6 +245,47 @@ def transfer(
         trials=trials, wind=wind, config=config, methods=by_method, controls=by_control,
         mapping=info, learned_mapping=learned,
     )
+
+
+def _outside_learner(learner: object):
+    """The outside learner ``learner`` names (None: the built-in ``sarsa``); an unknown name is
+    one line listing the learners."""
+    from armtransfer.learning import learners
+
+    if not isinstance(learner, str):
+        raise InvalidParameterError(f"learner is a learner's name; valid learners: {', '.join(learners.LEARNERS)}")
+    found = learners.get(learner)
+    return None if found.name == learners.SARSA else found
+
+
+def _transfer_outside(learner, src: DiscreteRobot, tgt: DiscreteRobot, the_task: Task, method_names: list[str],
+                      specs, trials: int, seed: int, wind: float, K, beta, config: LearnerConfig, controls: bool,
+                      progress, distance: int) -> TransferResult:
+    """``transfer`` by an outside learner (see its docstring): probed first, then every method
+    through the harness; no controls (``controls`` is not read)."""
+    from armtransfer.experiments import learner_trial, learner_transfer
+
+    start, goal = list(the_task.start), list(the_task.goal)
+    learner_trial.probe(learner, tgt, start, goal)  # a learner that raises: one line, before anything is learned
+    shaped = any(registry.get(m).shaped and registry.get(m).uses_trajectory for m in method_names)
+    trajs = resolve_trajectories(specs, src, the_task, config, seed) if shaped else []
+    start_cell, goal_cell = the_task.cells()
+    verified: dict[str, float] = {}
+    for m in method_names:  # a K that can be farmed is refused in one line, and 'auto' verified, as for the kernel
+        made = experiment.method_shaping(m, tgt, tgt.start_state(start_cell), goal_cell, trajs, K, config, wind,
+                                         potentials.DENSE_BETA if beta is None else beta)
+        if made is not None:
+            verified[m] = made.K
+    runs = learner_transfer.run_all(learner, src, tgt, start, goal, method_names, trajs, trials, seed, config,
+                                    wind=wind, K=verified, beta=beta, tick=progress)
+    by_method = {r.method: r for r in runs if r.control is None}
+    by_control: dict[str, dict] = {}
+    for r in runs:
+        if r.control is not None:
+            by_control.setdefault(r.control, {})[r.method] = r
+    return TransferResult(task=the_task, source=src, target=tgt, distance=distance, trajectories=trajs, seed=seed,
+                          trials=trials, wind=wind, config=config, methods=by_method, controls=by_control,
+                          learner=learner.name)
 
 
 def _cell_methods() -> tuple[str, ...]:

@@ -102,6 +102,7 @@ def _check_fast(args: argparse.Namespace) -> None:
 
 def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
+    common.check_learner(args)
     _check_fast(args)
     out = Path(args.out) if args.out else Path("runs") / _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
     check_distinct_outputs({"--json": args.json, "--render": args.render, "--mapping": args.mapping},
@@ -182,7 +183,7 @@ def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target
         kwargs["trajectory"] = ["learned"]
     elif not args.trajectory:
         kwargs["trajectory"] = ["optimal"]
-    total = experiment.count_trials(args.method, kwargs["trials"], kwargs["controls"])
+    total = experiment.count_trials(args.method, kwargs["trials"], kwargs["controls"] and "learner" not in kwargs)
     with common.progress_bar(total, "learning") as bar:
         result = api.transfer(source, target, progress=bar.update, **kwargs)
     out_json = result.to_json()
@@ -303,5 +304,6 @@ def _table_md(out_json: dict) -> str:
         + f"{t['name']}: {tuple(t['start'])} -> {tuple(t['goal'])}; target's optimal distance "
         f"{out_json['distance']}; {out_json['trials']} trials, seed {out_json['seed']}"
         + (f", wind {out_json['wind']}" if out_json["wind"] else "")
+        + (f", learner {out_json['learner']}" if out_json.get("learner") else "")
         + "\n\n" + results_table(out_json) + "\n"
     )

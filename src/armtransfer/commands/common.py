@@ -122,6 +122,32 @@ def add_learning_arguments(p: argparse.ArgumentParser, trials: int = 10) -> None
                    help="pseudo reward scale; 'auto' = the method's default (pseudo: half the farming "
                         "bound -step_reward/n)")
     add_config_arguments(p)
+    add_learner_argument(p)
+
+
+def add_learner_argument(p: argparse.ArgumentParser, several: bool = False) -> None:
+    """--learner: who learns on the target, the built-in sarsa or a learner of
+    ``armtransfer.LEARNERS`` (its installed plugins read now, so that --help lists them)."""
+    from armtransfer.learning.learners import LEARNERS, SARSA
+
+    learned = "; ".join(f"{name}: {lr.description}" for name, lr in LEARNERS.items())
+    p.add_argument("--learner", default=SARSA, metavar="NAME[,NAME...]" if several else "NAME",
+                   help=("the learners, comma-separated, each running every method beside the none it runs"
+                         if several else "the learner of the target, each method beside the none it runs")
+                        + " (an outside learner runs none and the reward-term methods through the benchmark's "
+                        "harness, within --max-total-steps steps a trial: give it a budget; no controls; docs/extending.md); "
+                        f"default {SARSA}. Learners: {learned}")
+
+
+def check_learner(args: argparse.Namespace, flag: str = "--method") -> None:
+    """--learner checked before anything is built: a known learner (a typo lists them) that
+    runs every method of ``flag`` (else one line listing the methods it runs)."""
+    from armtransfer.experiments.learner_trial import refuse_methods
+    from armtransfer.learning.learners import SARSA, get
+
+    learner = get(args.learner)
+    if learner.name != SARSA:
+        refuse_methods(learner, getattr(args, flag.lstrip("-")))
 
 
 def add_preset_argument(p: argparse.ArgumentParser) -> None:
@@ -202,7 +228,7 @@ def transfer_kwargs(args: argparse.Namespace) -> dict:
         world=world, task=args.task, start=start, goal=goal, methods=args.method, trials=args.trials, seed=args.seed,
         wind=args.wind, K=args.K, beta=args.beta, trajectory=args.trajectory, controls=not args.no_controls,
         mapping=args.mapping, save_mapping=args.mapping is not None, max_span=args.max_span,
-        **config_options(args),
+        **({} if args.learner == "sarsa" else {"learner": args.learner}), **config_options(args),
     )
 
 

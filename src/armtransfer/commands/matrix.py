@@ -88,6 +88,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="each source's learned path (default) or its shortest path")
     p.add_argument("--out", required=True, help="result store directory (re-running resumes)")
     common.add_preset_argument(p)
+    common.add_learner_argument(p, several=True)
+    p.add_argument("--max-total-steps", type=common.positive_int, default=None,
+                   help="steps per trial at most (default: the preset's, 20,000,000); an outside learner's budget")
     common.add_arm_file_arguments(p)
     add_executor_arguments(p)
 
@@ -99,11 +102,19 @@ def run(args: argparse.Namespace) -> int:
     for m in args.methods:
         methods.get(m)
     common.refuse_unused_method_options(args, "--methods")
+    from armtransfer.experiments.learner_trial import refuse_methods
+    from armtransfer.learning.learners import SARSA, get, parse
+
+    learners = parse(args.learner)  # a typo lists the valid names
+    for name in learners:
+        if name != SARSA:
+            refuse_methods(get(name), methods.with_baselines(["none", *args.methods]))
     layout = common.world_of(args)
     tasks = world_tasks(args.tasks, layout)
     robots, arms = arm_file_robots(args)
     sweep = matrix.matrix_sweep(robots, tasks, args.methods, args.trials, args.seeds, args.trajectory,
-                                arms=arms, world=args.world, preset=args.preset)
+                                arms=arms, world=args.world, preset=args.preset, learners=learners,
+                                max_total_steps=args.max_total_steps)
     code = run_sweep(sweep, args)
     text = write_summary(ResultStore.open_existing(args.out), Path(args.out))
     print(text)
@@ -147,7 +158,8 @@ def write_summary(store: ResultStore, out: Path) -> str:
     expected = len(store_runs(spec))
     header = (f"# Matrix {spec['name']!r}\n\n{len(records)} of {expected} runs finished; tasks "
               f"{', '.join(map(str, spec['tasks']))}; {spec['trials']} trials per run and seed; seeds "
-              f"{', '.join(map(str, spec['seeds']))}; {spec['trajectory']} trajectories.\n\n")
+              f"{', '.join(map(str, spec['seeds']))}; {spec['trajectory']} trajectories"
+              + (f"; learners {', '.join(spec['learner'])}" if "learner" in spec else "") + ".\n\n")
     write_json_atomic(out / "matrix.json", {
         "robots": robots, "families": {r: matrix.family(r) for r in robots}, "runs": len(records),
         "expected_runs": expected,

@@ -25,10 +25,11 @@ def add_arguments(p: argparse.ArgumentParser, source: str = "coarse", target: st
 
 
 def run(args: argparse.Namespace) -> int:
+    common.check_learner(args)
     check_distinct_outputs({"--json": args.json, "--mapping": args.mapping})
     if args.json:
         check_writable(args.json)
-    total = experiment.count_trials(args.method, args.trials, not args.no_controls)
+    total = experiment.count_trials(args.method, args.trials, not args.no_controls and args.learner == "sarsa")
     with common.progress_bar(total, "learning") as bar:
         result = api.transfer(args.source, args.target, progress=bar.update, **common.transfer_kwargs(args))
     out = result.to_json()

@@ -75,6 +75,8 @@ def check_runs(runs: list[dict]) -> dict:
     from armtransfer.learning.methods import probe_on, refuse_run_time
 
     refuse_run_time((run["method"] for run in runs), "a sweep's runs")
+    outside = list(dict.fromkeys(run["learner"] for run in runs if "learner" in run))
+    refuse_run_time_learners(outside)
     arms = {name: arm for run in runs for name, arm in run.get("arms", {}).items()}
     layout = sweeps.sweep_world(runs[0])  # one world a sweep
     robots = {spec: resolve(spec, arms=arms, layout=layout) for spec in robot_specs(runs)}
@@ -91,7 +93,38 @@ def check_runs(runs: list[dict]) -> dict:
             robots[spec].start_state(goal, what="goal")
     _check_farming_bounds(runs, robots)
     probe_on((run["method"] for run in runs), [robots[s] for s in dict.fromkeys(run["target"] for run in runs)])
+    probe_learners(outside, runs, robots)
     return robots
+
+
+def refuse_run_time_learners(names: list[str]) -> None:
+    """A learner registered in this process only (``register_learner``) cannot run in the
+    sweep's worker processes, which import the package afresh: one line, before anything is
+    written."""
+    from armtransfer.errors import PluginError
+    from armtransfer.learning.learners import GROUP, RUN_TIME, get
+
+    for name in names:
+        if get(name).origin == RUN_TIME:
+            raise PluginError(f"learner {name!r} was registered in this process (register_learner) and a sweep's "
+                              "runs run in other processes, which cannot see it; install it as a package declaring "
+                              f"it under the entry-point group {GROUP} (docs/extending.md), or run it with "
+                              "armtransfer.transfer(..., learner=...)")
+
+
+def probe_learners(names: list[str], runs: list[dict], robots: dict) -> None:
+    """Every outside learner made, learning a few steps and predicting on each target robot's
+    first task (``learner_trial.probe``): a learner's fault is one line now, before the store
+    is opened."""
+    from armtransfer.experiments import learner_trial
+    from armtransfer.learning.learners import get
+
+    for name in names:
+        seen: set[str] = set()
+        for run in runs:
+            if run.get("learner") == name and run["target"] not in seen:
+                seen.add(run["target"])
+                learner_trial.probe(get(name), robots[run["target"]], list(run["start"]), list(run["goal"]))
 
 
 def _check_farming_bounds(runs: list[dict], robots: dict) -> None:

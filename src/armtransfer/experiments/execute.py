@@ -40,11 +40,22 @@ def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
     config = learner_config(run)
     traj = None
     if methods.get(run["method"]).shaped and methods.get(run["method"]).uses_trajectory:
-        traj = experiment.source_trajectory(run["trajectory"], source, start, goal, config, run["seed"])
-    res = experiment.run_method(
-        run["method"], target, start, goal, traj, run["trials"], run["seed"], config,
-        wind=run["wind"], K=run["K"],
-    )
+        # robot 1 learns with its own step cap, whatever max_total_steps caps robot 2's trials at (as the
+        # benchmark's source runs); a run without max_total_steps has one config for both, as before
+        own = learner_config({k: v for k, v in run.items() if k != "max_total_steps"})
+        traj = experiment.source_trajectory(run["trajectory"], source, start, goal, own, run["seed"])
+    if run.get("learner", "sarsa") != "sarsa":  # an outside learner, through the benchmark's harness
+        from armtransfer.experiments import learner_transfer
+        from armtransfer.learning.learners import get
+
+        res = learner_transfer.run_method(get(run["learner"]), run["method"], target, list(run["start"]),
+                                          list(run["goal"]), None if traj is None else [traj], run["trials"],
+                                          run["seed"], config, wind=run["wind"], K=run["K"])
+    else:
+        res = experiment.run_method(
+            run["method"], target, start, goal, traj, run["trials"], run["seed"], config,
+            wind=run["wind"], K=run["K"],
+        )
     result = {
         "exploration_steps": res.column("exploration_steps"),
         "total_steps": res.column("total_steps"),

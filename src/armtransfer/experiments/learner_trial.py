@@ -150,9 +150,10 @@ def case_env(target: DiscreteRobot, start: list[int], goal: list[int], wind: flo
 
 
 def training_env(target: DiscreteRobot, run: dict, config: LearnerConfig,
-                 trajectory: Trajectory | None) -> tuple[gym.Env, TransferReward | None]:
+                 trajectory: Trajectory | list[Trajectory] | None) -> tuple[gym.Env, TransferReward | None]:
     """The case's training environment: the time limit of the registered ids, and the method's
-    reward term when it has one."""
+    reward term when it has one (its ``K`` and ``beta`` the run's, when it names them: a
+    benchmark run names neither and has 'auto' and the method's default)."""
     env: gym.Env = gym.wrappers.TimeLimit(case_env(target, run["start"], run["goal"], run["wind"], config),
                                           max_episode_steps=MAX_EPISODE_STEPS)
     if run["method"] == "none":
@@ -161,7 +162,8 @@ def training_env(target: DiscreteRobot, run: dict, config: LearnerConfig,
         raise ArmTransferError(f"method {run['method']!r} changes how the kernel chooses actions; an outside learner "
                                f"runs only none and the reward-term methods ({', '.join(methods.REWARD_ONLY)})")
     assert trajectory is not None
-    wrapped = TransferReward(env, trajectory, method=run["method"], K="auto", gamma=config.gamma)
+    wrapped = TransferReward(env, trajectory, method=run["method"], K=run.get("K", "auto"), gamma=config.gamma,
+                             beta=run.get("beta"))
     return wrapped, wrapped
 
 
@@ -190,6 +192,13 @@ def greedy_episode(model: Any, env: RobotRoomsEnv, cap: int, said: str) -> int |
 def run_trial(learner: Learner, run: dict, target: DiscreteRobot, trajectory: Trajectory | None) -> dict:
     """One trial run of ``learner``: the fields of ``benchmark_runs.trial_problem`` (and the
     greedy evaluations, as ``[training steps, greedy steps or None]``)."""
+    return trial(learner, run, target, trajectory)[0]
+
+
+def trial(learner: Learner, run: dict, target: DiscreteRobot,
+          trajectory: Trajectory | list[Trajectory] | None) -> tuple[dict, list[int]]:
+    """:func:`run_trial`'s result and the monitored stream of every training episode's steps
+    (an unfinished one negative, as the kernel's ``episode_steps``)."""
     said = where(learner)
     config = LearnerConfig(**run["config"])
     budget = int(config.max_total_steps)
@@ -227,7 +236,7 @@ def run_trial(learner: Learner, run: dict, target: DiscreteRobot, trajectory: Tr
     return {"error": None, "first_exposure": first, "converged": converged,
             "convergence_steps": converged_at if converged else None, "greedy_steps": greedy if converged else None,
             "episodes": len(stream), "area": float(curve.sum()), "curve": [float(v) for v in curve],
-            "K": None if term is None else float(term.K), "evaluations": evals}
+            "K": None if term is None else float(term.K), "evaluations": evals}, stream
 
 
 def probe(learner: Learner, target: DiscreteRobot, start: list[int], goal: list[int]) -> None:
@@ -244,6 +253,19 @@ def probe(learner: Learner, target: DiscreteRobot, start: list[int], goal: list[
         raise PluginError(f"{said}: its make returned {type(model).__name__}, not a model with learn and predict")
     _call(said, "learn", model.learn, PROBE_STEPS)
     greedy_episode(model, case_env(target, start, goal, 0.0, config), 4, said)
+
+
+def refuse_methods(learner: Learner, names: list[str] | tuple[str, ...]) -> None:
+    """A method ``learner`` cannot run (one that changes how the kernel chooses actions, or
+    the action sequence mapping, whose macros are the kernel's) is a one-line error naming the
+    learner and listing the methods it runs."""
+    from armtransfer.errors import InvalidParameterError
+
+    can = [n for n in reward_methods(list(methods.METHODS)) if not methods.get(n).macros]
+    for name in names:
+        if name not in can:
+            raise InvalidParameterError(f"{where(learner)} cannot run method {name!r}: an outside learner runs none "
+                                        f"and the reward-term methods; valid methods: {', '.join(can)}")
 
 
 def known(name: str) -> Learner:

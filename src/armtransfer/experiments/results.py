@@ -65,6 +65,9 @@ class TransferResult:
     mapping: MappingInfo | None = None
     learned_mapping: ActionMapping | None = None
     """For ``mapping``: the mapping updated from this run's converged trials (not in the JSON)."""
+    learner: str = "sarsa"
+    """Who learned on the target: ``sarsa``, the compiled kernel, or an outside learner
+    (``armtransfer.LEARNERS``; the JSON names it then, and only then)."""
 
     @property
     def start_cell(self) -> int:
@@ -143,6 +146,7 @@ class TransferResult:
             "trials": self.trials,
             "wind": self.wind,
             "config": self.config.to_dict(),
+            **({} if self.learner == "sarsa" else {"learner": self.learner}),  # sarsa's JSON is as it was
             "mapping": None if self.mapping is None else self.mapping.to_json(),
             "results": {m: summary[r.label] for m, r in self.methods.items()},
             "controls": {kind: {m: summary[r.label] for m, r in by.items()} for kind, by in self.controls.items()},

@@ -29,6 +29,14 @@ their own and then used by name in ``pairs``, as ``NAME`` or ``NAME:ACTIONS``::
     tool = "stylus:0.05"                 # optional: a pen held at the tool point
     # base_pos = [0, -0.4, 0]; base_yaw = 1.5708   (default: chosen automatically)
 
+Who learns on the target is ``learner`` (a name or a list, default ``"sarsa"``, the compiled
+kernel): a learner of ``armtransfer.LEARNERS`` from outside the package runs every method of
+the sweep through the benchmark's harness (``experiments.learner_transfer``), ``none`` run by it
+the baseline of its methods; it runs ``none`` and the reward-term methods, within
+``max_total_steps`` steps a trial of robot 2 (a scalar; give an outside learner a budget; robot
+1 learns its trajectory with its own cap, as in the benchmark). Its runs carry
+``learner`` (and ``max_total_steps`` when given); sarsa's runs carry neither and keep their keys.
+
 A sweep runs in one world, ``world = "rooms11"`` (a built-in name, ``generated:SEED[:SIDE]`` or
 a layout file, relative to the sweep file; default the paper's ``rooms``); ``tasks`` are then
 the world's task names. Every run carries the world's content (grid and tasks), so its key
@@ -129,7 +137,7 @@ def size(spec: dict) -> int:
     for key in _AXES:
         if key not in ("tasks", "start_goal"):
             n *= len(spec[key])
-    return n
+    return n * len(learners_of(spec))
 
 
 ARM_KEYS: dict[str, type | tuple[type, ...]] = {"xml": str, "tip_site": str, "tip_body": str, "tip_offset": list, "tool": str,
@@ -208,9 +216,9 @@ def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, ba
                              "[arms.NAME] tables")
     arms = _arms(raw.get("arms", {}), where, base)
     body = raw["sweep"]
-    valid = sorted([*_AXES, *_SCALARS, "world"])
+    valid = sorted([*_AXES, *_SCALARS, *_OPTIONAL])
     for key in body:
-        if key not in _AXES and key not in _SCALARS and key != "world":
+        if key not in _AXES and key not in _SCALARS and key not in _OPTIONAL:
             raise SweepFileError(f"{where}: unknown key {key!r}; valid keys: {', '.join(valid)}")
     spec: dict = {}
     preset = body.get("preset", _presets.DEFAULT)
@@ -273,11 +281,54 @@ def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, ba
         if not spec[key] and key not in ("tasks", "start_goal"):
             raise SweepFileError(f"{w}: {key} is empty; give at least one value")
     spec["arms"] = arms
+    _learners(body, spec, w)
     n = size(spec)
     if n > max_runs:
         raise SweepFileError(f"{w}: the sweep has {n:,} runs, over the limit of {max_runs:,}; "
                              "raise it with --max-runs")
     return spec
+
+
+_OPTIONAL = ("world", "learner", "max_total_steps")
+"""Keys a sweep file may give that its spec holds only when given (or, for ``learner``, when not
+the default): a sweep without them keeps the spec, and its store the key, it had before them."""
+
+SARSA = "sarsa"
+
+
+def _learners(body: dict, spec: dict, where: str) -> None:
+    """``learner`` and ``max_total_steps`` of a sweep file into ``spec``: every learner known
+    (a typo lists them), every method run by every learner (else one line naming the learner
+    and the methods it runs); ``learner`` stays out of the spec when it is sarsa alone."""
+    from armtransfer.learning import learners
+
+    names = _as_list("learner", body.get("learner", SARSA))
+    if not names or len(names) != len(set(map(str, names))):
+        raise SweepFileError(f"{where}: learner " + ("is empty; give at least one" if not names
+                                                     else "lists a value twice"))
+    for name in names:
+        if not isinstance(name, str) or name not in learners.LEARNERS:
+            raise SweepFileError(f"{where}: unknown learner {name!r}; valid learners: {', '.join(learners.LEARNERS)}")
+    outside = [n for n in names if n != SARSA]
+    if outside:
+        from armtransfer.experiments.learner_trial import refuse_methods
+
+        for name in outside:
+            try:
+                refuse_methods(learners.LEARNERS[name], spec["methods"])
+            except ArmTransferError as err:
+                raise SweepFileError(f"{where}: {err}") from None
+    if names != [SARSA]:
+        spec["learner"] = names
+    if "max_total_steps" in body:
+        spec["max_total_steps"] = _check_number(f"{where}: max_total_steps", body["max_total_steps"], 1,
+                                                LearnerConfig.__dataclass_fields__["max_total_steps"].metadata["hi"],
+                                                integer=True)
+
+
+def learners_of(spec: dict) -> list[str]:
+    """The learners of a normalised spec (sarsa when it names none)."""
+    return list(spec.get("learner", [SARSA]))
 
 
 def check_stored(spec: object, where: str) -> dict:
@@ -286,7 +337,7 @@ def check_stored(spec: object, where: str) -> dict:
     form; else ``SweepFileError``, one line naming ``where`` and the field."""
     if not isinstance(spec, dict):
         raise SweepFileError(f"{where}: field 'spec' " + ("is missing" if spec is None else f"must be a table, got {type(spec).__name__}"))
-    optional = {"world", "preset"}  # written only when not the default (the default keeps the old key)
+    optional = {*_OPTIONAL, "preset"}  # written only when not the default (the default keeps the old key)
     keys = {*_SCALARS, *_AXES, "arms"} - optional
     for key in sorted(keys - set(spec)):
         raise SweepFileError(f"{where}: field 'spec' has no {key!r}")
@@ -346,8 +397,8 @@ def expand(spec: dict) -> list[dict]:
         tasks = [{"task": t, "start": list(f.start), "goal": list(f.goal)} for t, f in zip(spec["tasks"], found)]
     tasks += [{"task": None, "start": s, "goal": g} for s, g in spec["start_goal"]]
     runs: dict[str, dict] = {}
-    for task, pair, method, seed, K, eps, lam, alpha, gamma, wind in itertools.product(
-        tasks, spec["pairs"], spec["methods"], spec["seeds"], spec["K"], spec["epsilon"],
+    for learner, task, pair, method, seed, K, eps, lam, alpha, gamma, wind in itertools.product(
+        learners_of(spec), tasks, spec["pairs"], spec["methods"], spec["seeds"], spec["K"], spec["epsilon"],
         spec["lam"], spec["alpha"], spec["gamma"], spec["wind"],
     ):
         run = {
@@ -371,6 +422,10 @@ def expand(spec: dict) -> list[dict]:
         }
         if "preset" in spec:  # its other settings (rewards, caps) come from the preset (execute.learner_config)
             run["preset"] = spec["preset"]
+        if "max_total_steps" in spec:
+            run["max_total_steps"] = spec["max_total_steps"]
+        if learner != SARSA:  # sarsa's runs keep the keys they had before learners
+            run["learner"] = learner
         used = {p.partition(":")[0] for p in pair} & set(spec.get("arms", {}))
         if used:  # a named arm's definition is part of the run (and of its key)
             run["arms"] = {name: spec["arms"][name] for name in sorted(used)}

@@ -187,4 +187,5 @@ def transfer_heading(out: dict) -> str:
     world = f"world {out['world']}, " if out.get("world") else ""
     return (f"{world}{t['name']}: {tuple(t['start'])} -> {tuple(t['goal'])}, {out['source']} -> {out['target']}, "
             f"target's optimal distance {out['distance']}, {out['trials']} trials, seed {out['seed']}"
-            + (f", wind {out['wind']}" if out["wind"] else ""))
+            + (f", wind {out['wind']}" if out["wind"] else "")
+            + (f", learner {out['learner']} (each method beside the none it runs; no controls)" if out.get("learner") else ""))

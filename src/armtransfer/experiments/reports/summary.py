@@ -19,8 +19,16 @@ from armtransfer.experiments.reports.report import (CAP_NOTE, fmt_ci, fmt_improv
 from armtransfer.experiments.sweep import group_key
 
 
+def _at(cfg: dict) -> str:
+    """``@LEARNER`` for a run of an outside learner (the benchmark's labels), else nothing."""
+    learner = cfg.get("learner", "sarsa")
+    return "" if learner == "sarsa" else f"@{learner}"
+
+
 def _method_label(cfg: dict) -> str:
-    return cfg["method"] if cfg["K"] in (None, "auto") else f"{cfg['method']} (K={cfg['K']})"
+    """``pseudo``, ``pseudo (K=0.1)``; ``pseudo@tabular-q`` for an outside learner's run."""
+    method = cfg["method"] + _at(cfg)
+    return method if cfg["K"] in (None, "auto") else f"{method} (K={cfg['K']})"
 
 
 def summarize(records: list[dict]) -> list[dict]:
@@ -38,10 +46,11 @@ def summarize(records: list[dict]) -> list[dict]:
     rows = []
     for gk in sorted(groups, key=repr):
         cols = groups[gk]
-        base = cols.get("none")
         for label in sorted(cols, key=lambda m: (m != "none", m)):
             col = cols[label]
             cfg = col["config"]
+            baseline = "none" + _at(cfg)  # the none its learner ran
+            base = cols.get(baseline)
             cap = int(cfg.get("max_total_steps", LearnerConfig.max_total_steps))
             st = metrics.exploration_stats(col["exploration_steps"], cap)
             row = {
@@ -76,7 +85,7 @@ def summarize(records: list[dict]) -> list[dict]:
                 "improvement_cap_dominated": None,
                 "mean_cap_dominated": st["cap_dominated"],
             }
-            if base is not None and label != "none":
+            if base is not None and label != baseline:
                 imp = _improvement(base, col, cap)
                 row["improvement_percent"] = imp["percent"]
                 row["improvement_ci95"] = imp["ci95"]
@@ -114,7 +123,7 @@ def summary_markdown(rows: list[dict]) -> str:
         _task_name(r), f"{r['source']} -> {r['target']}", f"{r['wind']:g}", f"{r['epsilon']:g}", f"{r['lam']:g}",
         r["method"], f"{r['reached']}/{r['trials']}", f"{fmt_mean(r)} {fmt_ci(r['ci95'])}",
         median_cell(r),
-        "" if r["method"] == "none" else f"{fmt_improvement(r)} {fmt_ci(r['improvement_ci95'])}",
+        "" if r["method"].partition("@")[0] == "none" else f"{fmt_improvement(r)} {fmt_ci(r['improvement_ci95'])}",
         fmt_num(r["greedy_mean"]), f"{r['converged']}/{r['trials']}",
     ] for r in rows]
     table = markdown_table(header, body)

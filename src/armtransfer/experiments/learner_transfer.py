@@ -1,0 +1,87 @@
+"""A transfer run by a learner from outside the package (``armtransfer.transfer(learner=...)``,
+``armtransfer rooms --learner``, ``armtransfer arms --learner``, a sweep's ``learner``).
+
+Each method's trials run through the benchmark's harness (:mod:`learner_trial`) on the case's
+environment, the method's reward term over it, ``none`` with none: trial ``k`` of every method
+starts from the seeds of trial ``k`` of the kernel (``SeedSequence([seed, 0, k])``), so a method
+and its baseline meet the same streams, and the same seed gives the same bytes when the
+learner draws only from the seed it is handed. Each trial becomes a
+:class:`~armtransfer.learning.sarsa.TrialResult` as the kernel's are, so the tables, JSON and
+frames read alike:
+
+- ``exploration_steps``: training steps until the goal was first reached (None: never, within
+  the budget ``max_total_steps``);
+- ``total_steps``: the steps to convergence (the harness's criterion, ``learner_trial``), or
+  the steps trained, the budget, when the trial did not converge;
+- ``greedy_steps``: the converged greedy episode's steps; ``episodes`` and ``episode_steps``:
+  the monitored training episodes (an unfinished one negative). The greedy path itself is not
+  recorded (the harness counts steps, not states): ``greedy_path`` is empty.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from armtransfer.experiments import learner_trial
+from armtransfer.experiments.experiment import MethodResult
+from armtransfer.learning import methods
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.learners import Learner
+from armtransfer.learning.sarsa import TrialResult
+from armtransfer.learning.trajectory import Trajectory
+from armtransfer.tasks.robot import DiscreteRobot
+
+EMPTY = np.zeros(0, dtype=np.int64)
+
+
+def trial_result(result: dict, stream: list[int]) -> TrialResult:
+    """The harness's result of one trial as the kernel's :class:`TrialResult`."""
+    trained = result["evaluations"][-1][0] if result["evaluations"] else 0
+    converged = bool(result["converged"])
+    return TrialResult(exploration_steps=result["first_exposure"], converged=converged,
+                       total_steps=result["convergence_steps"] if converged else int(trained),
+                       greedy_steps=result["greedy_steps"], episodes=int(result["episodes"]),
+                       episode_steps=np.asarray(stream, dtype=np.int64), greedy_lengths=EMPTY, macro_steps=EMPTY)
+
+
+def run_method(learner: Learner, method: str, target: DiscreteRobot, start: list[int], goal: list[int],
+               trajs: Sequence[Trajectory] | None, trials: int, seed: int, config: LearnerConfig,
+               wind: float = 0.0, K: float | str | None = "auto", beta: float | None = None,
+               on_trial: Callable[[], None] | None = None) -> MethodResult:
+    """``trials`` trials of ``method`` by ``learner`` on ``target`` from ``start`` to ``goal``
+    (x, y), one after the other (a Python learner holds the GIL), a shaped method paid for
+    ``trajs``. A learner's fault is a one-line ``PluginError`` naming it."""
+    learner_trial.refuse_methods(learner, [method])
+    shaped = methods.get(method).shaped
+    out = MethodResult(method)
+    ks: list[float | None] = []
+    for trial in range(trials):
+        given = trajs if shaped else None
+        run = {"method": method, "trial": trial, "seed": int(seed), "start": list(start), "goal": list(goal),
+               "wind": float(wind), "config": config.to_dict(), "K": "auto" if K is None else K, "beta": beta}
+        result, stream = learner_trial.trial(learner, run, target, None if given is None else list(given))
+        out.trials.append(trial_result(result, stream))
+        ks.append(result["K"])
+        if on_trial is not None:
+            on_trial()
+    if shaped:
+        out.extra["K"] = ks[0]
+    return out
+
+
+def run_all(learner: Learner, source: DiscreteRobot, target: DiscreteRobot, start: list[int], goal: list[int],
+            method_names: Sequence[str], trajs: Sequence[Trajectory], trials: int, seed: int, config: LearnerConfig,
+            wind: float = 0.0, K: float | str | dict = "auto", beta: float | None = None,
+            tick: Callable[[], None] | None = None) -> list[MethodResult]:
+    """Every method of ``method_names`` by ``learner``, in that order. No controls: a control
+    trajectory (``experiment.control_trajectories``) ends elsewhere than the task's goal, and
+    the harness's reward term (``TransferReward``) pays only a trajectory of the task."""
+    learner_trial.refuse_methods(learner, list(method_names))
+
+    def k_of(name: str) -> float | str:
+        return K.get(name, "auto") if isinstance(K, dict) else K
+
+    return [run_method(learner, m, target, start, goal, trajs, trials, seed, config, wind, k_of(m), beta, tick)
+            for m in method_names]
