@@ -105,7 +105,7 @@ def test_every_registered_method_runs_and_describes_itself():
     for name, m in registry.METHODS.items():
         assert m.name == name and m.description and "\n" not in m.description
         r = armtransfer.transfer(methods=[name], trials=1, seed=0, controls=False, max_episodes=50,
-                                 trajectory="optimal")
+                                 trajectory="optimal", world="rooms15")
         assert len(r.methods[name].trials) == 1
     help_text = subprocess.run([sys.executable, "-m", "armtransfer.cli", "rooms", "--help"],
                                capture_output=True, text=True, timeout=120).stdout

@@ -134,12 +134,12 @@ def test_a_broken_run_file_is_set_aside_and_redone(whole, tmp_path, capsys):
     assert (out / "results.json").read_bytes() == (whole / "results.json").read_bytes()
 
 
-@pytest.mark.parametrize("method", ["none", "pseudo", "guided"])
-def test_a_trial_run_alone_is_that_trial_of_the_whole_method(method):
+@pytest.mark.parametrize("method, episodes", [("none", 40), ("pseudo", 40), ("guided", 6)])
+def test_a_trial_run_alone_is_that_trial_of_the_whole_method(method, episodes):
     coarse, fine = grid_robot("coarse"), grid_robot("fine")
     start, goal = TABLE_I[1].cells()
     traj = experiment.source_trajectory("optimal", coarse, start, goal, LearnerConfig(), 0)
-    config = LearnerConfig(max_episodes=40)
+    config = LearnerConfig(max_episodes=episodes)  # guided plans after every episode: a few suffice
     whole = experiment.run_method(method, fine, start, goal, [traj], 3, 5, config, threads=1)
     for k in range(3):
         alone = experiment.run_method(method, fine, start, goal, [traj], 1, 5, config, threads=1, first_trial=k)
