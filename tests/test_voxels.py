@@ -225,3 +225,40 @@ def test_a_task_cell_out_of_reach_at_the_table_level_names_the_remedy(ur5e_joint
     with pytest.raises(InvalidCellError, match=rf"cannot reach the goal cell \({x}, {y}\) with its tool at the table "
                                                r"level \(level 0 of the 3D workspace\); give a finer joint step"):
         ur5e_joint.start_state(int(missing[0]), what="goal")
+
+
+def test_a_bring_your_own_7_joint_file_compiles_as_custom_joint_and_transfers(tmp_path):
+    """A Menagerie-style iiwa file (7 joints, a flange site, no keyframe, mount chosen by the
+    compiler) is a 3D robot as ``custom:joint``, and planar2:joint's cell path transfers to it
+    on rooms11 via the API with ``none`` and ``pseudo``."""
+    import sys
+    from pathlib import Path
+
+    import armtransfer
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    import menagerie_like as ml
+
+    xml = ml.iiwa_style(tmp_path)
+    tip = ml.SUGGESTED["iiwa"]
+    robot = arm_robot(None, "joint", xml_path=xml, layout=SMALL, **tip)
+    arm = robot.arm
+    assert arm is not None and is_spatial_joint(robot) and arm.dof == 7 and arm.levels == 3
+    assert len(arm.moved) == 3 and robot.n_actions == 6
+    assert robot.action_names == tuple(f"q{j + 1}{s}" for j in arm.moved for s in "+-")
+    vox = workspace_voxels(SMALL, arm_scene(None, xml_path=xml, layout=SMALL, base_pos=arm.mount,
+                                            base_yaw=arm.yaw, **tip).cell)
+    assert vox.free[robot.label].all() and (robot.label >= SMALL.n_cells).any()  # it leaves the table level
+    held = [j for j in range(arm.dof) if j not in arm.moved]
+    assert np.ptp(arm.qpos[:, held], axis=0).max() == 0.0
+
+    r = armtransfer.transfer("planar2:joint", "custom:joint", arm_xml=xml, arm_options=dict(tip),
+                             world="rooms11", task="2", methods=["none", "pseudo"], trials=2, controls=False)
+    assert r.target.name == robot.name == "iiwa14:joint" and np.array_equal(r.target.label, robot.label)
+    traj = r.trajectories[0]
+    assert traj.source == "planar2:joint" and all(0 <= c < SMALL.n_cells for c in traj.cells)
+    assert set(traj.cells) & set(robot.label.tolist())  # the 2D path is voxels the 7-joint arm reaches
+    for m in ("none", "pseudo"):
+        steps = r.methods[m].column("exploration_steps")
+        assert len(steps) == 2 and all(s is not None for s in steps)  # every trial reached the goal
+    assert r.distance == robot.distance(robot.start_state(r.start_cell), r.goal_cell)
