@@ -262,3 +262,23 @@ def test_a_bring_your_own_7_joint_file_compiles_as_custom_joint_and_transfers(tm
         steps = r.methods[m].column("exploration_steps")
         assert len(steps) == 2 and all(s is not None for s in steps)  # every trial reached the goal
     assert r.distance == robot.distance(robot.start_state(r.start_cell), r.goal_cell)
+
+
+def test_arms_list_lists_the_spatial_joint_robots(capsys, monkeypatch, tmp_path):
+    from armtransfer import cli
+
+    monkeypatch.setenv("ARMTRANSFER_CACHE", str(tmp_path / "cache"))
+    assert cli.main(["arms", "list", "--arm", "planar2,ur5e_like,panda_like", "--actions", "joint",
+                     "--world", "rooms11"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    table = out[1:out.index("")]  # the rows, then a blank line and the notes
+    rows = {line.split()[0]: line.split() for line in table}
+    assert list(rows) == ["planar2:joint", "ur5e_like:joint", "panda_like:joint"]
+    assert rows["ur5e_like:joint"][1:3] == ["6", "6"] and rows["panda_like:joint"][1:3] == ["7", "6"]
+    ur5e = arm_robot("ur5e_like", "joint", layout=SMALL)
+    assert rows["ur5e_like:joint"][3] == str(ur5e.n_states) and rows["ur5e_like:joint"][5] == "3/3"
+    notes = [line for line in out if line.endswith("its reach is of the free voxels")]
+    assert notes == ["ur5e_like:joint: joint space over the 3D workspace (3 levels); moves joints 1, 2, 3 and holds "
+                     "the others; its reach is of the free voxels",
+                     "panda_like:joint: joint space over the 3D workspace (3 levels); moves joints 1, 2, 4 and holds "
+                     "the others; its reach is of the free voxels"]
