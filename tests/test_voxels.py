@@ -282,3 +282,59 @@ def test_arms_list_lists_the_spatial_joint_robots(capsys, monkeypatch, tmp_path)
                      "the others; its reach is of the free voxels",
                      "panda_like:joint: joint space over the 3D workspace (3 levels); moves joints 1, 2, 4 and holds "
                      "the others; its reach is of the free voxels"]
+
+
+def test_the_gymnasium_env_with_a_3d_robot_passes_check_env_and_reaches_the_goal():
+    import gymnasium as gym
+    from gymnasium.utils.env_checker import check_env
+
+    import armtransfer  # noqa: F401  (registers the environments)
+
+    env = gym.make("armtransfer/ArmRooms-v0", arm="ur5e_like", actions="joint", world="rooms11", task="2")
+    check_env(env.unwrapped, skip_render_check=True)
+    u = env.unwrapped
+    assert u.robot.name == "ur5e_like:joint" and is_spatial_joint(u.robot) and u.action_space.n == 6
+    obs, info = env.reset(seed=0)
+    assert info["label"] == SMALL.cell(2, 2)  # rooms11 task 2 starts at (2, 2), at the table level
+    terminated = False
+    for _, action in u.robot.shortest_path(obs, u.goal_cell)[:-1]:
+        obs, reward, terminated, truncated, info = env.step(action)
+    assert terminated and info["label"] == u.goal_cell
+    env.close()
+
+
+def test_armtransfer_matrix_runs_with_a_3d_robot(tmp_path, capsys):
+    import json
+
+    from armtransfer.cli import main
+
+    out = tmp_path / "m"
+    assert main(["matrix", "--robots", "planar2:joint,ur5e_like:joint", "--world", "rooms11", "--tasks", "2",
+                 "--methods", "pseudo", "--trials", "1", "--out", str(out), "--workers", "1"]) == 0
+    assert "8 of 8 runs finished" in capsys.readouterr().out
+    cells = json.loads((out / "matrix.json").read_text())["cells"]
+    pairs = {(c["source"], c["target"]) for c in cells}
+    assert ("planar2:joint", "ur5e_like:joint") in pairs and ("ur5e_like:joint", "planar2:joint") in pairs
+    for c in cells:
+        assert c["tasks"] == 1 and c["trials"] == 1 and c["improvement"] is not None
+    assert "| source \\ target | planar2:joint | ur5e_like:joint |" in (out / "matrix.md").read_text()
+
+
+def test_armtransfer_sweep_runs_with_a_3d_robot(tmp_path, capsys):
+    import json
+
+    from armtransfer.cli import main
+
+    sweep = tmp_path / "s.toml"
+    sweep.write_text('[sweep]\nname = "spatial"\nworld = "rooms11"\ntasks = ["2"]\n'
+                     'pairs = [["planar2:joint", "ur5e_like:joint"]]\nmethods = ["none", "pseudo"]\n'
+                     'seeds = [0]\ntrials = 2\n')
+    out = tmp_path / "out"
+    assert main(["sweep", str(sweep), "--out", str(out), "--workers", "1"]) == 0
+    assert "2/2 runs" in capsys.readouterr().out and not any((out / "failed").iterdir())
+    assert main(["summarize", str(out)]) == 0
+    data = json.loads((out / "summary.json").read_text())
+    assert data["runs"] == 2
+    rows = {r["method"]: r for r in data["rows"]}
+    assert set(rows) == {"none", "pseudo"} and all(r["trials"] == 2 for r in rows.values())
+    assert rows["pseudo"]["improvement_percent"] is not None
