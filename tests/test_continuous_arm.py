@@ -11,7 +11,7 @@ from gymnasium.utils.env_checker import check_env
 
 import armtransfer
 from armtransfer.errors import ArmTransferError, InvalidActionError, InvalidParameterError, UnknownArmError
-from armtransfer.ik.continuous import BLOCKED, clearance_cells
+from armtransfer.ik.continuous import BLOCKED, ContinuousArm, clearance_cells
 from armtransfer.ik.labels import cells_of_xy
 from armtransfer.learning import linear, tiles
 from armtransfer.learning import trajectory as trajectories
@@ -202,7 +202,8 @@ def test_api_runs_a_continuous_target_and_refuses_bad_values_in_one_line():
     assert out["state"] == "continuous" and set(out["results"]) == {"none", "pseudo"}
     assert len(out["results"]["pseudo"]["exploration_steps"]) == 2
     bad = [(dict(state="cont"), "valid states: discrete, continuous"),
-           (dict(state="continuous", target="ur5e_like:cartesian"), "valid arms: planar2, planar3, planar4"),
+           (dict(state="continuous", target="ur5e_like:cartesian"), "valid action models: joint"),
+           (dict(state="continuous", target="puma:joint"), "valid arms: planar2, planar3, planar4, ur5e_like"),
            (dict(state="continuous", target="planar3:cartesian"), "valid action models: joint"),
            (dict(state="continuous", methods=["guided"]), "method 'guided' does not apply.*valid methods: none, pseudo"),
            (dict(state="continuous", wind=0.1), "valid wind: 0")]
@@ -214,8 +215,8 @@ def test_api_runs_a_continuous_target_and_refuses_bad_values_in_one_line():
 
 
 def test_continuous_arm_names_the_valid_arms():
-    with pytest.raises(UnknownArmError, match="valid arms: planar2, planar3, planar4, PATH.xml"):
-        continuous_arm("panda_like")
+    with pytest.raises(UnknownArmError, match="valid arms: planar2, planar3, planar4, ur5e_like, panda_like, PATH.xml"):
+        continuous_arm("puma")
 
 
 def test_benchmark_fast_mode_writes_its_report(tmp_path):
@@ -231,13 +232,17 @@ def test_benchmark_fast_mode_writes_its_report(tmp_path):
 
 
 @pytest.mark.slow
-def test_a_generated_planar_arm_is_a_continuous_arm_and_a_spatial_one_is_refused():
+def test_a_generated_arm_is_a_continuous_arm_a_spatial_one_over_the_3d_workspace():
+    from armtransfer.ik.continuous3d import SpatialContinuousArm
+
     arm = continuous_arm("gen:planar:3:1:joint")
     start = TABLE_I[1].cells(arm.layout)[0]
     arm.place(start)
     assert arm.dof == 3 and arm.label == start
+    spatial = continuous_arm("gen:spatial6:6:1")
+    assert isinstance(spatial, SpatialContinuousArm) and spatial.dof == 3 and spatial.levels == 3
     with pytest.raises(ArmTransferError, match="needs a planar arm"):
-        continuous_arm("gen:spatial6:6:1")
+        ContinuousArm(spatial.scene, 0.05)
 
 
 def test_from_its_start_the_arm_reaches_the_goal_in_the_joint_robots_fewest_moves():

@@ -225,3 +225,116 @@ def test_a_task_cell_out_of_reach_at_the_table_level_names_the_remedy(ur5e_joint
     with pytest.raises(InvalidCellError, match=rf"cannot reach the goal cell \({x}, {y}\) with its tool at the table "
                                                r"level \(level 0 of the 3D workspace\); give a finer joint step"):
         ur5e_joint.start_state(int(missing[0]), what="goal")
+
+
+def test_a_bring_your_own_7_joint_file_compiles_as_custom_joint_and_transfers(tmp_path):
+    """A Menagerie-style iiwa file (7 joints, a flange site, no keyframe, mount chosen by the
+    compiler) is a 3D robot as ``custom:joint``, and planar2:joint's cell path transfers to it
+    on rooms11 via the API with ``none`` and ``pseudo``."""
+    import sys
+    from pathlib import Path
+
+    import armtransfer
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    import menagerie_like as ml
+
+    xml = ml.iiwa_style(tmp_path)
+    tip = ml.SUGGESTED["iiwa"]
+    robot = arm_robot(None, "joint", xml_path=xml, layout=SMALL, **tip)
+    arm = robot.arm
+    assert arm is not None and is_spatial_joint(robot) and arm.dof == 7 and arm.levels == 3
+    assert len(arm.moved) == 3 and robot.n_actions == 6
+    assert robot.action_names == tuple(f"q{j + 1}{s}" for j in arm.moved for s in "+-")
+    vox = workspace_voxels(SMALL, arm_scene(None, xml_path=xml, layout=SMALL, base_pos=arm.mount,
+                                            base_yaw=arm.yaw, **tip).cell)
+    assert vox.free[robot.label].all() and (robot.label >= SMALL.n_cells).any()  # it leaves the table level
+    held = [j for j in range(arm.dof) if j not in arm.moved]
+    assert np.ptp(arm.qpos[:, held], axis=0).max() == 0.0
+
+    r = armtransfer.transfer("planar2:joint", "custom:joint", arm_xml=xml, arm_options=dict(tip),
+                             world="rooms11", task="2", methods=["none", "pseudo"], trials=2, controls=False)
+    assert r.target.name == robot.name == "iiwa14:joint" and np.array_equal(r.target.label, robot.label)
+    traj = r.trajectories[0]
+    assert traj.source == "planar2:joint" and all(0 <= c < SMALL.n_cells for c in traj.cells)
+    assert set(traj.cells) & set(robot.label.tolist())  # the 2D path is voxels the 7-joint arm reaches
+    for m in ("none", "pseudo"):
+        steps = r.methods[m].column("exploration_steps")
+        assert len(steps) == 2 and all(s is not None for s in steps)  # every trial reached the goal
+    assert r.distance == robot.distance(robot.start_state(r.start_cell), r.goal_cell)
+
+
+def test_arms_list_lists_the_spatial_joint_robots(capsys, monkeypatch, tmp_path):
+    from armtransfer import cli
+
+    monkeypatch.setenv("ARMTRANSFER_CACHE", str(tmp_path / "cache"))
+    assert cli.main(["arms", "list", "--arm", "planar2,ur5e_like,panda_like", "--actions", "joint",
+                     "--world", "rooms11"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    table = out[1:out.index("")]  # the rows, then a blank line and the notes
+    rows = {line.split()[0]: line.split() for line in table}
+    assert list(rows) == ["planar2:joint", "ur5e_like:joint", "panda_like:joint"]
+    assert rows["ur5e_like:joint"][1:3] == ["6", "6"] and rows["panda_like:joint"][1:3] == ["7", "6"]
+    ur5e = arm_robot("ur5e_like", "joint", layout=SMALL)
+    assert rows["ur5e_like:joint"][3] == str(ur5e.n_states) and rows["ur5e_like:joint"][5] == "3/3"
+    notes = [line for line in out if line.endswith("its reach is of the free voxels")]
+    assert notes == ["ur5e_like:joint: joint space over the 3D workspace (3 levels); moves joints 1, 2, 3 and holds "
+                     "the others; its reach is of the free voxels",
+                     "panda_like:joint: joint space over the 3D workspace (3 levels); moves joints 1, 2, 4 and holds "
+                     "the others; its reach is of the free voxels"]
+
+
+def test_the_gymnasium_env_with_a_3d_robot_passes_check_env_and_reaches_the_goal():
+    import gymnasium as gym
+    from gymnasium.utils.env_checker import check_env
+
+    import armtransfer  # noqa: F401  (registers the environments)
+
+    env = gym.make("armtransfer/ArmRooms-v0", arm="ur5e_like", actions="joint", world="rooms11", task="2")
+    check_env(env.unwrapped, skip_render_check=True)
+    u = env.unwrapped
+    assert u.robot.name == "ur5e_like:joint" and is_spatial_joint(u.robot) and u.action_space.n == 6
+    obs, info = env.reset(seed=0)
+    assert info["label"] == SMALL.cell(2, 2)  # rooms11 task 2 starts at (2, 2), at the table level
+    terminated = False
+    for _, action in u.robot.shortest_path(obs, u.goal_cell)[:-1]:
+        obs, reward, terminated, truncated, info = env.step(action)
+    assert terminated and info["label"] == u.goal_cell
+    env.close()
+
+
+def test_armtransfer_matrix_runs_with_a_3d_robot(tmp_path, capsys):
+    import json
+
+    from armtransfer.cli import main
+
+    out = tmp_path / "m"
+    assert main(["matrix", "--robots", "planar2:joint,ur5e_like:joint", "--world", "rooms11", "--tasks", "2",
+                 "--methods", "pseudo", "--trials", "1", "--out", str(out), "--workers", "1"]) == 0
+    assert "8 of 8 runs finished" in capsys.readouterr().out
+    cells = json.loads((out / "matrix.json").read_text())["cells"]
+    pairs = {(c["source"], c["target"]) for c in cells}
+    assert ("planar2:joint", "ur5e_like:joint") in pairs and ("ur5e_like:joint", "planar2:joint") in pairs
+    for c in cells:
+        assert c["tasks"] == 1 and c["trials"] == 1 and c["improvement"] is not None
+    assert "| source \\ target | planar2:joint | ur5e_like:joint |" in (out / "matrix.md").read_text()
+
+
+def test_armtransfer_sweep_runs_with_a_3d_robot(tmp_path, capsys):
+    import json
+
+    from armtransfer.cli import main
+
+    sweep = tmp_path / "s.toml"
+    sweep.write_text('[sweep]\nname = "spatial"\nworld = "rooms11"\ntasks = ["2"]\n'
+                     'pairs = [["planar2:joint", "ur5e_like:joint"]]\nmethods = ["none", "pseudo"]\n'
+                     'seeds = [0]\ntrials = 2\n')
+    out = tmp_path / "out"
+    assert main(["sweep", str(sweep), "--out", str(out), "--workers", "1"]) == 0
+    assert "2/2 runs" in capsys.readouterr().out and not any((out / "failed").iterdir())
+    assert main(["summarize", str(out)]) == 0
+    data = json.loads((out / "summary.json").read_text())
+    assert data["runs"] == 2
+    rows = {r["method"]: r for r in data["rows"]}
+    assert set(rows) == {"none", "pseudo"} and all(r["trials"] == 2 for r in rows.values())
+    assert rows["pseudo"]["improvement_percent"] is not None

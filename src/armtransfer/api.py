@@ -96,8 +96,9 @@ def transfer(
     (:mod:`armtransfer.worlds`); ``task`` is then one of its task names. Robots given as
     ``DiscreteRobot`` objects bring their own world when ``world`` is None.
 
-    ``state="continuous"``: the target is a planar arm (``"planar3:joint"``, an arm file
-    ``"PATH.xml"``, or ``"custom"`` with ``arm_xml=``) whose state is its joint configuration,
+    ``state="continuous"``: the target is an arm (``"planar3:joint"``; a spatial arm such as
+    ``"ur5e_like:joint"`` moves its joint robot's three joints over the 3D workspace, with
+    hashed tiles; an arm file ``"PATH.xml"``, or ``"custom"`` with ``arm_xml=``) whose state is its joint configuration,
     learned by linear SARSA(lambda) over tile coding (:data:`STATES`); the methods are those
     paid on labels alone (``learning.cells.CELL_METHODS``), no controls or mapping are run, and
     the result is an ``experiments.continuous.ContinuousResult``. ``noise`` (continuous only) is
@@ -302,8 +303,9 @@ def _transfer_continuous(source, target, the_task: Task, method_names: list[str]
     from armtransfer.tasks.continuous import ARM_KEYWORDS, continuous_arm
 
     if isinstance(target, DiscreteRobot) or not isinstance(target, str):
-        raise InvalidParameterError("a continuous target is named by a string: a planar arm such as "
-                                    f"'planar3:joint', PATH.xml or 'custom' with arm_xml, got {target!r}")
+        raise InvalidParameterError("a continuous target is named by a string: an arm such as "
+                                    f"'planar3:joint' or 'ur5e_like:joint', PATH.xml or 'custom' with arm_xml, "
+                                    f"got {target!r}")
     unknown = sorted(k for k in options if k not in ARM_KEYWORDS)
     if unknown:
         raise InvalidParameterError(f"arm option {unknown[0]!r} does not apply to a continuous target; valid "
@@ -316,6 +318,9 @@ def _transfer_continuous(source, target, the_task: Task, method_names: list[str]
         arm = continuous_arm(target, layout=the_task.layout,
                              **{k: v for k, v in options.items() if k in ("joint_step", "cell_size")}, noise=noise)
     start_cell, goal_cell = the_task.cells(arm.layout)
+    # a spatial arm's joint box is 3 joints of up to 2 pi each: hashed tiles keep its weights small
+    approx = runs.Approximation(table_bits=runs.SPATIAL_TABLE_BITS) if getattr(arm, "levels", 0) else \
+        runs.Approximation()
     arm.place(start_cell)  # the task's start must be reachable before the source learns anything
     src = resolve(source, xml_path=arm_xml, layout=the_task.layout, **options)
     for cell, what in ((start_cell, "start"), (goal_cell, "goal")):
@@ -323,10 +328,10 @@ def _transfer_continuous(source, target, the_task: Task, method_names: list[str]
     shaped = any(registry.get(m).shaped for m in method_names)
     trajs = resolve_trajectories(specs, src, the_task, config, seed) if shaped else []
     # the arm is placed over the start already (above): run_all would solve the same IK again
-    results = [runs.run_method(m, arm, goal_cell, trajs, trials, seed, config, K, on_trial=progress)
+    results = [runs.run_method(m, arm, goal_cell, trajs, trials, seed, config, K, approx, on_trial=progress)
                for m in method_names]
     return runs.ContinuousResult(task=the_task, source=src.name, target=f"{target} (continuous)", trajectories=trajs,
-                                 seed=seed, trials=trials, config=config, approximation=runs.Approximation(),
+                                 seed=seed, trials=trials, config=config, approximation=approx,
                                  methods={r.method: r for r in results})
 
 

@@ -57,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
         return arm_transfer.run(args)
     common.refuse_other_options(args, LIST_OPTIONS, "'arms list'")
     common.check_arm_flags(args)
-    from armtransfer.tasks.arms import arm_robot, robot_specs
+    from armtransfer.tasks.arms import arm_robot, is_spatial_joint, robot_specs, spatial_joint_specs
     from armtransfer.worlds.resolve import is_default
 
     layout = common.world_of(args)
@@ -78,7 +78,8 @@ def run(args: argparse.Namespace) -> int:
             if a not in ARMS:
                 raise ArmModelError(f"unknown arm {a!r}; valid arms: {', '.join(ARMS)}")
     jobs: list[dict[str, Any]] = []
-    for spec in robot_specs():
+    order = list(ARMS)  # each arm's rows together: its robots on the plane, then its 3D joint robot
+    for spec in sorted(robot_specs() + spatial_joint_specs(), key=lambda s: order.index(s.split(":")[0])):
         arm, actions = spec.split(":")
         if (wanted is None or actions in wanted) and (arms is None or arm in arms):
             jobs.append(dict(arm=arm, actions=actions))
@@ -109,9 +110,14 @@ def run(args: argparse.Namespace) -> int:
         solved = tasks_solvable(r)
         print(f"{r.name:<24} {r.arm.dof:>3} {r.n_actions:>7} {r.n_states:>7} "
               f"{r.arm.reach:>6.1%} {solved:>4}/{len(layout.tasks)} {r.arm.cache:>6}")
+    spatial = [r for r in robots if is_spatial_joint(r)]
     custom = [r for r in robots if r.arm.kind == "custom"]
-    if custom:
+    if spatial or custom:
         print()
+    for r in spatial:
+        moved = ", ".join(str(j + 1) for j in r.arm.moved)
+        print(f"{r.name}: joint space over the 3D workspace ({r.arm.levels} levels); moves joints {moved} "
+              f"and holds the others; its reach is of the free voxels")
     for r in custom:
         print(f"{r.name}: {mount_line(r.arm)}")
         if cause := walls_cause(r):

@@ -27,6 +27,9 @@ if TYPE_CHECKING:
     import pandas as pd
 
 
+SPATIAL_TABLE_BITS = 18
+"""The hashed table (2**18 features per action) ``armtransfer.transfer`` gives a spatial arm's
+tiles: its three moved joints' box at 2-step tiles has ~4 million dense tiles over 8 tilings."""
 NOISE_STREAM = 2
 """``trial_rng``'s stream of a trial's actuation noise (0: the learner's, 1: the source robot's)."""
 
@@ -69,7 +72,7 @@ def run_method(method: str, arm, goal_cell: int, trajs: Sequence[Trajectory] | N
     cells.check_method(method)
     if trials < 1:
         raise InvalidParameterError(f"trials must be a positive integer, got {trials}")
-    shaping = cells.cell_shaping(method, arm.layout, trajs, K, config)
+    shaping = cells.cell_shaping(method, arm.layout, trajs, K, config, int(getattr(arm, "levels", 1)))
     coding, lin = approx.coding(arm), approx.linear()
     out = MethodResult(method)
     noise = float(getattr(arm, "noise", 0.0))

@@ -36,9 +36,11 @@ def check_method(method: str) -> str:
 
 
 def cell_shaping(method: str, layout: Layout, trajs: Trajectory | Sequence[Trajectory] | None,
-                 K: float | str | None, config: LearnerConfig) -> Shaping | None:
-    """Method ``method``'s shaping arrays over the cells of ``layout`` (None for ``none``)."""
+                 K: float | str | None, config: LearnerConfig, levels: int = 1) -> Shaping | None:
+    """Method ``method``'s shaping arrays over the cells of ``layout`` (None for ``none``);
+    ``levels`` > 1: over the voxels of the 3D workspace (a spatial arm's labels)."""
     check_method(method)
     if not registry.get(method).shaped:
         return None
-    return registry.build_shaping(method, cell_robot(layout), trajs, K, config.step_reward, gamma=config.gamma)
+    return registry.build_shaping(method, cell_robot(layout, levels), trajs, K, config.step_reward,
+                                  gamma=config.gamma)

@@ -5,7 +5,9 @@ the same mount, tool point, cell size and layout) and moved by the ``joint`` act
 increments (the arm's lattice step: ``ARMS[arm].joint_step`` for a built-in arm, the
 generator's for a generated arm file, else ``joint_step=`` or the finest step of
 ``ik.compile.STEP_LADDER`` whose lattice ``compile_joint`` would allow), with no lattice
-laid out: ``ik.continuous.ContinuousArm``.
+laid out: ``ik.continuous.ContinuousArm``. A spatial arm (``ur5e_like``, ``panda_like``, a
+6- or 7-joint file) is ``ik.continuous3d.SpatialContinuousArm``: three joints moved over the 3D
+workspace, labelled with voxels, as its ``joint`` robot (``ik.voxels``).
 """
 
 from __future__ import annotations
@@ -43,10 +45,9 @@ def parse_spec(spec: str) -> tuple[str | None, str | None]:
     else:
         name, _, actions = spec.partition(":")
         path = None
-        planar = [a for a, info in ARMS.items() if info.kind == "planar"]
-        if name not in planar:
-            raise UnknownArmError(f"unknown continuous arm {name!r}; valid arms: {', '.join(planar)}, PATH.xml "
-                                  "(a planar arm file) or gen:planar:DOF:SEED")
+        if name not in ARMS:
+            raise UnknownArmError(f"unknown continuous arm {name!r}; valid arms: {', '.join(ARMS)}, PATH.xml "
+                                  "(an arm file) or gen:planar:DOF:SEED")
     if actions and actions not in ACTIONS:
         raise UnknownArmError(f"a continuous arm has no action model {actions!r}; valid action models: "
                               f"{', '.join(ACTIONS)}")
@@ -57,12 +58,15 @@ def continuous_arm(spec: str | None = None, *, xml_path=None, tip_site: str | No
                    tip_body: str | None = None, tip_offset=None, base_pos=None, base_yaw: float | None = None,
                    joint_step: float | None = None, cell_size: float | None = None, layout: Layout = ROOMS,
                    noise: float = 0.0):
-    """The continuous arm of a built-in planar arm (``spec``, e.g. ``"planar3:joint"``) or of a
-    planar arm file (``spec`` ``"PATH.xml"`` or ``xml_path=``) with its tool point and mount
+    """The continuous arm of a built-in arm (``spec``, e.g. ``"planar3:joint"``) or of an arm
+    file (``spec`` ``"PATH.xml"`` or ``xml_path=``) with its tool point and mount
     (a generated arm's from its sidecar; without ``base_pos`` the automatic mount), on the
     world ``layout`` (its cell size ``ik.workspace.world_cell`` unless given); ``noise``: the
-    actuation noise sigma (``ik.continuous``; 0, the default: none)."""
+    actuation noise sigma (``ik.continuous``; 0, the default: none). A planar arm is an
+    ``ik.continuous.ContinuousArm``; a spatial one an ``ik.continuous3d.SpatialContinuousArm``
+    over the 3D workspace (the moved joints, origin and default step of its ``joint`` robot)."""
     from armtransfer.ik.continuous import MAX_NOISE, ContinuousArm
+    from armtransfer.ik.continuous3d import SpatialContinuousArm
     from armtransfer.tasks.arms import arm_scene, automatic_mount, make_tool, read_sidecar
 
     name, path = parse_spec(spec) if spec is not None else (None, None)
@@ -76,6 +80,8 @@ def continuous_arm(spec: str | None = None, *, xml_path=None, tip_site: str | No
         if name is None:
             raise UnknownArmError("give a continuous arm: a built-in planar arm or an arm file")
         scene = arm_scene(name, cell_size=cell_size, layout=layout)
+        if ARMS[name].kind != "planar":  # over the 3D workspace, its step chosen as its joint robot's
+            return SpatialContinuousArm(scene, joint_step, noise)
         return ContinuousArm(scene, joint_step or ARMS[name].joint_step, noise)
     if tip_site is None and tip_body is None and spec is not None and spec.startswith("gen:"):
         tip_site = "tip"  # a generated arm's tool point
@@ -89,6 +95,8 @@ def continuous_arm(spec: str | None = None, *, xml_path=None, tip_site: str | No
         base_pos, base_yaw = pose.pos, pose.yaw
     scene = arm_scene(None, cell_size=cell_size, xml_path=path, tip_site=tip_site, tip_body=tip_body,
                       tip_offset=tip_offset, base_pos=base_pos, base_yaw=base_yaw, layout=layout)
+    if not scene.planar:
+        return SpatialContinuousArm(scene, joint_step, noise)
     return ContinuousArm(scene, joint_step or ladder_step(scene), noise)
 
 

@@ -26,6 +26,7 @@ from armtransfer.tasks.catalog import Task
 from armtransfer.tasks.continuous import ARM_KEYWORDS
 from armtransfer.tasks.envs import check_options, check_reset_options, rooms_task
 from armtransfer.tasks.robot import cell_robot
+from armtransfer.worlds.voxels import cell_of_label
 
 ACTIONS = ("discrete", "box")
 """The action spaces: ``Discrete(2 * dof)`` (one joint by +-delta) or ``Box(-1, 1, (dof,))``
@@ -64,8 +65,9 @@ class ContinuousArmRoomsEnv(gym.Env):
         self.action_space: spaces.Space = (spaces.Discrete(arm.n_actions) if actions == "discrete" else
                                            spaces.Box(-1.0, 1.0, (arm.dof,), dtype=np.float32))
         self._obs_size = arm.dof + 3
-        self.robot = cell_robot(layout)
-        """The cells as a robot (states = cells): what ``TransferReward`` pays transfer by."""
+        self.robot = cell_robot(layout, int(getattr(arm, "levels", 1)))
+        """The cells as a robot (states = cells; a spatial arm's: the voxels): what
+        ``TransferReward`` pays transfer by."""
         self.start_state = self.start_cell
 
     def _obs(self) -> np.ndarray:
@@ -119,15 +121,17 @@ class ContinuousArmRoomsEnv(gym.Env):
     def render(self):
         if self.render_mode == "ansi":
             layout = self.arm.layout
-            return layout.ascii({layout.xy(self.arm.label): "R", layout.xy(self.goal_cell): "G"}) + "\n"
+            here = cell_of_label(self.arm.label, layout)  # a spatial arm's voxel: the cell under it
+            return layout.ascii({layout.xy(here): "R", layout.xy(self.goal_cell): "G"}) + "\n"
         return None
 
 
 def make_continuous_arm_rooms_env(arm: str | None = "planar3", task: int | str | None = 1,
                                   start: tuple[int, int] | None = None, goal: tuple[int, int] | None = None,
                                   world: Any = None, **kwargs: Any) -> ContinuousArmRoomsEnv:
-    """Entry point of ``armtransfer/ContinuousArmRooms-v0``: a built-in planar arm (``arm``, e.g.
-    ``"planar3"`` or ``"planar3:joint"``) or a planar arm file (``xml_path=``) on a Table I or
+    """Entry point of ``armtransfer/ContinuousArmRooms-v0``: a built-in arm (``arm``, e.g.
+    ``"planar3"``, ``"planar3:joint"`` or, over the 3D workspace, ``"ur5e_like"``) or an arm file
+    (``xml_path=``) on a Table I or
     custom task; ``world=`` as the other environments'."""
     from armtransfer.tasks.continuous import continuous_arm
 

@@ -149,10 +149,11 @@ class DiscreteRobot:
         return path
 
 
-def cell_robot(layout: Layout) -> DiscreteRobot:
+def cell_robot(layout: Layout, levels: int = 1) -> DiscreteRobot:
     """The layout's cells as a robot: each cell a state labelled with itself, one action that
-    stays. What a robot known only by its label is paid by (``learning.cells``)."""
-    n = layout.n_cells
+    stays. What a robot known only by its label is paid by (``learning.cells``). ``levels`` > 1:
+    the voxels of the 3D workspace (``worlds.voxels``: id = level * n_cells + cell) instead."""
+    n = layout.n_cells * max(1, int(levels))
     return DiscreteRobot(name="cells", next_state=np.arange(n, dtype=np.int32)[:, None],
                          wind_state=np.arange(n, dtype=np.int32), label=np.arange(n, dtype=np.int32),
                          action_names=("stay",), layout=layout)

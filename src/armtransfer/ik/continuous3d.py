@@ -1,0 +1,319 @@
+"""A spatial arm whose state is its joint configuration, over the 3D workspace (``worlds.voxels``).
+
+The continuous counterpart of a spatial arm's ``joint`` robot (``ik.voxels``): the same three
+moved joints (the origin's best-conditioned, ``ik.voxels.moved_joints``), the others held at
+the same origin (``ik.voxels.spatial_origin``), the same step (``ik.voxels.choose_step``
+unless given) and the same move rule, but no lattice laid out: every move runs MuJoCo.
+Action ``2i`` turns moved joint i by +delta, ``2i+1`` by -delta (``q1+`` ... as the joint
+robot names them). A move is blocked, and the arm stays, when it leaves the joint box (an
+unlimited joint: pi either side of the origin), when MuJoCo reports a contact that
+``ik.scene.ContactChecker`` counts at its end or at points along the straight joint move (at
+most half a cell of tool travel apart), or when the tool point at any of them is outside the
+workspace or in a solid voxel (``ik.voxels._move_clear``, the joint robot's own test).
+
+``q`` is the moved joints' angles (the held joints are not the learner's: they never change);
+the label is the voxel of the tool point (``ik.voxels.voxel_of_point``), so a task's cells are
+their level-0 voxels and a 2D source's path is paid where the tool is within one cell size of
+the table. Without noise the configuration is kept as origin + n * delta with integer n: the
+points and moves are those of the joint robot's lattice, bit for bit (a test walks both).
+
+**Actuation noise** (``noise=sigma``), as ``ik.continuous``'s: a move turns its joint by
+delta * (1 + eps), eps ~ Normal(0, sigma^2) clipped to [-NOISE_CLIP, NOISE_CLIP], drawn from
+the arm's own generator (:meth:`SpatialContinuousArm.seed_noise`), one draw per move, blocked
+ones too; the configuration leaves the lattice and :meth:`key` is q itself. The start is the
+lattice point over the start cell with and without noise; inside :meth:`noiseless` (the greedy
+roll-out) the moves are the lattice's.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import mujoco
+import numpy as np
+
+from armtransfer.errors import ArmModelError, InvalidCellError, UnreachableTableError
+from armtransfer.ik.compile import joint_box
+from armtransfer.ik.continuous import BLOCKED, MAX_NOISE, NOISE_BUFFER, NOISE_CLIP
+from armtransfer.ik.scene import ArmScene, ContactChecker
+from armtransfer.ik.voxels import (SpatialFK, _move_clear, choose_step, moved_joints, spatial_origin,
+                                   voxel_of_point, workspace_voxels)
+
+IK_ITERATIONS = 200
+"""Damped least-squares iterations of :meth:`SpatialContinuousArm.place`'s IK on the moved joints."""
+IK_RESTARTS = 8
+"""Random starts (a fixed seed) tried after the one from the origin."""
+
+
+class SpatialContinuousArm:
+    """A spatial arm in its table scene, moved by turns of ``step`` radians of three of its joints.
+
+    The interface of ``ik.continuous.ContinuousArm`` that the linear learner, the runs and the
+    environments use: ``q``, ``label``, ``place``, ``reset``, ``move``, ``move_by``, ``key``,
+    ``bounds``, ``box``, ``seed_noise``, ``noiseless``, ``tip``, ``tool_point``."""
+
+    def __init__(self, scene: ArmScene, step: float | None = None, noise: float = 0.0) -> None:
+        if scene.planar:
+            raise ArmModelError("this arm is planar: its continuous arm is ik.continuous.ContinuousArm")
+        model = scene.model
+        if model.njnt != model.nq or np.any(model.jnt_type != mujoco.mjtJoint.mjJNT_HINGE):
+            raise ArmModelError("the continuous arm needs an arm with hinge joints only")
+        if step is not None and not (math.isfinite(step) and 0.0 < step <= math.pi):
+            raise ArmModelError(f"the joint step must be in (0, pi] radians, got {step!r}")
+        if isinstance(noise, bool) or not isinstance(noise, (int, float, np.floating, np.integer)) \
+                or not (math.isfinite(noise) and 0.0 <= noise <= MAX_NOISE):
+            raise ArmModelError(f"the actuation noise sigma must be a number in [0, {MAX_NOISE}], got {noise!r}")
+        self.scene = scene
+        self.layout = scene.layout
+        self.cell = float(scene.cell)
+        self.vox = workspace_voxels(self.layout, self.cell)
+        self.levels = self.vox.levels
+        """Labels are voxel ids of this many levels (``learning.cells`` pays by them)."""
+        self.checker = ContactChecker(scene)
+        self._fk = SpatialFK(scene)
+        self.origin = spatial_origin(scene)
+        jac = self._fk.jacobian(self.origin)
+        self.moved = moved_joints(jac)
+        self.step = float(step) if step is not None else choose_step(jac, self.moved, self.cell)
+        self.dof = len(self.moved)
+        """The joints the learner moves (the others are held at the origin)."""
+        self.n_actions = 2 * self.dof
+        self.action_names = tuple(f"q{j + 1}{s}" for j in self.moved for s in "+-")
+        self.noise = float(noise)
+        self._noisy = self.noise > 0.0
+        self._rng = np.random.default_rng(0)
+        self._eps: list[float] = []
+        self._k = 0
+        lo, hi = joint_box(scene, self.origin)
+        idx = list(self.moved)
+        self._lo, self._hi = lo[idx].astype(float), hi[idx].astype(float)
+        self._q0 = self.origin[idx].astype(float)
+        self._nlo = np.ceil((self._lo - self._q0) / self.step - 1e-9).astype(np.int64)
+        self._nhi = np.floor((self._hi - self._q0) / self.step + 1e-9).astype(np.int64)
+        self._full = self.origin.astype(float).copy()  # the whole configuration; only the moved joints change
+        self._q = self._q0.copy()  # what ``q`` returns: updated in place (the learner keeps the array)
+        self._n = np.zeros(self.dof, np.int64)
+        self._off = False  # a box move left the lattice
+        self._tip = np.full(3, np.nan)
+        self.label = -1
+        self._start: tuple[np.ndarray, int, np.ndarray] | None = None
+        self.moves = 0
+        """MuJoCo kinematics + collision checks made by :meth:`move` and :meth:`move_by` (blocked ones too)."""
+
+    # ------------------------------------------------------------------ configurations
+
+    def _full_of(self, qm: np.ndarray) -> np.ndarray:
+        full = self._full.copy()
+        full[list(self.moved)] = qm
+        return full
+
+    def _voxel(self, full: np.ndarray) -> tuple[int, np.ndarray]:
+        """(voxel, tip) of a whole configuration; voxel -1 when it touches, is outside or solid."""
+        hit, tip = self.checker.touches_and_tip(full)
+        v = voxel_of_point(tip, self.cell, self.vox)
+        return (-1 if hit or v < 0 or not self.vox.free[v] else v), tip
+
+    def _set(self, qm: np.ndarray, n: np.ndarray | None, tip: np.ndarray, label: int) -> None:
+        self._q[:] = qm
+        self._full[list(self.moved)] = qm
+        if n is not None:
+            self._n[:] = n
+        self._tip = tip
+        self.label = label
+
+    def set_configuration(self, q: np.ndarray) -> int:
+        """Put the moved joints at ``q`` (a lattice point, origin + n * step, keeps the lattice;
+        any other leaves it) as the start, and return its voxel. A configuration that touches
+        something or whose tool point is not in a free voxel is refused."""
+        qm = np.array(q, dtype=np.float64).reshape(-1)
+        if qm.shape != (self.dof,) or not np.all(np.isfinite(qm)):
+            raise ArmModelError(f"a configuration of this arm's moved joints is {self.dof} finite angles, got "
+                                f"{np.asarray(q).tolist()}")
+        if np.any(qm < self._lo - 1e-9) or np.any(qm > self._hi + 1e-9):
+            raise ArmModelError("the configuration is outside the joint limits")
+        v, tip = self._voxel(self._full_of(qm))
+        if v < 0:
+            raise InvalidCellError("the arm touches something or its tool point is not in a free voxel at this "
+                                   "configuration")
+        n = np.rint((qm - self._q0) / self.step).astype(np.int64)
+        on = bool(np.array_equal(self._q0 + n * self.step, qm))
+        self._off = not on
+        self._set(qm, n if on else np.zeros(self.dof, np.int64), tip, v)
+        self._start = (qm.copy(), v, tip.copy())
+        return v
+
+    def reset(self) -> int:
+        """Back to the configuration last set (:meth:`set_configuration`, :meth:`place`); its voxel."""
+        if self._start is None:
+            raise ArmModelError("place the arm (place or set_configuration) before resetting it")
+        qm, v, tip = self._start
+        n = np.rint((qm - self._q0) / self.step).astype(np.int64)
+        self._off = not bool(np.array_equal(self._q0 + n * self.step, qm))
+        self._set(qm, n, tip.copy(), v)
+        return v
+
+    @property
+    def q(self) -> np.ndarray:
+        """The moved joints' angles (read it, never write it)."""
+        return self._q
+
+    @property
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lowest, highest) moved-joint configuration the moves can reach: the lattice's extent
+        in the joint box (with noise: the box itself)."""
+        if self._noisy:
+            return self._lo.copy(), self._hi.copy()
+        return self._q0 + self._nlo * self.step, self._q0 + self._nhi * self.step
+
+    @property
+    def box(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lowest, highest) moved-joint configuration any move may reach: the joint box."""
+        return self._lo.copy(), self._hi.copy()
+
+    def key(self) -> tuple:
+        """Lattice steps from the origin (with noise or off the lattice: the angles themselves)."""
+        if self._noisy or self._off:
+            return tuple(self._q.tolist())
+        return tuple(self._n.tolist())
+
+    def place(self, cell: int) -> np.ndarray:
+        """The lattice point (origin + n * step) with the tool point in ``cell``'s level-0
+        voxel, nearest its centre and touching nothing, set as the start; returns its moved
+        joints. Damped least squares on the moved joints (from the origin, then from
+        ``IK_RESTARTS`` random starts of a fixed seed) gives a configuration with the tool at
+        the cell, at the origin's height; the lattice points around it (each joint rounded,
+        then one step either way) are tried."""
+        cell = int(cell)
+        x, y = self.layout.xy(cell)
+        target = np.array([x * self.cell, y * self.cell, float(self._fk.tip(self.origin)[2])])
+        centre = np.array([x * self.cell, y * self.cell, 0.5 * self.cell])
+        rng = np.random.default_rng(0)
+        starts = [self._q0] + [rng.uniform(np.maximum(self._lo, self._q0 - 1.5), np.minimum(self._hi, self._q0 + 1.5))
+                               for _ in range(IK_RESTARTS)]
+        for start in starts:
+            qm = self._ik(target, start)
+            if qm is None:
+                continue
+            base = np.rint((qm - self._q0) / self.step)
+            best, best_d = None, np.inf
+            for off in itertools.product((0, -1, 1), repeat=self.dof):
+                cand = self._q0 + (base + np.array(off)) * self.step
+                if np.any(cand < self._lo - 1e-9) or np.any(cand > self._hi + 1e-9):
+                    continue
+                v, tip = self._voxel(self._full_of(cand))
+                if v != cell:
+                    continue
+                d = float(np.linalg.norm(tip - centre))
+                if d < best_d:
+                    best, best_d = cand, d
+            if best is not None:
+                self.set_configuration(best)
+                return self._q.copy()
+        raise UnreachableTableError(f"the arm cannot place its tool point in cell {(x, y)} at the table level with "
+                                    "its moved joints without touching anything")
+
+    def _ik(self, target: np.ndarray, start: np.ndarray) -> np.ndarray | None:
+        idx = list(self.moved)
+        qm = start.copy()
+        for _ in range(IK_ITERATIONS):
+            full = self._full_of(qm)
+            err = target - self._fk.tip(full)
+            if float(np.linalg.norm(err)) < 0.05 * self.cell:
+                return qm
+            J = self._fk.jacobian(full)[:, idx]
+            dq = J.T @ np.linalg.solve(J @ J.T + (0.01 ** 2) * np.eye(3), err)
+            qm = np.clip(qm + np.clip(dq, -0.2, 0.2), self._lo, self._hi)
+        return None
+
+    # ------------------------------------------------------------------ actuation noise
+
+    def seed_noise(self, rng: np.random.Generator) -> None:
+        """Draw the actuation noise from ``rng`` from now on (nothing is drawn when sigma is 0)."""
+        if not isinstance(rng, np.random.Generator):
+            raise ArmModelError(f"the noise generator must be a numpy.random.Generator, got {rng!r}")
+        self._rng, self._eps, self._k = rng, [], 0
+
+    def _next_eps(self) -> float:
+        k = self._k
+        if k >= len(self._eps):
+            self._eps = np.clip(self._rng.normal(0.0, self.noise, NOISE_BUFFER), -NOISE_CLIP, NOISE_CLIP).tolist()
+            k = 0
+        self._k = k + 1
+        return self._eps[k]
+
+    class _Noiseless:
+        def __init__(self, arm: "SpatialContinuousArm") -> None:
+            self.arm, self.was = arm, arm._noisy
+
+        def __enter__(self) -> "SpatialContinuousArm":
+            self.arm._noisy = False
+            return self.arm
+
+        def __exit__(self, *exc: object) -> None:
+            self.arm._noisy = self.was
+
+    def noiseless(self) -> "SpatialContinuousArm._Noiseless":
+        """A context in which the moves have no noise (reset first: the moves are the lattice's)."""
+        return SpatialContinuousArm._Noiseless(self)
+
+    # ------------------------------------------------------------------ moving
+
+    def move(self, a: int) -> int:
+        """Take action ``a`` (0 .. 2 * dof - 1): the voxel of the tool point after the move, or
+        ``BLOCKED`` (the arm has not moved)."""
+        i, sign = a >> 1, 1 - 2 * (a & 1)
+        self.moves += 1
+        n = None
+        qm = self._q.copy()
+        if self._noisy:
+            qm[i] += sign * self.step * (1.0 + self._next_eps())
+        elif self._off:
+            qm[i] += sign * self.step
+        else:
+            n = self._n.copy()
+            n[i] += sign
+            if n[i] < self._nlo[i] or n[i] > self._nhi[i]:
+                return BLOCKED
+            qm[i] = self._q0[i] + n[i] * self.step
+        if qm[i] < self._lo[i] or qm[i] > self._hi[i]:
+            return BLOCKED
+        return self._go(qm, n)
+
+    def move_by(self, dq: np.ndarray) -> int:
+        """Turn every moved joint at once, joint i by ``dq[i]`` radians (times 1 + eps_i with
+        noise): the voxel after the move, or ``BLOCKED``. It leaves the lattice (:meth:`key` is
+        then q; :meth:`reset` goes back to the start)."""
+        turn = np.asarray(dq, dtype=np.float64).reshape(-1)
+        if turn.shape != (self.dof,) or not np.all(np.isfinite(turn)):
+            raise ArmModelError(f"a joint move of this arm is {self.dof} finite angles, got {dq!r}")
+        if self._noisy:
+            turn = turn * (1.0 + np.array([self._next_eps() for _ in range(self.dof)]))
+        self.moves += 1
+        qm = self._q + turn
+        if np.any(qm < self._lo) or np.any(qm > self._hi):
+            return BLOCKED
+        label = self._go(qm, None)
+        if label >= 0:
+            self._off = True
+        return label
+
+    def _go(self, qm: np.ndarray, n: np.ndarray | None) -> int:
+        old = self._full.copy()
+        new = self._full_of(qm)
+        v, tip = self._voxel(new)
+        if v < 0 or not _move_clear(self.checker, self._fk, old, new, self._tip, tip, self.cell, self.vox):
+            return BLOCKED
+        if n is None and not self._noisy and not self._off:
+            self._off = True
+        self._set(qm, n, tip, v)
+        return v
+
+    def tip(self) -> tuple[float, float, float]:
+        """The tool point (x, y, z) the last move or placement computed: no MuJoCo call."""
+        x, y, z = self._tip.tolist()
+        return (x, y, z)
+
+    def tool_point(self) -> np.ndarray:
+        """The tool point at the current configuration (MuJoCo's kinematics, run now)."""
+        return self._fk.tip(self._full)
