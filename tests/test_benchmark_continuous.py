@@ -137,3 +137,18 @@ def test_a_discrete_trial_run_names_no_state_and_keeps_its_key():
     cont = benchmark_runs.trial_run(*args, state="continuous", noise=0.1)
     assert cont["key"] != run["key"] and {k: v for k, v in cont.items() if k not in ("key", "state", "noise")} \
         == {k: v for k, v in run.items() if k != "key"}
+
+
+def test_the_command_on_two_workers_writes_the_records_of_one_process(records, tmp_path, monkeypatch):
+    """``armtransfer benchmark`` on a continuous section: its trial runs go to worker processes
+    (which get the table robots by spec and make the arms themselves), through the store, and the
+    report's records are those of :func:`benchmark.run_suite` in this process."""
+    from armtransfer.cli import main
+
+    suite = replace(small_suite(), name="tiny-continuous")
+    monkeypatch.setitem(suites.SUITES, suite.name, suite)
+    out = tmp_path / "store"
+    assert main(["benchmark", "--suite", suite.name, "--out", str(out), "--workers", "2"]) == 0
+    data = json.loads((out / "results.json").read_text())
+    assert data["records"] == records
+    assert "continuous (noise 0.1)" in (out / "report.md").read_text()
