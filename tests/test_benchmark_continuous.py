@@ -152,3 +152,16 @@ def test_the_command_on_two_workers_writes_the_records_of_one_process(records, t
     data = json.loads((out / "results.json").read_text())
     assert data["records"] == records
     assert "continuous (noise 0.1)" in (out / "report.md").read_text()
+
+
+def test_a_continuous_target_that_cannot_be_placed_over_the_start_names_the_case(monkeypatch):
+    from armtransfer.errors import InvalidTaskError, UnreachableTableError
+    from armtransfer.ik.continuous3d import SpatialContinuousArm
+
+    def nowhere(self, cell):
+        raise UnreachableTableError("the arm cannot place its tool point in cell (9, 9)")
+
+    monkeypatch.setattr(SpatialContinuousArm, "place", nowhere)
+    with pytest.raises(InvalidTaskError, match=r"^planar2:joint -> ur5e_like:joint continuous \(noise 0.1\), task 2, "
+                                               r"in rooms11: the arm cannot place its tool point in cell \(9, 9\)$"):
+        benchmark.plan(small_suite(), 0)

@@ -425,7 +425,10 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
                 start, goal = case_cells(case, source, target, seed, section.name, ci, j)
                 source.start_state(start)
                 if arm is not None and start not in placed:
-                    arm.place(start)
+                    try:
+                        arm.place(start)
+                    except ArmTransferError as err:  # the case named, before anything runs
+                        raise InvalidTaskError(f"{case.label}: {err}") from None
                     placed.add(start)
                 path = target.shortest_path(target.start_state(start), goal)
                 if path is None:
