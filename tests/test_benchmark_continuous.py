@@ -165,3 +165,11 @@ def test_a_continuous_target_that_cannot_be_placed_over_the_start_names_the_case
     with pytest.raises(InvalidTaskError, match=r"^planar2:joint -> ur5e_like:joint continuous \(noise 0.1\), task 2, "
                                                r"in rooms11: the arm cannot place its tool point in cell \(9, 9\)$"):
         benchmark.plan(small_suite(), 0)
+
+
+def test_a_continuous_case_with_noise_out_of_range_names_the_case():
+    case = replace(suites.VOXELS_CONTINUOUS.cases[0], noise=0.9)
+    section = replace(suites.VOXELS_CONTINUOUS, cases=(case,), source_seeds=1)
+    with pytest.raises(InvalidParameterError, match=r"^planar2:joint -> ur5e_like:joint continuous \(noise 0.9\), "
+                                                    r"task 2, in rooms11: the actuation noise .*0\.9"):
+        benchmark.plan(suites.Suite("t", 1, True, "", (section,)), 0)

@@ -420,7 +420,10 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
             if case.state != "discrete":  # a continuous target: its arm, placed over every start before anything runs
                 from armtransfer.tasks.continuous import continuous_arm
 
-                arm = continuous_arm(case.target, layout=target.layout, noise=case.noise)
+                try:  # a bad noise or an arm with no continuous counterpart: the case named
+                    arm = continuous_arm(case.target, layout=target.layout, noise=case.noise)
+                except ArmTransferError as err:
+                    raise InvalidParameterError(f"{case.label}: {err}") from None
             for j in range(section.source_seeds):
                 start, goal = case_cells(case, source, target, seed, section.name, ci, j)
                 source.start_state(start)
