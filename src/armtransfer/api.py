@@ -318,9 +318,7 @@ def _transfer_continuous(source, target, the_task: Task, method_names: list[str]
         arm = continuous_arm(target, layout=the_task.layout,
                              **{k: v for k, v in options.items() if k in ("joint_step", "cell_size")}, noise=noise)
     start_cell, goal_cell = the_task.cells(arm.layout)
-    # a spatial arm's joint box is 3 joints of up to 2 pi each: hashed tiles keep its weights small
-    approx = runs.Approximation(table_bits=runs.SPATIAL_TABLE_BITS) if getattr(arm, "levels", 0) else \
-        runs.Approximation()
+    approx = runs.approximation_for(arm)  # hashed tiles for a spatial arm
     arm.place(start_cell)  # the task's start must be reachable before the source learns anything
     src = resolve(source, xml_path=arm_xml, layout=the_task.layout, **options)
     for cell, what in ((start_cell, "start"), (goal_cell, "goal")):

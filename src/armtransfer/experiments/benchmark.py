@@ -28,7 +28,7 @@ from typing import cast
 
 import numpy as np
 
-from armtransfer.errors import ArmTransferError, InvalidTaskError
+from armtransfer.errors import ArmTransferError, InvalidParameterError, InvalidTaskError
 from armtransfer.experiments import benchmark_runs, experiment, suites
 from armtransfer.learning import methods
 from armtransfer.learning import presets
@@ -221,7 +221,8 @@ class Pair:
     start: tuple[int, int]
     goal: tuple[int, int]
     optimal: int
-    """Robot 2's shortest path, in its own steps."""
+    """Robot 2's shortest path, in its own steps (a continuous target's: its table robot's, the
+    moves it makes without noise)."""
     learner: LearnerConfig = SOURCE_CONFIG
     """Robot 2's learner settings (a preset's; the defaults unless one is named)."""
 
@@ -240,7 +241,8 @@ class Pair:
         without the source run's result, only those of the methods that read no trajectory."""
         return [benchmark_runs.trial_run(name, k, self.case.source, self.case.target, list(self.start),
                                          list(self.goal), self.case.wind, self.seed, self.config, source_result,
-                                         learner=learner, world=self.case.world)
+                                         learner=learner, world=self.case.world, state=self.case.state,
+                                         noise=self.case.noise)
                 for name in names if source_result is not None or not benchmark_runs.needs_trajectory(name)
                 for k in range(self.section.trials)]
 
@@ -261,7 +263,8 @@ class Pair:
                 "source_steps": None if traj is None else len(traj["cells"]),
                 "source_failure": source_result["failure"], "optimal": self.optimal,
                 "cap": self.section.max_total_steps, "budget": suites.BUDGET_FACTOR * self.optimal,
-                **({} if self.case.world == suites.DEFAULT_WORLD else {"world": self.case.world})}
+                **({} if self.case.world == suites.DEFAULT_WORLD else {"world": self.case.world}),
+                **({} if self.case.state == "discrete" else {"state": self.case.state, "noise": self.case.noise})}
 
 
 def record(pair: Pair, name: str, source_result: dict, trials: list[dict]) -> dict:
@@ -407,11 +410,29 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
     robots = robots if robots is not None else Robots({})
     pairs = []
     for section in suite.sections:
+        outside = [lr for lr in (section.learners if learners is None else learners) if lr != benchmark_runs.LEARNER]
         for ci, case in enumerate(section.cases):
+            if case.state != "discrete" and outside:
+                raise InvalidParameterError(f"learner {outside[0]!r} learns on a discrete target; {case.label} has a "
+                                            f"continuous one; valid learners for it: {benchmark_runs.LEARNER}")
             source, target = robots(case.source, case.world), robots(case.target, case.world)
+            arm, placed = None, set()
+            if case.state != "discrete":  # a continuous target: its arm, placed over every start before anything runs
+                from armtransfer.tasks.continuous import continuous_arm
+
+                try:  # a bad noise or an arm with no continuous counterpart: the case named
+                    arm = continuous_arm(case.target, layout=target.layout, noise=case.noise)
+                except ArmTransferError as err:
+                    raise InvalidParameterError(f"{case.label}: {err}") from None
             for j in range(section.source_seeds):
                 start, goal = case_cells(case, source, target, seed, section.name, ci, j)
                 source.start_state(start)
+                if arm is not None and start not in placed:
+                    try:
+                        arm.place(start)
+                    except ArmTransferError as err:  # the case named, before anything runs
+                        raise InvalidTaskError(f"{case.label}: {err}") from None
+                    placed.add(start)
                 path = target.shortest_path(target.start_state(start), goal)
                 if path is None:
                     raise InvalidTaskError(f"{case.label}: {target.name} cannot reach the goal")

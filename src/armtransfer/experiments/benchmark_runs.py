@@ -16,6 +16,10 @@ learner of Algorithm 1, :func:`armtransfer.experiments.experiment.run_method`) i
 this build has; :data:`LEARNERS` maps a name to the function that runs one trial, so a learner
 added later runs through the same store, its runs keyed apart from the built-in one's.
 
+A trial run of a case with a continuous target (``suites.Case.state``) names ``state`` and
+``noise``: its trial runs the linear learner on the target's continuous arm
+(:func:`_continuous_trial`); robot 1's source run is the same table-based one.
+
 A trial's random stream is ``SeedSequence([seed, 0, trial])``, the stream of trial ``trial``
 of the whole method, so running the trials one by one, in any order and on any worker, gives
 the bytes of running them together.
@@ -78,17 +82,29 @@ def source_run(source: str, target: str, start: list[int], goal: list[int], seed
                           world))
 
 
+CONTINUOUS = "continuous"
+"""A trial run's ``state`` when robot 2 is a continuous arm; a run without ``state`` is on the
+target's compiled table (every run written before continuous targets, with its key)."""
+
+
 def trial_run(method: str, trial: int, source: str, target: str, start: list[int], goal: list[int], wind: float,
               seed: int, config: LearnerConfig, source_result: dict | None, learner: str = LEARNER,
-              world: str = DEFAULT_WORLD) -> dict:
+              world: str = DEFAULT_WORLD, state: str = "discrete", noise: float = 0.0) -> dict:
     """Trial ``trial`` of ``method`` on robot 2 (``target``). A method that reads the trajectory
     is handed ``source_result``'s (the result of the case's source run: its path, or why there
     is none); the others carry neither. Where robot 1 handed nothing over, the run also names
-    ``told_nothing``: the method's baseline, which the trial then runs (:func:`trial_result`)."""
+    ``told_nothing``: the method's baseline, which the trial then runs (:func:`trial_result`).
+    ``state`` ``continuous``: robot 2 is ``target``'s continuous arm with actuation noise
+    ``noise`` (the run names both; a discrete run names neither, keeping its key)."""
     run = {"format": TRIAL_FORMAT, "learner": learner, "method": method, "trial": int(trial), "source": source,
            "target": target, "start": list(start), "goal": list(goal), "wind": wind, "seed": int(seed),
            "config": config.to_dict()}
     _in_world(run, world)
+    if state == CONTINUOUS:
+        run["state"], run["noise"] = CONTINUOUS, float(noise)
+    elif state != "discrete" or noise:
+        raise ValueError(f"a trial run's state is discrete or continuous (noise with continuous only), got "
+                         f"{state!r} with noise {noise!r}")
     if needs_trajectory(method):
         if source_result is None:
             raise ValueError(f"a trial of {method} needs its source run's result")
@@ -140,12 +156,36 @@ def _sarsa_trial(run: dict, target: DiscreteRobot) -> dict:
     res = experiment.run_method(run["method"], target, start, goal, given, 1, run["seed"],
                                 LearnerConfig(**run["config"]), wind=run["wind"], threads=1,
                                 first_trial=run["trial"])
+    return _fields(res)
+
+
+def _fields(res: experiment.MethodResult) -> dict:
+    """The result fields of a run's one trial (``res.trials[0]``)."""
     t = res.trials[0]
     curve = learning_metrics.curve(t.episode_steps, t.greedy_steps)
     return {"error": None, "first_exposure": t.exploration_steps, "converged": bool(t.converged),
             "convergence_steps": t.total_steps if t.converged else None, "greedy_steps": t.greedy_steps,
             "episodes": int(t.episodes), "area": float(curve.sum()), "curve": [float(v) for v in curve],
             "K": res.extra.get("K")}
+
+
+def _continuous_trial(run: dict, target: DiscreteRobot) -> dict:
+    """One trial on ``target``'s continuous arm (in ``target``'s world, with the run's actuation
+    noise), placed over the start: the linear learner of ``armtransfer.transfer(...,
+    state="continuous")`` (``experiments.continuous.run_method``, its tile coding), trial
+    ``run["trial"]``'s streams; the fields of :func:`trial_result`. The arm is made for the trial
+    (a few ms once its scene is cached), so trials on threads share no MuJoCo data."""
+    from armtransfer.experiments import continuous
+    from armtransfer.tasks.continuous import continuous_arm
+
+    start, goal = _cells(run, target)
+    arm = continuous_arm(run["target"], layout=target.layout, noise=run["noise"])
+    arm.place(start)
+    traj = run.get("trajectory")
+    given = [trajectory_of(traj)] if traj is not None else None
+    res = continuous.run_method(run["method"], arm, goal, given, 1, run["seed"], LearnerConfig(**run["config"]),
+                                approx=continuous.approximation_for(arm), first_trial=run["trial"])
+    return _fields(res)
 
 
 def _outside_trial(run: dict, target: DiscreteRobot) -> dict:
@@ -190,7 +230,12 @@ def trial_result(run: dict, target: DiscreteRobot) -> dict:
         skip = ("key", "trajectory", "source_failure", "told_nothing")
         return trial_result(dict({k: v for k, v in run.items() if k not in skip}, method=run["told_nothing"]), target)
     learner = LEARNERS.get(run["learner"])
-    if learner is None:
+    if run.get("state") == CONTINUOUS:
+        if learner is None:  # an outside learner learns on a table; no result of a continuous case is its
+            raise ArmTransferError(f"learner {run['learner']!r} learns on a discrete target; valid learners for "
+                                   f"a continuous one: {LEARNER}")
+        learner = _continuous_trial
+    elif learner is None:
         from armtransfer.learning.learners import LEARNERS as OUTSIDE
 
         if run["learner"] not in OUTSIDE:  # a run of a learner this build does not have fails; it is no result

@@ -65,13 +65,24 @@ class Approximation:
         return {"tilings": self.tilings, "tile_width_steps": self.width, "traces": self.traces, **hashed}
 
 
+def approximation_for(arm) -> Approximation:
+    """The tile coding ``armtransfer.transfer`` gives ``arm``: hashed tiles
+    (:data:`SPATIAL_TABLE_BITS`) for a spatial arm over the 3D workspace, dense ones otherwise."""
+    # a spatial arm's joint box is 3 joints of up to 2 pi each: hashed tiles keep its weights small
+    return Approximation(table_bits=SPATIAL_TABLE_BITS) if getattr(arm, "levels", 0) else Approximation()
+
+
 def run_method(method: str, arm, goal_cell: int, trajs: Sequence[Trajectory] | None, trials: int, seed: int,
                config: LearnerConfig, K: float | str = "auto", approx: Approximation = Approximation(),
-               on_trial: Callable[[], None] | None = None) -> MethodResult:
-    """``trials`` trials of ``method`` on ``arm`` (placed at the start) towards ``goal_cell``."""
+               on_trial: Callable[[], None] | None = None, first_trial: int = 0) -> MethodResult:
+    """``trials`` trials of ``method`` on ``arm`` (placed at the start) towards ``goal_cell``;
+    they are numbered from ``first_trial`` (their random streams), so trial k run alone is trial k
+    of a run of them all."""
     cells.check_method(method)
     if trials < 1:
         raise InvalidParameterError(f"trials must be a positive integer, got {trials}")
+    if isinstance(first_trial, bool) or not isinstance(first_trial, int) or first_trial < 0:
+        raise InvalidParameterError(f"first_trial must be an integer >= 0, got {first_trial!r}")
     shaping = cells.cell_shaping(method, arm.layout, trajs, K, config, int(getattr(arm, "levels", 1)))
     coding, lin = approx.coding(arm), approx.linear()
     out = MethodResult(method)
@@ -79,7 +90,7 @@ def run_method(method: str, arm, goal_cell: int, trajs: Sequence[Trajectory] | N
     from armtransfer.experiments import fastloop  # MuJoCo from numba: imported when a run needs it
 
     steps_by = fastloop.episode_steps(arm)
-    for trial in range(trials):
+    for trial in range(first_trial, first_trial + trials):
         if noise > 0.0:  # the arm's own stream, trial by trial (the learner's is trial_rng(seed, trial))
             arm.seed_noise(trial_rng(seed, trial, stream=NOISE_STREAM))
         out.trials.append(linear.learn(arm, goal_cell, coding, config, trial_rng(seed, trial), shaping, lin, steps_by))

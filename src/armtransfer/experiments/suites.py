@@ -36,6 +36,11 @@ cells every parameter of this package was chosen on, ``research/select_defaults.
 
 DEFAULT_WORLD = "rooms"
 
+STATES = ("discrete", "continuous")
+"""What robot 2's state is in a case: ``discrete`` (its compiled table, learned by the tabular
+SARSA(lambda)) or ``continuous`` (an arm's joint configuration with MuJoCo at every move, learned
+by the linear learner over tile coding: ``armtransfer.transfer(..., state="continuous")``'s)."""
+
 
 @dataclass(frozen=True)
 class Case:
@@ -53,6 +58,19 @@ class Case:
     world: str = "rooms"
     """The world the robots move in: a name ``armtransfer.worlds.resolve.world`` knows (``rooms``,
     the paper's; ``rooms11``, ``rooms15``, ``generated:SEED[:SIDE]``)."""
+    state: str = "discrete"
+    """Robot 2's state (``STATES``): ``continuous`` runs the target arm's continuous counterpart
+    (``tasks.continuous.continuous_arm(target)``); robot 1 stays table-based either way."""
+    noise: float = 0.0
+    """A continuous target's actuation noise sigma (``ik.continuous``); 0 for a discrete one."""
+
+    def __post_init__(self) -> None:
+        if self.state not in STATES:
+            raise InvalidParameterError(f"unknown state {self.state!r}; valid states: {', '.join(STATES)}")
+        if self.state == "discrete" and self.noise:
+            raise InvalidParameterError("noise (actuation noise) applies to a continuous target; valid noise: 0")
+        if self.state == "continuous" and self.wind:
+            raise InvalidParameterError("a continuous target has no wind; valid wind: 0")
 
     @property
     def label(self) -> str:
@@ -64,7 +82,10 @@ class Case:
             task += f" on {self.cells} cells"
         wind = f", wind {self.wind:g}" if self.wind else ""
         world = f", in {self.world}" if self.world != DEFAULT_WORLD else ""
-        return f"{self.source} -> {self.target}, {task}{wind}{world}"
+        target = self.target
+        if self.state == "continuous":
+            target += " continuous" + (f" (noise {self.noise:g})" if self.noise else "")
+        return f"{self.source} -> {target}, {task}{wind}{world}"
 
 
 DEFAULT_LEARNERS = ("sarsa",)
@@ -95,6 +116,8 @@ class Section:
         for case in out["cases"]:  # a case of the default world keeps the bytes it had before worlds
             if case["world"] == DEFAULT_WORLD:
                 del case["world"]
+            if case["state"] == "discrete":  # a discrete case keeps the bytes it had before states
+                del case["state"], case["noise"]
         if self.learners == DEFAULT_LEARNERS:
             del out["learners"]
         else:
@@ -186,6 +209,20 @@ VOXELS = Section(
      Case("ur5e_like:joint", "panda_like:joint", 2, world="rooms11")),
     source_seeds=10, trials=ARM_TRIALS, max_total_steps=1_000_000, methods=("none", "pseudo"))
 
+CONTINUOUS_CAP = 300_000
+"""The step cap of a continuous target's trial (``voxels-continuous``): every move runs MuJoCo
+(and, with actuation noise, the Python loop), so a trial costs far more per step than a
+table-based one."""
+
+VOXELS_CONTINUOUS = Section(
+    "voxels-continuous", "the voxels cases with a continuous target: the joint robot's arm in its joint "
+    "configuration with MuJoCo at every move, actuation noise 0.1, learned by linear SARSA(lambda) over hashed "
+    "tiles; robot 1 is table-based: planar2:joint -> ur5e_like (6 joints), ur5e_like:joint -> panda_like "
+    "(7 joints), rooms11 task 2; none and pseudo",
+    (Case("planar2:joint", "ur5e_like:joint", 2, world="rooms11", state="continuous", noise=0.1),
+     Case("ur5e_like:joint", "panda_like:joint", 2, world="rooms11", state="continuous", noise=0.1)),
+    source_seeds=10, trials=ARM_TRIALS, max_total_steps=CONTINUOUS_CAP, methods=("none", "pseudo"))
+
 SUITES: dict[str, Suite] = {
     s.name: s
     for s in (
@@ -198,7 +235,9 @@ SUITES: dict[str, Suite] = {
         Suite("dev", 3, False, DEV.description, (DEV,)),
         Suite("fast", 2, False, FAST.description, (FAST,)),
         Suite("small", 1, True, SMALL.description, (SMALL,)),
-        Suite("voxels", 1, True, VOXELS.description, (VOXELS,)),
+        Suite("voxels", 2, True, "arms moving their joints over the 3D workspace of rooms11, table-based and "
+              "continuous targets: " + VOXELS.description + "; " + VOXELS_CONTINUOUS.description,
+              (VOXELS, VOXELS_CONTINUOUS)),
     )
 }
 """Every suite by name."""
