@@ -14,6 +14,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import types
 from pathlib import Path
 
 import numpy as np
@@ -271,3 +272,49 @@ def test_a_ray_cluster_by_address_gives_the_same_bytes(whole, tmp_path, monkeypa
     assert _run_files(out) == _run_files(whole)
     for name in REPORT:
         assert (out / name).read_bytes() == (whole / name).read_bytes(), name
+
+
+class _InlineRay:
+    """Ray's calls that ``run_ray`` makes, done in this process: enough to see which robots a
+    task is handed, without starting Ray."""
+
+    def is_initialized(self):
+        return True
+
+    def put(self, value):
+        return ("ref", value)
+
+    def remote(self, **options):
+        def wrap(f):
+            def call(run, robots, fn):
+                return ("done", f(run, {key: ref[1] for key, ref in dict.items(robots)}, fn))
+            return types.SimpleNamespace(remote=call)
+        return wrap
+
+    def wait(self, pending, num_returns=1):
+        return pending[:num_returns], pending[num_returns:]
+
+    def get(self, ref):
+        return ref[1]
+
+    def shutdown(self):
+        pass
+
+
+def test_ray_tasks_get_the_robots_of_a_case_in_another_world(monkeypatch):
+    """A benchmark's robots are keyed by spec in their world ('coarse in rooms11'); a Ray task
+    of such a run is handed them (it used to look them up by the bare spec, a KeyError)."""
+    from armtransfer.parallel import executors
+
+    monkeypatch.setattr(executors, "_import_ray", lambda: _InlineRay())
+    robots = {"coarse in rooms11": grid_robot("coarse"), "fine in rooms11": grid_robot("fine"),
+              "fine": grid_robot("fine")}
+    runs = [{"source": "coarse", "target": "fine", "world": "rooms11", "n": 0}]
+    seen, failed = [], []
+
+    def fn(run, handed):
+        return tuple(sorted(handed)), 0.0
+
+    executors.run_ray(runs, robots, 1, None, lambda run, result, secs: seen.append(result),
+                      lambda run, why, tries: failed.append(why), fn=fn)
+    assert failed == [] and seen == [("coarse in rooms11", "fine", "fine in rooms11")]

@@ -189,7 +189,7 @@ def run_ray(
         futures = {}
 
         def submit(run: dict):
-            needed = {run["source"]: refs[run["source"]], run["target"]: refs[run["target"]]}
+            needed = {key: refs[key] for key in _robots_for([run], robots)}
             ref = remote_execute.remote(run, _RobotRefs(needed), fn)
             futures[ref] = run
             return ref
