@@ -76,7 +76,51 @@ def clearance_cells(layout) -> np.ndarray:
     return dist.reshape(-1)
 
 
-class ContinuousArm:
+class NoisyJointMoves:
+    """Actuation noise of an arm's joint moves: each move turns delta * (1 + eps), eps drawn from
+    the arm's own generator (:meth:`seed_noise`) in buffers of NOISE_BUFFER, Normal(0, noise^2)
+    clipped to [-NOISE_CLIP, NOISE_CLIP]; :meth:`noiseless` turns it off for a roll-out. The arm
+    sets ``noise`` and ``_noisy``."""
+
+    noise: float
+    _noisy: bool
+    _rng: np.random.Generator
+    _eps: list[float]
+    _k: int
+
+    def seed_noise(self, rng: np.random.Generator) -> None:
+        """Draw the actuation noise from ``rng`` from now on (nothing is drawn when sigma is 0)."""
+        if not isinstance(rng, np.random.Generator):
+            raise ArmModelError(f"the noise generator must be a numpy.random.Generator, got {rng!r}")
+        self._rng, self._eps, self._k = rng, [], 0
+
+    def _next_eps(self) -> float:
+        k = self._k
+        if k >= len(self._eps):
+            self._eps = np.clip(self._rng.normal(0.0, self.noise, NOISE_BUFFER), -NOISE_CLIP, NOISE_CLIP).tolist()
+            k = 0
+        self._k = k + 1
+        return self._eps[k]
+
+    def noiseless(self) -> "_Noiseless":
+        """A context in which the moves have no noise (a greedy path's roll-out: reset first,
+        the moves are then the lattice's from the start); no draw is taken inside it."""
+        return _Noiseless(self)
+
+
+class _Noiseless:
+    def __init__(self, arm: NoisyJointMoves) -> None:
+        self.arm, self.was = arm, arm._noisy
+
+    def __enter__(self) -> NoisyJointMoves:
+        self.arm._noisy = False
+        return self.arm
+
+    def __exit__(self, *exc: object) -> None:
+        self.arm._noisy = self.was
+
+
+class ContinuousArm(NoisyJointMoves):
     """A planar arm in its table scene, moved by joint increments of ``step`` radians.
 
     ``q`` is the configuration (a view of MuJoCo's ``qpos``: read it, never write it),
@@ -269,40 +313,6 @@ class ContinuousArm:
         if self._noisy:
             return tuple(self._qpos.tolist())
         return tuple(self._n)
-
-    # ------------------------------------------------------------------ actuation noise
-
-    def seed_noise(self, rng: np.random.Generator) -> None:
-        """Draw the actuation noise from ``rng`` from now on (nothing is drawn when sigma is 0)."""
-        if not isinstance(rng, np.random.Generator):
-            raise ArmModelError(f"the noise generator must be a numpy.random.Generator, got {rng!r}")
-        self._rng = rng
-        self._eps = []
-        self._k = 0
-
-    def _next_eps(self) -> float:
-        k = self._k
-        if k >= len(self._eps):
-            self._eps = np.clip(self._rng.normal(0.0, self.noise, NOISE_BUFFER), -NOISE_CLIP, NOISE_CLIP).tolist()
-            k = 0
-        self._k = k + 1
-        return self._eps[k]
-
-    class _Noiseless:
-        def __init__(self, arm: "ContinuousArm") -> None:
-            self.arm, self.was = arm, arm._noisy
-
-        def __enter__(self) -> "ContinuousArm":
-            self.arm._noisy = False
-            return self.arm
-
-        def __exit__(self, *exc: object) -> None:
-            self.arm._noisy = self.was
-
-    def noiseless(self) -> "ContinuousArm._Noiseless":
-        """A context in which the moves have no noise (a greedy path's roll-out: reset first,
-        the moves are then the lattice's from the start); no draw is taken inside it."""
-        return ContinuousArm._Noiseless(self)
 
     # ------------------------------------------------------------------ moving
 

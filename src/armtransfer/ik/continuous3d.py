@@ -35,7 +35,7 @@ import numpy as np
 
 from armtransfer.errors import ArmModelError, InvalidCellError, UnreachableTableError
 from armtransfer.ik.compile import joint_box
-from armtransfer.ik.continuous import BLOCKED, MAX_NOISE, NOISE_BUFFER, NOISE_CLIP
+from armtransfer.ik.continuous import BLOCKED, MAX_NOISE, NoisyJointMoves
 from armtransfer.ik.scene import ArmScene, ContactChecker
 from armtransfer.ik.voxels import (SpatialFK, _move_clear, choose_step, moved_joints, spatial_origin,
                                    voxel_of_point, workspace_voxels)
@@ -46,7 +46,7 @@ IK_RESTARTS = 8
 """Random starts (a fixed seed) tried after the one from the origin."""
 
 
-class SpatialContinuousArm:
+class SpatialContinuousArm(NoisyJointMoves):
     """A spatial arm in its table scene, moved by turns of ``step`` radians of three of its joints.
 
     The interface of ``ik.continuous.ContinuousArm`` that the linear learner, the runs and the
@@ -225,37 +225,6 @@ class SpatialContinuousArm:
             dq = J.T @ np.linalg.solve(J @ J.T + (0.01 ** 2) * np.eye(3), err)
             qm = np.clip(qm + np.clip(dq, -0.2, 0.2), self._lo, self._hi)
         return None
-
-    # ------------------------------------------------------------------ actuation noise
-
-    def seed_noise(self, rng: np.random.Generator) -> None:
-        """Draw the actuation noise from ``rng`` from now on (nothing is drawn when sigma is 0)."""
-        if not isinstance(rng, np.random.Generator):
-            raise ArmModelError(f"the noise generator must be a numpy.random.Generator, got {rng!r}")
-        self._rng, self._eps, self._k = rng, [], 0
-
-    def _next_eps(self) -> float:
-        k = self._k
-        if k >= len(self._eps):
-            self._eps = np.clip(self._rng.normal(0.0, self.noise, NOISE_BUFFER), -NOISE_CLIP, NOISE_CLIP).tolist()
-            k = 0
-        self._k = k + 1
-        return self._eps[k]
-
-    class _Noiseless:
-        def __init__(self, arm: "SpatialContinuousArm") -> None:
-            self.arm, self.was = arm, arm._noisy
-
-        def __enter__(self) -> "SpatialContinuousArm":
-            self.arm._noisy = False
-            return self.arm
-
-        def __exit__(self, *exc: object) -> None:
-            self.arm._noisy = self.was
-
-    def noiseless(self) -> "SpatialContinuousArm._Noiseless":
-        """A context in which the moves have no noise (reset first: the moves are the lattice's)."""
-        return SpatialContinuousArm._Noiseless(self)
 
     # ------------------------------------------------------------------ moving
 
