@@ -121,3 +121,32 @@ def test_the_environments_with_a_spatial_arm_pass_check_env(env_id):
         if terminated:
             break
     assert len(labels) > 1
+
+
+@pytest.mark.slow  # 5-6 s: the default suite is near its budget
+def test_a_bring_your_own_7_joint_file_learns_in_its_continuous_joint_space(tmp_path):
+    """A Menagerie-style iiwa file (7 joints, its own servos, the mount chosen by the compiler)
+    as a continuous target under actuation noise 0.1: every trial of none and pseudo reaches the
+    goal of rooms11 task 2 from planar2:joint's learned path."""
+    import sys
+    from pathlib import Path
+
+    from armtransfer.api import resolve_trajectories
+    from armtransfer.learning.config import LearnerConfig
+    from armtransfer.tasks.arms import robot
+    from armtransfer.tasks.catalog import world_task
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    import menagerie_like as ml
+
+    xml = ml.iiwa_style(tmp_path)
+    traj = resolve_trajectories(["learned"], robot("planar2:joint", layout=SMALL), world_task(SMALL, "2"),
+                                LearnerConfig(), 0)[0]
+    r = armtransfer.transfer("planar2:joint", "custom", arm_xml=xml, arm_options=dict(ml.SUGGESTED["iiwa"]),
+                             state="continuous", world="rooms11", task="2", noise=0.1, methods=["none", "pseudo"],
+                             trials=2, max_total_steps=20_000, trajectory=traj)
+    out = r.to_json()
+    assert r.target == "custom (continuous)" and out["approximation"]["table_bits"] == 18  # hashed: spatial
+    for m in ("none", "pseudo"):
+        steps = out["results"][m]["exploration_steps"]
+        assert len(steps) == 2 and all(s is not None and s > 0 for s in steps), (m, steps)
