@@ -80,6 +80,7 @@ def test_panda_with_hand_by_body_and_offset(panda):
     assert _solved(panda) == 4
 
 
+@pytest.mark.slow  # 7 s for the so100 file alone
 def test_so100_style_by_fixed_jaw_and_offset(so100):
     assert so100.name == "so_arm100:cartesian"
     # the arm's joints are those that move the tip: the Jaw, below the tip body, is not one
@@ -116,7 +117,7 @@ def test_planar5_straight_joint_model_automatic_mount(files):
     assert tasks_solvable(r, [TABLE_I[1]]) == 1
 
 
-@pytest.mark.parametrize("which, reach, solved", [("ur5e", 0.8, 4), ("so100", 0.6, 3)])
+@pytest.mark.parametrize("which, reach, solved", [("ur5e", 0.8, 4), pytest.param("so100", 0.6, 3, marks=pytest.mark.slow)])
 def test_an_explicit_mount_is_the_file_frame_pose(files, which, reach, solved):
     # base_pos/base_yaw place the file's own frame: the SO100-style arm stands on a body 1.5 m
     # from that frame, and its suggested mount brings the base beside the table
@@ -173,7 +174,7 @@ def test_transfer_both_ways_between_menagerie_style_arms(ur5e, panda):
         assert any(s is not None for s in r.methods["pseudo"].column("exploration_steps"))
 
 
-@pytest.mark.parametrize("which", ["ur5e", "panda", "so100"])
+@pytest.mark.parametrize("which", ["ur5e", "panda", pytest.param("so100", marks=pytest.mark.slow)])
 def test_physics_replay_reaches_the_goal(request, which):
     from armtransfer.ik.replay import replay
 

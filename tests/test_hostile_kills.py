@@ -208,7 +208,7 @@ def _kill_a_starting_worker(tmp_path: Path, delay: float) -> str:
     return out
 
 
-@pytest.mark.parametrize("delay", [0.0, 0.4])
+@pytest.mark.parametrize("delay", [0.0, pytest.param(0.4, marks=pytest.mark.slow)])  # 5 s each
 def test_a_worker_killed_while_it_starts_costs_a_retry(tmp_path, delay):
     """Killed as it starts (0 s: the interpreter is coming up) or as it imports or takes the
     robots: the driver sees the death, gives the run to a fresh worker, and finishes. The
