@@ -32,6 +32,7 @@ from armtransfer.errors import ArmTransferError, InvalidParameterError, InvalidT
 from armtransfer.experiments import benchmark_runs, experiment, suites
 from armtransfer.learning import methods
 from armtransfer.learning import presets
+from armtransfer.learning.learner_names import AT as AT, label as label, parse_label as parse_label
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.tasks.catalog import table_task
 from armtransfer.tasks.robot import DiscreteRobot
@@ -46,22 +47,6 @@ DRAWS = 1000
 SOURCE_CONFIG = LearnerConfig()
 """Robot 1 learns with the learner's defaults (its own step cap), whatever a section caps
 robot 2's trials at."""
-
-
-AT = "@"
-"""A record of an outside learner's trials is labelled ``METHOD@LEARNER`` (``pseudo@dqn``); the
-built-in learner's keep the method's name alone, so its records are the bytes they were."""
-
-
-def label(method: str, learner: str = benchmark_runs.LEARNER) -> str:
-    """The name a record of ``method`` run by ``learner`` goes by in the records and the report."""
-    return method if learner == benchmark_runs.LEARNER else f"{method}{AT}{learner}"
-
-
-def parse_label(name: str) -> tuple[str, str]:
-    """(method, learner) of a record's name (:func:`label`)."""
-    method, _, learner = name.partition(AT)
-    return method, learner or benchmark_runs.LEARNER
 
 
 def baselines_of(name: str) -> tuple[str, ...]:

@@ -36,6 +36,7 @@ from armtransfer.experiments.stats import learning_metrics
 from armtransfer.experiments.sweep import content_key
 from armtransfer.learning import methods
 from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.learner_names import SARSA
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.robot import DiscreteRobot
 
@@ -43,7 +44,7 @@ SOURCE_FORMAT = "armtransfer-benchmark-source/1"
 TRIAL_FORMAT = "armtransfer-benchmark-trial/1"
 FORMATS = (SOURCE_FORMAT, TRIAL_FORMAT)
 
-LEARNER = "sarsa"
+LEARNER = SARSA
 """The built-in learner: SARSA(lambda), Algorithm 1 with the method's shaping."""
 
 

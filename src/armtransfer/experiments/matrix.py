@@ -26,6 +26,7 @@ import numpy as np
 from armtransfer.errors import InvalidParameterError
 from armtransfer.experiments import sweep as sweeps
 from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.learner_names import SARSA, label, parse_label
 from armtransfer.learning.methods import with_baselines
 from armtransfer.experiments.reports.report import markdown_table
 
@@ -53,7 +54,7 @@ def family(spec: str) -> str:
 def matrix_spec(robots: Sequence[str], tasks: Sequence[int | str], methods: Sequence[str], trials: int,
                 seeds: Sequence[int] = (0,), trajectory: str = "learned", name: str = "matrix",
                 arms: dict | None = None, world: str | None = None, preset: str = "default",
-                learners: Sequence[str] = ("sarsa",), max_total_steps: int | None = None) -> dict:
+                learners: Sequence[str] = (SARSA,), max_total_steps: int | None = None) -> dict:
     """The sweep of every ordered pair of ``robots`` (each robot to itself too); ``arms`` names
     bring-your-own arms as a sweep file's ``[arms.NAME]`` tables do (``NAME[:ACTIONS]`` robots);
     ``world`` is the sweep's world (the paper's rooms when None); ``preset`` the learner's
@@ -76,7 +77,7 @@ def matrix_spec(robots: Sequence[str], tasks: Sequence[int | str], methods: Sequ
         raw["arms"] = arms
     if world is not None:
         raw["sweep"]["world"] = world
-    if list(learners) != ["sarsa"]:  # sarsa alone: the spec (and its store's key) it was before learners
+    if list(learners) != [SARSA]:  # sarsa alone: the spec (and its store's key) it was before learners
         raw["sweep"]["learner"] = list(learners)
     if max_total_steps is not None:
         raw["sweep"]["max_total_steps"] = max_total_steps
@@ -86,7 +87,7 @@ def matrix_spec(robots: Sequence[str], tasks: Sequence[int | str], methods: Sequ
 def matrix_sweep(robots: Sequence[str], tasks: Sequence[int | str], methods: Sequence[str], trials: int,
                  seeds: Sequence[int] = (0,), trajectory: str = "learned", name: str = "matrix",
                  arms: dict | None = None, world: str | None = None, preset: str = "default",
-                 learners: Sequence[str] = ("sarsa",), max_total_steps: int | None = None) -> sweeps.Sweep:
+                 learners: Sequence[str] = (SARSA,), max_total_steps: int | None = None) -> sweeps.Sweep:
     spec = matrix_spec(robots, tasks, methods, trials, seeds, trajectory, name, arms, world, preset, learners,
                        max_total_steps)
     return sweeps.Sweep(spec["name"], spec, tuple(sweeps.expand(spec)))
@@ -109,12 +110,6 @@ def _steps(values: list, cap: int) -> np.ndarray:
     return np.array([cap if v is None else v for v in values], dtype=float)
 
 
-def label(method: str, learner: str = "sarsa") -> str:
-    """A cell's method: ``pseudo``; ``pseudo@tabular-q`` when an outside learner ran it (its
-    baseline is then ``none@tabular-q``, the none that learner ran)."""
-    return method if learner == "sarsa" else f"{method}@{learner}"
-
-
 def cells(records: list[dict], cap: int = LearnerConfig().max_total_steps) -> list[Cell]:
     """Every (source, target, method) cell of the finished runs in a store (a trial that never
     reached the goal counts at its run's ``max_total_steps``, ``cap`` when the run names none)."""
@@ -122,14 +117,14 @@ def cells(records: list[dict], cap: int = LearnerConfig().max_total_steps) -> li
     for rec in records:
         cfg = rec["config"]
         task = (cfg["task"], tuple(cfg["start"]), tuple(cfg["goal"]))
-        key = (cfg["source"], cfg["target"], label(cfg["method"], cfg.get("learner", "sarsa")), task)
+        key = (cfg["source"], cfg["target"], label(cfg["method"], cfg.get("learner", SARSA)), task)
         entry = by.setdefault(key, {"steps": [], "cap": int(cfg.get("max_total_steps", cap))})
         entry["steps"].extend(rec["result"]["exploration_steps"])
     rng = np.random.default_rng(BOOTSTRAP_SEED)
     out = []
-    combos = sorted({(s, t, m) for s, t, m, _ in by if m.partition("@")[0] != "none"})
+    combos = sorted({(s, t, m) for s, t, m, _ in by if parse_label(m)[0] != "none"})
     for source, target, method in combos:
-        none = label("none", method.partition("@")[2] or "sarsa")
+        none = label("none", parse_label(method)[1])
         tasks = sorted({k[3] for k in by if k[:3] == (source, target, method)
                         and (source, target, none, k[3]) in by}, key=repr)
         if not tasks:
@@ -202,8 +197,8 @@ def markdown(all_cells: list[Cell], robots: list[str]) -> str:
     for method in sorted({c.method for c in all_cells}):
         at = {(c.source, c.target): c for c in all_cells if c.method == method}
         rows = [[s, *(_fmt(at.get((s, t))) for t in robots)] for s in robots]
-        by = method.partition("@")[2]
-        parts.append(f"### {method}: improvement over no transfer{f' (none@{by})' if by else ''} (source rows, "
+        none = label("none", parse_label(method)[1])
+        parts.append(f"### {method}: improvement over no transfer{f' ({none})' if none != 'none' else ''} (source rows, "
                      "target columns)\n\n"
                      + markdown_table(["source \\ target", *robots], rows))
     fam = family_rows(all_cells)

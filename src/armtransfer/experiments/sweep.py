@@ -68,6 +68,7 @@ from armtransfer.learning import methods as _methods
 from armtransfer.learning import presets as _presets
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.lazy_registry import Names
+from armtransfer.learning.learner_names import SARSA
 
 RUN_FORMAT = "armtransfer-run/1"
 METHODS = Names(_methods.METHODS, lambda name, m: not m.macros)
@@ -292,8 +293,6 @@ def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, ba
 _OPTIONAL = ("world", "learner", "max_total_steps")
 """Keys a sweep file may give that its spec holds only when given (or, for ``learner``, when not
 the default): a sweep without them keeps the spec, and its store the key, it had before them."""
-
-SARSA = "sarsa"
 
 
 def _learners(body: dict, spec: dict, where: str) -> None:

@@ -34,6 +34,7 @@ import gymnasium
 
 from armtransfer.errors import InvalidParameterError, PluginError
 from armtransfer.learning.lazy_registry import Registry, read_entry_points
+from armtransfer.learning.learner_names import SARSA as SARSA  # the built-in learner's name
 
 GROUP = "armtransfer.learners"
 """The entry-point group installed packages declare their learners under."""
@@ -43,8 +44,6 @@ RUN_TIME = "registered at run time"
 
 BUILTIN_ORIGIN = "armtransfer"
 
-SARSA = "sarsa"
-"""The built-in learner's name."""
 
 
 class Model(Protocol):

@@ -17,17 +17,17 @@ from armtransfer.learning.config import LearnerConfig
 from armtransfer.experiments.reports.report import (CAP_NOTE, fmt_ci, fmt_improvement, fmt_mean, fmt_num, markdown_table,
                                           median_column)
 from armtransfer.experiments.sweep import group_key
+from armtransfer.learning.learner_names import SARSA, label, parse_label
 
 
-def _at(cfg: dict) -> str:
-    """``@LEARNER`` for a run of an outside learner (the benchmark's labels), else nothing."""
-    learner = cfg.get("learner", "sarsa")
-    return "" if learner == "sarsa" else f"@{learner}"
+def _learned(method: str, cfg: dict) -> str:
+    """``method`` as a run of ``cfg``'s learner is labelled (``pseudo``; ``pseudo@tabular-q``)."""
+    return label(method, cfg.get("learner", SARSA))
 
 
 def _method_label(cfg: dict) -> str:
     """``pseudo``, ``pseudo (K=0.1)``; ``pseudo@tabular-q`` for an outside learner's run."""
-    method = cfg["method"] + _at(cfg)
+    method = _learned(cfg["method"], cfg)
     return method if cfg["K"] in (None, "auto") else f"{method} (K={cfg['K']})"
 
 
@@ -49,7 +49,7 @@ def summarize(records: list[dict]) -> list[dict]:
         for label in sorted(cols, key=lambda m: (m != "none", m)):
             col = cols[label]
             cfg = col["config"]
-            baseline = "none" + _at(cfg)  # the none its learner ran
+            baseline = _learned("none", cfg)  # the none its learner ran
             base = cols.get(baseline)
             cap = int(cfg.get("max_total_steps", LearnerConfig.max_total_steps))
             st = metrics.exploration_stats(col["exploration_steps"], cap)
@@ -123,7 +123,7 @@ def summary_markdown(rows: list[dict]) -> str:
         _task_name(r), f"{r['source']} -> {r['target']}", f"{r['wind']:g}", f"{r['epsilon']:g}", f"{r['lam']:g}",
         r["method"], f"{r['reached']}/{r['trials']}", f"{fmt_mean(r)} {fmt_ci(r['ci95'])}",
         median_cell(r),
-        "" if r["method"].partition("@")[0] == "none" else f"{fmt_improvement(r)} {fmt_ci(r['improvement_ci95'])}",
+        "" if parse_label(r["method"])[0] == "none" else f"{fmt_improvement(r)} {fmt_ci(r['improvement_ci95'])}",
         fmt_num(r["greedy_mean"]), f"{r['converged']}/{r['trials']}",
     ] for r in rows]
     table = markdown_table(header, body)
