@@ -36,6 +36,7 @@ import mujoco
 import numpy as np
 
 from armtransfer.errors import ArmModelError, UnreachableTableError
+from armtransfer.ik.compile import _progress
 from armtransfer.ik.labels import cells_of_xy
 from armtransfer.ik.scene import ArmScene, ContactChecker
 from armtransfer.ik.seeds import _cells_by_distance
@@ -257,9 +258,3 @@ def _move_clear(contact: ContactChecker, fk: SpatialFK, qa, qb, pa, pb, cell: fl
             return False
     return True
 
-
-def _progress(enabled: bool, text: str) -> None:
-    if enabled:
-        import sys
-
-        print(text, file=sys.stderr, flush=True)
