@@ -206,8 +206,6 @@ def summarize(records: list[dict]) -> dict:
     for section, sec in out.items():
         if any(case["source_failures"] for case in sec["cases"]):
             sec["with_trajectory"] = with_trajectory(section, by_cell)
-            if any(r.get("told_nothing") for r in records if r["section"] == section):
-                sec["with_trajectory"]["told_nothing"] = True
     tested = [v for v in verdicts if v["p"] is not None]
     for v, adj in zip(tested, multiplicity.holm([v["p"] for v in tested])):
         v["p_holm"] = adj
@@ -238,7 +236,7 @@ def _pairings(section: str, name: str, by_cell: dict,
 def with_trajectory(section: str, by_cell: dict) -> dict:
     """The stratum of a section's (case, source seed) pairs on which robot 1 converged and
     handed a trajectory over: ``{"pairs", "of", "pooled": {name: {baseline: {metric: factor}}}}``
-    (and ``told_nothing``, set by the caller, when the records ran their baselines there).
+    (and ``told_nothing`` when the records ran their baselines there).
     On the other pairs every method that needs a trajectory learned as its baseline told nothing
     (records written before that rule: counted as failed); the claims keep them, and this says
     what the methods did where there was something to transfer. It is a
@@ -254,4 +252,5 @@ def with_trajectory(section: str, by_cell: dict) -> dict:
                 {k: dict(compare(cases, k), p_holm=None, verdicts=0) for k in METRICS}, baseline=base)
     pairs = {(c, r["source_seed"]): r["source_failure"] is None for (s, c, _), recs in by_cell.items()
              if s == section for r in recs}
-    return {"pairs": sum(pairs.values()), "of": len(pairs), "pooled": pooled}
+    told = any(r.get("told_nothing") for (s, _, _), recs in by_cell.items() if s == section for r in recs)
+    return {"pairs": sum(pairs.values()), "of": len(pairs), "pooled": pooled, **({"told_nothing": True} if told else {})}
