@@ -123,6 +123,66 @@ def test_the_reaper_stops_what_the_sweep_started_that_it_was_never_told_of():
         assert settle(driver.pid, 5) == []
 
 
+DAEMON = """
+import os, subprocess, sys, time
+from armtransfer.parallel.reaper import Reaper
+reaper = Reaper()
+time.sleep(1.5)  # the watcher has looked: what starts next, it has not seen
+leave = ("import os, subprocess, sys; p = subprocess.Popen([sys.executable, '-c', 'import time; "
+         "time.sleep(120)'], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL); print(p.pid, flush=True); os._exit(0)")
+middle = subprocess.run([sys.executable, "-c", leave], capture_output=True, text=True)
+print(middle.stdout.strip(), flush=True)
+time.sleep(120)
+"""
+
+
+def test_the_reaper_stops_a_process_that_left_the_sweep_before_it_looked():
+    """A process whose parent ended at once (it is PID 1's from its first moment) and that the
+    watcher never saw below the sweep still carries the sweep's mark, and goes with it."""
+    driver = subprocess.Popen([sys.executable, "-c", DAEMON], stdout=subprocess.PIPE, text=True,
+                              start_new_session=True)
+    try:
+        orphan = int(driver.stdout.readline())
+        assert _killed_takes(driver, orphan), "a process that left the sweep's tree outlived it"
+    finally:
+        assert settle(driver.pid, 5) == []
+
+
+FORKER = """
+import os, subprocess, sys, time
+from armtransfer.parallel.reaper import Reaper
+reaper = Reaper()
+forker = ("import os, time\\n"
+          "for _ in range(1000):\\n"
+          "    if os.fork() == 0:\\n"
+          "        time.sleep(120); os._exit(0)\\n"
+          "    time.sleep(0.003)\\n"
+          "time.sleep(120)")
+subprocess.Popen([sys.executable, "-c", forker])
+print("started", flush=True)
+time.sleep(120)
+"""
+
+
+def test_the_reaper_stops_what_starts_while_it_kills():
+    """A process that starts others without pause (as a raylet starts workers) cannot start
+    one the watcher does not see between its last look and its kill: it stops them first."""
+    driver = subprocess.Popen([sys.executable, "-c", FORKER], stdout=subprocess.PIPE, text=True,
+                              start_new_session=True)
+    try:
+        driver.stdout.readline()
+        time.sleep(1.2)  # forking, a fork every few ms, past the watcher's first look
+        os.kill(driver.pid, signal.SIGKILL)
+        driver.wait()
+        deadline = time.time() + 10
+        while time.time() < deadline and session(driver.pid):
+            time.sleep(0.05)
+        left = session(driver.pid)
+    finally:
+        settle(driver.pid, 0)
+    assert left == [], f"{len(left)} processes outlived the sweep"
+
+
 def _dies_on_first(run, robots):
     """A worker that dies at once the first time it runs (a marker file says it did)."""
     marker = Path(os.environ["HOSTILE_MARKER"])

@@ -13,6 +13,14 @@ lists every process the sweep starts from then on (and the pids it is told), and
 pipe from the sweep. When the sweep says ``done`` (it stopped them itself) the watcher just
 exits; when the pipe closes without it (the sweep died), the watcher kills those processes
 and every process they started.
+
+Two races are closed at that moment. A process the sweep started since the watcher's last look,
+whose parent then died, belongs to PID 1 and is below no listed process: while the watcher
+lives, the sweep's environment carries :data:`MARK` with the watcher's own token, which every
+process started from then on inherits, and the watcher kills what carries it. And a listed
+process may start another between the watcher's look and its kill (a raylet starting a
+worker): the watcher first stops (SIGSTOP) what it found, looks again, stops what is new, until
+a look finds nothing new, and only then kills them all.
 """
 
 from __future__ import annotations
@@ -28,6 +36,8 @@ from typing import IO
 from pathlib import Path
 
 DONE = "done"
+MARK = "ARMTRANSFER_REAPER"
+"""The environment variable that names the watcher whose sweep started a process."""
 
 
 def _stat(pid: int) -> list[str] | None:
@@ -69,6 +79,8 @@ class Reaper:
                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         assert self.proc.stdin is not None  # stdin=PIPE always opens it
         self.stdin: IO[str] = self.proc.stdin
+        self._before = os.environ.get(MARK)
+        os.environ[MARK] = token(self.proc.pid) or ""  # every process started from now on carries it
 
     def watch(self, pids) -> None:
         for pid in pids:
@@ -85,7 +97,58 @@ class Reaper:
             self.stdin.close()
         except OSError:
             pass
+        if self._before is None:
+            os.environ.pop(MARK, None)
+        else:
+            os.environ[MARK] = self._before
         self.proc.wait()
+
+
+def token(pid: int) -> str | None:
+    """The mark of the watcher ``pid``: its pid and start time."""
+    start = start_time(pid)
+    return f"{pid}:{start}" if start is not None else None
+
+
+def carrying(mark: str) -> set[int]:
+    """Every process whose environment has ``MARK=mark`` (those of other users are not read)."""
+    needle = f"{MARK}={mark}".encode() + b"\0"
+    out = set()
+    for entry in Path("/proc").glob("[0-9]*"):
+        try:
+            environ = (entry / "environ").read_bytes()
+        except OSError:
+            continue
+        if (b"\0" + environ).find(b"\0" + needle) >= 0:
+            out.add(int(entry.name))
+    return out
+
+
+def stop_all(pids: set[int], mark: str, me: int) -> set[int]:
+    """Kill ``pids``, everything below them and everything carrying ``mark``; first stop each
+    one found, and look again until nothing new is found, so that none can start another
+    unseen. Returns the pids killed."""
+    stopped: dict[int, str] = {}
+    for _ in range(100):  # each look finds what the last one's processes started before they stopped
+        found = descendants(pids | set(stopped) | carrying(mark)) - set(stopped) - {me}
+        if not found:
+            break
+        for pid in found:
+            start = start_time(pid)
+            if start is None:
+                continue
+            try:
+                os.kill(pid, signal.SIGSTOP)
+            except (ProcessLookupError, PermissionError):
+                continue
+            stopped[pid] = start
+    for pid, start in stopped.items():
+        if start_time(pid) == start:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except (ProcessLookupError, PermissionError):
+                pass
+    return set(stopped)
 
 
 def children_of(pid: int) -> set[int]:
@@ -102,7 +165,8 @@ def main() -> None:
     :data:`POLL` s, adds those started since: Ray starts its agents after ``init`` returns,
     and a raylet that dies first would leave them to PID 1) and the "PID START" lines it is
     sent; when the pipe closes, unless the last line was ``done``, kill each listed process
-    that still is the one listed, with everything below it."""
+    that still is the one listed, with everything below it and everything carrying its mark
+    (:func:`stop_all`)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # a Ctrl-C to the sweep's group is the sweep's
     import selectors
 
@@ -130,11 +194,7 @@ def main() -> None:
     if last == DONE:
         return
     alive = {pid for pid, start in listed.items() if start_time(pid) == start}
-    for pid in descendants(alive):
-        try:
-            os.kill(pid, signal.SIGKILL)
-        except (ProcessLookupError, PermissionError):
-            pass
+    stop_all(alive, token(me) or "", me)
 
 
 GUARD = """import os
