@@ -4,6 +4,7 @@ driver hands out work costs only a retry; an `arms` run killed mid-way leaves a 
 folder that the next run into the same --out removes. Every test here kills only processes
 it started, and kills whatever it finds left over even when its check fails."""
 
+import contextlib
 import os
 import re
 import signal
@@ -83,16 +84,24 @@ def _killed_takes(driver: subprocess.Popen, pid: int, seconds: float = 10.0) -> 
     return _gone(pid)
 
 
+@contextlib.contextmanager
+def driving(script: str):
+    """A driver running ``script`` in a session of its own; whatever of that session is left
+    when the check ends is killed, and must have been nothing."""
+    driver = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True,
+                              start_new_session=True)
+    try:
+        yield driver
+    finally:
+        assert settle(driver.pid, 5) == []
+
+
 def test_a_guarded_worker_ends_with_its_driver_whatever_it_runs():
     """The guard runs before the worker imports anything: a worker whose own code never looks
     at its parent (here it sleeps for two minutes) still ends when its driver is killed."""
-    driver = subprocess.Popen([sys.executable, "-c", GUARDED], stdout=subprocess.PIPE, text=True,
-                              start_new_session=True)
-    try:
+    with driving(GUARDED) as driver:
         child = int(driver.stdout.readline())
         assert _killed_takes(driver, child), "the worker outlived its killed driver"
-    finally:
-        assert settle(driver.pid, 5) == []
 
 
 REAPED = """
@@ -112,15 +121,11 @@ def test_the_reaper_stops_what_the_sweep_started_that_it_was_never_told_of():
     """Ray starts processes after its init (its agents), whose parent (the raylet) may die
     before them: the watcher lists every process below the sweep while it lives, so such an
     orphan goes too when the sweep is killed."""
-    driver = subprocess.Popen([sys.executable, "-c", REAPED], stdout=subprocess.PIPE, text=True,
-                              start_new_session=True)
-    try:
+    with driving(REAPED) as driver:
         middle, orphan = map(int, driver.stdout.readline().split())
         time.sleep(2.5)  # two of the watcher's looks at least
         os.kill(middle, signal.SIGKILL)  # the parent dies first: its child is PID 1's now
         assert _killed_takes(driver, orphan), "a process the sweep started outlived it"
-    finally:
-        assert settle(driver.pid, 5) == []
 
 
 DAEMON = """
@@ -139,13 +144,9 @@ time.sleep(120)
 def test_the_reaper_stops_a_process_that_left_the_sweep_before_it_looked():
     """A process whose parent ended at once (it is PID 1's from its first moment) and that the
     watcher never saw below the sweep still carries the sweep's mark, and goes with it."""
-    driver = subprocess.Popen([sys.executable, "-c", DAEMON], stdout=subprocess.PIPE, text=True,
-                              start_new_session=True)
-    try:
+    with driving(DAEMON) as driver:
         orphan = int(driver.stdout.readline())
         assert _killed_takes(driver, orphan), "a process that left the sweep's tree outlived it"
-    finally:
-        assert settle(driver.pid, 5) == []
 
 
 FORKER = """
@@ -167,20 +168,11 @@ time.sleep(120)
 def test_the_reaper_stops_what_starts_while_it_kills():
     """A process that starts others without pause (as a raylet starts workers) cannot start
     one the watcher does not see between its last look and its kill: it stops them first."""
-    driver = subprocess.Popen([sys.executable, "-c", FORKER], stdout=subprocess.PIPE, text=True,
-                              start_new_session=True)
-    try:
+    with driving(FORKER) as driver:  # nothing of its session may be left 5 s after the kill
         driver.stdout.readline()
         time.sleep(1.2)  # forking, a fork every few ms, past the watcher's first look
         os.kill(driver.pid, signal.SIGKILL)
         driver.wait()
-        deadline = time.time() + 10
-        while time.time() < deadline and session(driver.pid):
-            time.sleep(0.05)
-        left = session(driver.pid)
-    finally:
-        settle(driver.pid, 0)
-    assert left == [], f"{len(left)} processes outlived the sweep"
 
 
 def _dies_on_first(run, robots):
