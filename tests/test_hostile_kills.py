@@ -168,11 +168,13 @@ time.sleep(120)
 def test_the_reaper_stops_what_starts_while_it_kills():
     """A process that starts others without pause (as a raylet starts workers) cannot start
     one the watcher does not see between its last look and its kill: it stops them first."""
-    with driving(FORKER) as driver:  # nothing of its session may be left 5 s after the kill
+    with driving(FORKER) as driver:
         driver.stdout.readline()
         time.sleep(1.2)  # forking, a fork every few ms, past the watcher's first look
         os.kill(driver.pid, signal.SIGKILL)
         driver.wait()
+        left = settle(driver.pid, 5)
+        assert left == [], f"{len(left)} processes outlived the sweep"
 
 
 def _dies_on_first(run, robots):

@@ -119,15 +119,15 @@ def carrying(mark: str) -> set[int]:
             environ = (entry / "environ").read_bytes()
         except OSError:
             continue
-        if (b"\0" + environ).find(b"\0" + needle) >= 0:
+        if b"\0" + needle in b"\0" + environ:
             out.add(int(entry.name))
     return out
 
 
-def stop_all(pids: set[int], mark: str, me: int) -> set[int]:
+def stop_all(pids: set[int], mark: str, me: int) -> None:
     """Kill ``pids``, everything below them and everything carrying ``mark``; first stop each
     one found, and look again until nothing new is found, so that none can start another
-    unseen. Returns the pids killed."""
+    unseen."""
     stopped: dict[int, str] = {}
     for _ in range(100):  # each look finds what the last one's processes started before they stopped
         found = descendants(pids | set(stopped) | carrying(mark)) - set(stopped) - {me}
@@ -148,7 +148,6 @@ def stop_all(pids: set[int], mark: str, me: int) -> set[int]:
                 os.kill(pid, signal.SIGKILL)
             except (ProcessLookupError, PermissionError):
                 pass
-    return set(stopped)
 
 
 def children_of(pid: int) -> set[int]:
