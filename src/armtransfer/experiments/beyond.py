@@ -33,9 +33,8 @@ WHY_WORSE = {
     "potential": "Phi = i*K on trajectory cells and 0 elsewhere: stepping off the trajectory costs "
     "-i*K. The coarse robot's cells are two apart, so the fine robot must step off between every two "
     "of them, and the cells between look like losses it first learns to avoid.",
-    "first-visit": "the bonus is paid once per cell, so after the first visit a trajectory cell "
-    "looks no better than any other; the agent is pulled to cells in index order only while it "
-    "meets them in that order.",
+    "first-visit": "the bonus is paid once per cell in a trial, so it shapes the first episode "
+    "alone; later episodes learn as without transfer while the values it left behind fade.",
     "progress": "only new maxima of the trajectory index pay; a cell of a high index reached by a "
     "detour takes the reward of every index below it, and the agent can learn to skip ahead "
     "rather than follow the trajectory.",
@@ -92,7 +91,7 @@ def methods_markdown(res: dict) -> str:
         markdown_table(header, rows),
         "",
         "(Nx) = mean exploration steps / the fine robot's optimal distance. Methods new here: "
-        "`first-visit` (the paper's i*K, paid at most once per cell per episode), `potential` "
+        "`first-visit` (the paper's i*K, paid at most once per cell per trial), `potential` "
         "(shaping F = gamma*Phi(s') - Phi(s) with Phi = i*K on trajectory cells), `progress` (only "
         "passing the highest index so far pays), `dense` (a potential over the workspace: "
         "Phi = K*(20*(i*/n - 1) - beta*d), d the straight-line distance to the nearest trajectory cell, "

@@ -19,8 +19,8 @@ trapped in a set of non-goal states. That is what SARSA converges towards, so a 
 K makes the paper's learner loop instead of finishing.
 
 Only ``pseudo`` and ``mapping`` (pseudo rewards plus macros, which change exploration,
-not the optimal Q) can be farmed. ``first-visit`` and ``progress`` pay each cell or each
-gain at most once per episode, so the shaping paid in an episode is bounded by n*K and
+not the optimal Q) can be farmed. ``first-visit`` pays each cell once per trial and ``progress``
+each gain once per episode, so the shaping paid in an episode is bounded by n*K and
 an endless loop earns only step rewards; ``potential`` and ``dense`` are potential-based
 (gamma*phi(s') - phi(s), phi = 0 at the goal), which leaves the optimal policy unchanged
 (Ng, Harada and Russell 1999). :func:`check_k` therefore accepts every K for them.

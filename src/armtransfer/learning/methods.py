@@ -145,7 +145,7 @@ _BUILTIN: dict[str, Method] = {
                paper=True, build=_pseudo, farmable=True, baselines=("none",)),
         Method("mapping", "pseudo plus the action sequence mapping's macros (the paper's III.C)",
                paper=True, build=_pseudo, farmable=True, macros=True, baselines=("none",)),
-        Method("first-visit", "the pseudo reward paid at most once per cell per episode",
+        Method("first-visit", "the pseudo reward paid the first time each trajectory cell is reached in a trial",
                paper=False, build=_first_visit, auto_k=10.0, baselines=("none",)),
         Method("potential", "potential-based shaping with phi = i*K (Ng, Harada and Russell)",
                paper=False, build=_potential, auto_k=3.0, baselines=("none",)),

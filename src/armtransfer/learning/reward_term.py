@@ -1,8 +1,8 @@
 """A transfer method's shaping as a reward term paid move by move, for learners outside the project.
 
 :class:`TransferTerm` holds the shaping arrays the method registry builds for a robot and its
-transferred trajectories, and the per-episode state the learner kernel keeps (which trajectory
-cells ``first-visit`` has paid, how far ``progress`` got); each move's term is computed by the
+transferred trajectories, and the state the learner kernel keeps (which trajectory cells
+``first-visit`` has paid in the trial, how far ``progress`` got in the episode); each move's term is computed by the
 kernel's own shaping function (``armtransfer.learning.sarsa._shaping``), so a learner that adds
 it sees exactly the rewards the project's SARSA(lambda) sees. The Gymnasium wrapper
 (``armtransfer.wrappers.TransferReward``) and the dm_control one (``armtransfer.dmc``) add it.
@@ -83,7 +83,7 @@ class TransferTerm:
         return self.shaping.K
 
     def reset(self) -> None:
-        """A new episode: nothing paid yet, no progress yet."""
+        """A new episode: no progress yet (the cells ``first-visit`` paid stay paid for the term's life)."""
         self._episode += 1
         self._best = 0.0
 

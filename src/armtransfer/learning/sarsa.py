@@ -250,9 +250,9 @@ def _shaping(mode, s, s2, terminal, bonus, traj_index, phi, gamma, paid_stamp, e
     """The shaping term for the move s -> s2; returns (term, the best bonus so far)."""
     if mode == MODE_PSEUDO:
         return bonus[s2], best
-    if mode == MODE_FIRST_VISIT:
+    if mode == MODE_FIRST_VISIT:  # once per trial: a bonus paid again every episode is not a reward of the state
         i = traj_index[s2]
-        if i > 0 and paid_stamp[i] != episode:
+        if i > 0 and paid_stamp[i] < 0:
             paid_stamp[i] = episode
             return bonus[s2], best
         return 0.0, best

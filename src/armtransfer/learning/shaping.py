@@ -15,7 +15,7 @@ MODE_NONE = 0
 MODE_PSEUDO = 1
 """r'(s') = bonus[s']: the paper's pseudo reward i*K on reaching the i-th trajectory cell."""
 MODE_FIRST_VISIT = 2
-"""bonus[s'] once per trajectory cell per episode."""
+"""bonus[s'] once per trajectory cell per trial: the first time the cell is reached."""
 MODE_POTENTIAL = 3
 """gamma * phi(s') - phi(s), with phi = 0 at the goal."""
 MODE_PROGRESS = 4

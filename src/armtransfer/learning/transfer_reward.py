@@ -12,8 +12,8 @@ Every step's reward is the environment's plus the chosen method's shaping term f
 just made, computed by the learner kernel's own shaping function
 (``armtransfer.learning.sarsa._shaping``) on arrays built by the method registry, so an
 agent learning on the wrapped env sees exactly the rewards the project's SARSA(lambda) sees.
-The term is also in ``info["shaping"]``. Per-episode state (which trajectory cells
-``first-visit`` has paid, how far ``progress`` got) starts afresh at every ``reset``.
+The term is also in ``info["shaping"]``. How far ``progress`` got starts afresh at every
+``reset``; the cells ``first-visit`` has paid stay paid for the wrapper's life (one trial).
 """
 
 from __future__ import annotations
