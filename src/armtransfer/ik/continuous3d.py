@@ -36,6 +36,7 @@ import numpy as np
 from armtransfer.errors import ArmModelError, InvalidCellError, UnreachableTableError
 from armtransfer.ik.compile import joint_box
 from armtransfer.ik.continuous import BLOCKED, MAX_NOISE, NoisyJointMoves
+from armtransfer.ik import swept
 from armtransfer.ik.scene import ArmScene, ContactChecker
 from armtransfer.ik.voxels import (SpatialFK, _move_clear, choose_step, moved_joints, spatial_origin,
                                    voxel_of_point, workspace_voxels)
@@ -71,6 +72,7 @@ class SpatialContinuousArm(NoisyJointMoves):
         self.levels = self.vox.levels
         """Labels are voxel ids of this many levels (``learning.cells`` pays by them)."""
         self.checker = ContactChecker(scene)
+        self.model = scene.model
         self._fk = SpatialFK(scene)
         self.origin = spatial_origin(scene)
         jac = self._fk.jacobian(self.origin)
@@ -97,9 +99,85 @@ class SpatialContinuousArm(NoisyJointMoves):
         self._off = False  # a box move left the lattice
         self._tip = np.full(3, np.nan)
         self.label = -1
-        self._start: tuple[np.ndarray, int, np.ndarray] | None = None
+        self._start: tuple | None = None
         self.moves = 0
-        """MuJoCo kinematics + collision checks made by :meth:`move` and :meth:`move_by` (blocked ones too)."""
+        """Moves asked of :meth:`move` and :meth:`move_by` (blocked ones too)."""
+        self._setup_sweep()
+
+    def _setup_sweep(self) -> None:
+        """The arrays of the swept check (``ik.swept``) and of the move's MuJoCo call."""
+        model, checker = self.model, self.checker
+        self.data = checker.data
+        self._qpos = self.data.qpos
+        self._site_xpos = self.data.site_xpos
+        self._tip_id = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, self.scene.tip))
+        self._qidx = [int(j) for j in self.moved]
+        by_adr = {int(model.jnt_qposadr[j]): j for j in range(model.njnt)}
+        self._joints = np.array([by_adr[j] for j in self._qidx], np.int64)
+        lay = self.vox.layout
+        self._shape = (int(lay.lo), int(lay.hi), int(lay.width), int(lay.n_cells), int(self.vox.levels))
+        self._vfree = np.ascontiguousarray(self.vox.free, dtype=np.bool_)
+        d = mujoco.MjData(model)
+        d.qpos[:] = self.origin
+        mujoco.mj_kinematics(model, d)
+        env = np.flatnonzero(self.scene.env_geoms)
+        box = mujoco.mjtGeom.mjGEOM_BOX
+        aligned = all(model.geom_type[g] == box and np.allclose(d.geom_xmat[g], np.eye(3).ravel(), atol=1e-12)
+                      for g in env)
+        self._boxes = np.array([np.concatenate([d.geom_xpos[g], model.geom_size[g]]) for g in env]).reshape(-1, 6)
+        counted = checker._env[:, None] & checker._moving[None, :]  # [env geom, arm geom]
+        geoms = [g for g in range(model.ngeom) if checker._moving[g] and counted[env, g].any()]
+        self._geoms = np.array(geoms, np.int64)
+        self._pairs = np.ascontiguousarray(counted[np.ix_(env, geoms)].T) if geoms else np.zeros((0, len(env)), bool)
+        # a capsule (a sphere: of length 0) is its own shape; any other geom, MuJoCo's box around it
+        kind = model.geom_type
+        capsule = [kind[g] in (mujoco.mjtGeom.mjGEOM_CAPSULE, mujoco.mjtGeom.mjGEOM_SPHERE) for g in geoms]
+        self._kinds = np.array([0 if c else 1 for c in capsule], np.int64)
+        self._sizes = np.array([[model.geom_size[g, 1] if kind[g] == mujoco.mjtGeom.mjGEOM_CAPSULE else 0.0,
+                                 model.geom_size[g, 0], 0.0] if c else model.geom_aabb[g, 3:6]
+                                for g, c in zip(geoms, capsule)]).reshape(-1, 3)
+        self._offset = np.array([np.zeros(3) if c else model.geom_aabb[g, :3] for g, c in zip(geoms, capsule)]
+                                ).reshape(-1, 3)
+        # the geoms each moved joint carries: those on bodies below its body
+        parent = model.body_parentid
+        below = np.zeros((model.njnt, model.nbody), bool)
+        for b in range(model.nbody):
+            k = b
+            while k > 0:
+                below[model.jnt_bodyid == k, b] = True
+                k = parent[k]
+        self._carried = np.ascontiguousarray(below[np.ix_(self._joints, model.geom_bodyid[geoms])]) if geoms \
+            else np.zeros((self.dof, 0), bool)
+        # reach[q, g]: a bound on the distance of geom g's core from joint q's axis in any
+        # configuration (the anchors below it, one to the next, then to the core's ends)
+        frames = np.empty((len(geoms), 4, 3))
+        swept.capture(d.geom_xpos, d.geom_xmat, self._geoms, self._offset, d.xanchor, d.xaxis, self._joints, frames,
+                      np.empty((self.dof, 3)), np.empty((self.dof, 3)))
+        self._reach = np.zeros((model.nq, len(geoms)))
+        for gi, g in enumerate(geoms):
+            chain = [j for j in range(model.njnt) if below[j, model.geom_bodyid[g]]]
+            chain.sort(key=lambda j: (self._depth(model.jnt_bodyid[j]), j))
+            for a, j in enumerate(chain):
+                path = sum(float(np.linalg.norm(d.xanchor[chain[k + 1]] - d.xanchor[chain[k]]))
+                           for k in range(a, len(chain) - 1))
+                self._reach[model.jnt_qposadr[j], gi] = path + float(np.linalg.norm(
+                    frames[gi, 0] - d.xanchor[chain[-1]])) + float(np.linalg.norm(self._sizes[gi]))
+        self._sampled = bool(checker.can_self_collide or not aligned)
+        """Self-contacts or a workspace not made of axis-aligned boxes: the moves are checked by
+        MuJoCo at points of the move instead (``ik.voxels._move_clear``), in Python."""
+        self._frames = np.zeros((len(geoms), 4, 3))
+        self._anchors = np.zeros((self.dof, 3))
+        self._axes = np.zeros((self.dof, 3))
+        self._work = np.zeros(3)
+        self._work2 = np.zeros((6, 3))
+        self._stack = np.zeros((64, 4))
+        self._fast: tuple | None | bool = False
+
+    def _depth(self, body: int) -> int:
+        k, n = int(body), 0
+        while k > 0:
+            k, n = int(self.model.body_parentid[k]), n + 1
+        return n
 
     # ------------------------------------------------------------------ configurations
 
@@ -140,17 +218,20 @@ class SpatialContinuousArm(NoisyJointMoves):
         on = bool(np.array_equal(self._q0 + n * self.step, qm))
         self._off = not on
         self._set(qm, n if on else np.zeros(self.dof, np.int64), tip, v)
-        self._start = (qm.copy(), v, tip.copy())
+        self._capture()  # the kinematics ``_voxel`` ran at this configuration
+        self._start = (qm.copy(), v, tip.copy(), (self._frames.copy(), self._anchors.copy(), self._axes.copy()))
         return v
 
     def reset(self) -> int:
         """Back to the configuration last set (:meth:`set_configuration`, :meth:`place`); its voxel."""
         if self._start is None:
             raise ArmModelError("place the arm (place or set_configuration) before resetting it")
-        qm, v, tip = self._start
+        qm, v, tip, (frames, anchors, axes) = self._start
         n = np.rint((qm - self._q0) / self.step).astype(np.int64)
         self._off = not bool(np.array_equal(self._q0 + n * self.step, qm))
         self._set(qm, n, tip.copy(), v)
+        self._qpos[:] = self._full
+        self._frames[:], self._anchors[:], self._axes[:] = frames, anchors, axes
         return v
 
     @property
@@ -234,25 +315,72 @@ class SpatialContinuousArm(NoisyJointMoves):
         i, sign = a >> 1, 1 - 2 * (a & 1)
         self.moves += 1
         n = None
-        qm = self._q.copy()
+        old = float(self._q[i])
         if self._noisy:
-            qm[i] += sign * self.step * (1.0 + self._next_eps())
+            new = old + sign * self.step * (1.0 + self._next_eps())
         elif self._off:
-            qm[i] += sign * self.step
+            new = old + sign * self.step
         else:
-            n = self._n.copy()
-            n[i] += sign
-            if n[i] < self._nlo[i] or n[i] > self._nhi[i]:
+            n = int(self._n[i]) + sign
+            if n < self._nlo[i] or n > self._nhi[i]:
                 return BLOCKED
-            qm[i] = self._q0[i] + n[i] * self.step
-        if qm[i] < self._lo[i] or qm[i] > self._hi[i]:
+            new = float(self._q0[i] + n * self.step)
+        if new < self._lo[i] or new > self._hi[i]:
             return BLOCKED
-        return self._go(qm, n)
+        if self._sampled:
+            qm = self._q.copy()
+            qm[i] = new
+            nn = None if n is None else self._n.copy()
+            if nn is not None:
+                nn[i] = n
+            return self._go(qm, nn)
+        return self._turn(i, old, new, n)
+
+    def _turn(self, i: int, old: float, new: float, n: int | None) -> int:
+        """Moved joint i from ``old`` to ``new``: the tool point's arc through free voxels, the
+        swept check (``ik.swept``), both on the state the last move left; then MuJoCo at the end."""
+        theta = new - old
+        c, ax = self._anchors[i], self._axes[i]
+        sh = self._shape
+        if swept.tip_arc(self._tip, c, ax, theta, self.cell, sh[0], sh[1], sh[2], sh[3], sh[4], self._vfree,
+                         self._work) < 0:
+            return BLOCKED
+        if not swept.rotation_clear(self._frames, self._sizes, self._kinds, self._carried[i], c, ax, theta,
+                                    self._boxes, self._pairs, self._stack, self._work2):
+            return BLOCKED
+        m, d = self.model, self.data
+        qpos = self._qpos
+        j = self._qidx[i]
+        qpos[j] = new
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_collision(m, d)
+        if d.ncon and self.checker.touches_now():
+            qpos[j] = old
+            return BLOCKED
+        tip = self._site_xpos[self._tip_id]
+        v = swept.voxel(tip, self.cell, sh[0], sh[1], sh[2], sh[3], sh[4])
+        if v < 0 or not self._vfree[v]:
+            qpos[j] = old
+            return BLOCKED
+        self._q[i] = new
+        self._full[j] = new
+        if n is not None:
+            self._n[i] = n
+        self._tip[:] = tip
+        self.label = v
+        self._capture()
+        return v
+
+    def _capture(self) -> None:
+        """The swept check's state at the configuration whose kinematics MuJoCo last ran on data."""
+        d = self.data
+        swept.capture(d.geom_xpos, d.geom_xmat, self._geoms, self._offset, d.xanchor, d.xaxis, self._joints,
+                      self._frames, self._anchors, self._axes)
 
     def move_by(self, dq: np.ndarray) -> int:
         """Turn every moved joint at once, joint i by ``dq[i]`` radians (times 1 + eps_i with
-        noise): the voxel after the move, or ``BLOCKED``. It leaves the lattice (:meth:`key` is
-        then q; :meth:`reset` goes back to the start)."""
+        noise), along the straight line in joint space: the voxel after the move, or ``BLOCKED``.
+        It leaves the lattice (:meth:`key` is then q; :meth:`reset` goes back to the start)."""
         turn = np.asarray(dq, dtype=np.float64).reshape(-1)
         if turn.shape != (self.dof,) or not np.all(np.isfinite(turn)):
             raise ArmModelError(f"a joint move of this arm is {self.dof} finite angles, got {dq!r}")
@@ -268,15 +396,78 @@ class SpatialContinuousArm(NoisyJointMoves):
         return label
 
     def _go(self, qm: np.ndarray, n: np.ndarray | None) -> int:
+        """The straight joint move to ``qm``: MuJoCo at its end, the tool point at points at most
+        half a cell apart in free voxels, and the swept check along the line (``_line_clear``)."""
         old = self._full.copy()
         new = self._full_of(qm)
         v, tip = self._voxel(new)
-        if v < 0 or not _move_clear(self.checker, self._fk, old, new, self._tip, tip, self.cell, self.vox):
+        if v < 0:
+            self.data.qpos[:] = old
+            return BLOCKED
+        ok = self._line_clear(old, new, tip)
+        if ok:
+            ok = _move_clear(self.checker, self._fk, old, new, self._tip, tip, self.cell, self.vox) \
+                if self._sampled else self._tip_line_clear(old, new, tip)
+        self.data.qpos[:] = new if ok else old
+        mujoco.mj_kinematics(self.model, self.data)
+        if not ok:
             return BLOCKED
         if n is None and not self._noisy and not self._off:
             self._off = True
         self._set(qm, n, tip, v)
+        self._capture()
         return v
+
+    def _tip_line_clear(self, qa: np.ndarray, qb: np.ndarray, pb: np.ndarray) -> bool:
+        """The tool point at points of the straight move at most half a cell of its travel apart
+        (``ik.voxels._move_clear``'s points) in free voxels (kinematics only)."""
+        m = max(1, int(math.ceil(2.0 * float(np.linalg.norm(pb - self._tip)) / self.cell)))
+        for t in np.arange(1, m + 1) / (m + 1):
+            tip = self._fk.tip(qa + (qb - qa) * t)
+            v = voxel_of_point(tip, self.cell, self.vox)
+            if v < 0 or not self.vox.free[v]:
+                return False
+        return True
+
+    def _line_clear(self, qa: np.ndarray, qb: np.ndarray, pb: np.ndarray) -> bool:
+        """The swept check of a straight joint move qa -> qb (several joints at once): D_g(t), the
+        least clearance of geom g to the boxes (``swept``), is Lipschitz in t with constant
+        sum_j |qb_j - qa_j| * reach[j, g] (``reach``: a bound on the distance of g's core from
+        joint j's axis in any configuration); intervals are split as in ``ik.swept``, the cores at
+        a point from MuJoCo's kinematics there."""
+        if not len(self._geoms):
+            return True
+        rate = np.abs(qb - qa) @ self._reach  # per geom: metres per unit t
+        d0 = self._clearances(qa)
+        d1 = self._clearances(qb)
+        todo = [(0.0, 1.0, d0, d1)]
+        evals = 2
+        while todo:
+            t0, t1, da, db = todo.pop()
+            bad = (da + db <= (t1 - t0) * rate)
+            if not bad.any():
+                continue
+            if float(((t1 - t0) * rate)[bad].max()) < swept.RESOLUTION or evals >= swept.MAX_EVALS:
+                return False
+            tm = 0.5 * (t0 + t1)
+            dm = self._clearances(qa + (qb - qa) * tm)
+            evals += 1
+            if np.any(dm <= 0.0):
+                return False
+            todo += [(tm, t1, dm, db), (t0, tm, da, dm)]
+        return bool(np.all(d0 > 0.0) and np.all(d1 > 0.0))
+
+    def _clearances(self, full: np.ndarray) -> np.ndarray:
+        """Per swept geom, its least D to the boxes at the whole configuration ``full``."""
+        d = self._fk.data
+        d.qpos[:] = full
+        mujoco.mj_kinematics(self.model, d)
+        frames = np.empty_like(self._frames)
+        swept.capture(d.geom_xpos, d.geom_xmat, self._geoms, self._offset, d.xanchor, d.xaxis, self._joints,
+                      frames, np.empty_like(self._anchors), np.empty_like(self._axes))
+        out = np.empty(len(self._geoms))
+        swept.clearances(frames, self._sizes, self._kinds, self._boxes, self._pairs, self._work2, out)
+        return out
 
     def tip(self) -> tuple[float, float, float]:
         """The tool point (x, y, z) the last move or placement computed: no MuJoCo call."""
