@@ -197,7 +197,7 @@ class SpatialContinuousArm(NoisyJointMoves):
         self._full[list(self.moved)] = qm
         if n is not None:
             self._n[:] = n
-        self._tip = tip
+        self._tip[:] = tip
         self.label = label
 
     def set_configuration(self, q: np.ndarray) -> int:
@@ -468,6 +468,51 @@ class SpatialContinuousArm(NoisyJointMoves):
         out = np.empty(len(self._geoms))
         swept.clearances(frames, self._sizes, self._kinds, self._boxes, self._pairs, self._work2, out)
         return out
+
+    # ------------------------------------------------------------------ the compiled move
+
+    def fast(self) -> tuple | None:
+        """The arm's arrays for ``ik.fastmove3d.move`` (the compiled :meth:`move`), or None when
+        there is none (actuation noise, off the lattice, moves checked by sampling, or MuJoCo's
+        memory not as ``ik.fastmove.layout`` expects). Call :meth:`fast_done` after moving with it."""
+        if self._noisy or self._off or self._sampled or self._start is None:
+            return None
+        if self._fast is False:
+            self._fast = self._build_fast()
+        if not isinstance(self._fast, tuple):
+            return None
+        state = self._fast
+        state[-2][0] = self.label
+        state[-1][0] = self.moves
+        return state
+
+    def fast_done(self) -> None:
+        """Take back the arm's state from the compiled move's arrays."""
+        state = self._fast
+        assert isinstance(state, tuple)
+        self.label = int(state[-2][0])
+        self.moves = int(state[-1][0])
+        self._full[self._qidx] = self._q
+
+    def _build_fast(self) -> tuple | None:
+        from armtransfer.ik import fastmove
+
+        c = self.checker
+        g = np.arange(self.model.ngeom)
+        g1, g2 = (x.ravel() for x in np.meshgrid(g, g, indexing="ij"))
+        counts = ((c._env[g1] & c._moving[g2]) | (c._env[g2] & c._moving[g1]) | c._own(g1, g2))
+        full = np.tile(self._full, (400, 1))
+        full[:, self._qidx] = np.random.default_rng(0).uniform(self._lo, self._hi, (400, self.dof))
+        raw = fastmove.layout(self.model, self.data, counts.reshape(self.model.ngeom, self.model.ngeom), full)
+        if raw is None:
+            return None
+        d = self.data
+        return (raw, self._qpos, self._site_xpos, d.geom_xpos, d.geom_xmat, d.xanchor, d.xaxis, self._tip_id,
+                np.array(self._qidx, np.int64), self._joints, self._q, self._q0, self._n, self._nlo, self._nhi,
+                self.step, self._lo, self._hi, self.cell, np.array(self._shape, np.int64), self._vfree, self._tip,
+                self._frames, self._sizes, self._kinds, self._carried, self._boxes, self._pairs, self._geoms,
+                self._offset, self._anchors, self._axes, self._stack, self._work, self._work2,
+                np.zeros(1, np.int64), np.zeros(1, np.int64))
 
     def tip(self) -> tuple[float, float, float]:
         """The tool point (x, y, z) the last move or placement computed: no MuJoCo call."""
