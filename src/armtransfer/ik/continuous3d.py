@@ -117,28 +117,13 @@ class SpatialContinuousArm(NoisyJointMoves):
         lay = self.vox.layout
         self._shape = (int(lay.lo), int(lay.hi), int(lay.width), int(lay.n_cells), int(self.vox.levels))
         self._vfree = np.ascontiguousarray(self.vox.free, dtype=np.bool_)
+        arrays = swept.shapes(self.scene, checker, self._joints, self.origin)
+        (self._geoms, self._sizes, self._kinds, self._offset, self._boxes, self._pairs, self._carried,
+         aligned) = arrays
+        geoms = self._geoms.tolist()
         d = mujoco.MjData(model)
         d.qpos[:] = self.origin
         mujoco.mj_kinematics(model, d)
-        env = np.flatnonzero(self.scene.env_geoms)
-        box = mujoco.mjtGeom.mjGEOM_BOX
-        aligned = all(model.geom_type[g] == box and np.allclose(d.geom_xmat[g], np.eye(3).ravel(), atol=1e-12)
-                      for g in env)
-        self._boxes = np.array([np.concatenate([d.geom_xpos[g], model.geom_size[g]]) for g in env]).reshape(-1, 6)
-        counted = checker._env[:, None] & checker._moving[None, :]  # [env geom, arm geom]
-        geoms = [g for g in range(model.ngeom) if checker._moving[g] and counted[env, g].any()]
-        self._geoms = np.array(geoms, np.int64)
-        self._pairs = np.ascontiguousarray(counted[np.ix_(env, geoms)].T) if geoms else np.zeros((0, len(env)), bool)
-        # a capsule (a sphere: of length 0) is its own shape; any other geom, MuJoCo's box around it
-        kind = model.geom_type
-        capsule = [kind[g] in (mujoco.mjtGeom.mjGEOM_CAPSULE, mujoco.mjtGeom.mjGEOM_SPHERE) for g in geoms]
-        self._kinds = np.array([0 if c else 1 for c in capsule], np.int64)
-        self._sizes = np.array([[model.geom_size[g, 1] if kind[g] == mujoco.mjtGeom.mjGEOM_CAPSULE else 0.0,
-                                 model.geom_size[g, 0], 0.0] if c else model.geom_aabb[g, 3:6]
-                                for g, c in zip(geoms, capsule)]).reshape(-1, 3)
-        self._offset = np.array([np.zeros(3) if c else model.geom_aabb[g, :3] for g, c in zip(geoms, capsule)]
-                                ).reshape(-1, 3)
-        # the geoms each moved joint carries: those on bodies below its body
         parent = model.body_parentid
         below = np.zeros((model.njnt, model.nbody), bool)
         for b in range(model.nbody):
@@ -146,8 +131,6 @@ class SpatialContinuousArm(NoisyJointMoves):
             while k > 0:
                 below[model.jnt_bodyid == k, b] = True
                 k = parent[k]
-        self._carried = np.ascontiguousarray(below[np.ix_(self._joints, model.geom_bodyid[geoms])]) if geoms \
-            else np.zeros((self.dof, 0), bool)
         # reach[q, g]: a bound on the distance of geom g's core from joint q's axis in any
         # configuration (the anchors below it, one to the next, then to the core's ends)
         frames = np.empty((len(geoms), 4, 3))

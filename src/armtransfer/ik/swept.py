@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 
+import mujoco
 import numba
 import numpy as np
 
@@ -311,3 +312,41 @@ def clearances(frames, sizes, kinds, boxes, pairs, work, out):
                 if d < best:
                     best = d
         out[g] = best
+
+
+def shapes(scene, checker, joints: np.ndarray, q: np.ndarray) -> tuple:
+    """The arrays of the swept check for the arm of ``scene`` moving ``joints`` (joint ids):
+    (geoms: the arm's geoms that may touch a box of the table body; sizes and kinds of their
+    shapes; offsets of the shapes' centres in the geoms' frames; boxes [O, 6]: the table body's
+    geoms as centre and half sizes; pairs [G, O]: which of them a geom's contact counts with
+    (``ContactChecker``); carried [len(joints), G]: the geoms each joint turns; whether every
+    box is an axis-aligned box, at the configuration ``q``)."""
+    model = scene.model
+    d = mujoco.MjData(model)
+    d.qpos[:] = q
+    mujoco.mj_kinematics(model, d)
+    env = np.flatnonzero(scene.env_geoms)
+    box = mujoco.mjtGeom.mjGEOM_BOX
+    aligned = all(model.geom_type[g] == box and np.allclose(d.geom_xmat[g], np.eye(3).ravel(), atol=1e-12)
+                  for g in env)
+    boxes = np.array([np.concatenate([d.geom_xpos[g], model.geom_size[g]]) for g in env]).reshape(-1, 6)
+    counted = checker._env[:, None] & checker._moving[None, :]  # [env geom, arm geom]
+    geoms = [g for g in range(model.ngeom) if checker._moving[g] and counted[env, g].any()]
+    pairs = np.ascontiguousarray(counted[np.ix_(env, geoms)].T).reshape(len(geoms), len(env))
+    # a capsule (a sphere: of length 0) is its own shape; any other geom, MuJoCo's box around it
+    kind = model.geom_type
+    capsule = [kind[g] in (mujoco.mjtGeom.mjGEOM_CAPSULE, mujoco.mjtGeom.mjGEOM_SPHERE) for g in geoms]
+    kinds = np.array([0 if c else 1 for c in capsule], np.int64)
+    sizes = np.array([[model.geom_size[g, 1] if kind[g] == mujoco.mjtGeom.mjGEOM_CAPSULE else 0.0,
+                       model.geom_size[g, 0], 0.0] if c else model.geom_aabb[g, 3:6]
+                      for g, c in zip(geoms, capsule)]).reshape(-1, 3)
+    offset = np.array([np.zeros(3) if c else model.geom_aabb[g, :3] for g, c in zip(geoms, capsule)]).reshape(-1, 3)
+    below = np.zeros((model.njnt, model.nbody), bool)  # joint j turns body b
+    for b in range(model.nbody):
+        k = b
+        while k > 0:
+            below[model.jnt_bodyid == k, b] = True
+            k = model.body_parentid[k]
+    carried = np.ascontiguousarray(below[np.ix_(np.asarray(joints, np.int64), model.geom_bodyid[geoms])]
+                                   ).reshape(len(joints), len(geoms))
+    return (np.array(geoms, np.int64), sizes, kinds, offset, boxes, pairs, carried, bool(aligned))
