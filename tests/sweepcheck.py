@@ -65,3 +65,24 @@ class SweepChecker:
         qa, qb = np.asarray(qa, float), np.asarray(qb, float)
         deepest = max(self.depth(qa + t * (qb - qa)) for t in self.points(qa, qb))
         return deepest if deepest > MIN_DEPTH else 0.0
+
+
+def clearance(checker: SweepChecker, q: np.ndarray, reach: float = 0.01) -> float:
+    """The least distance between a geom of the arm and a geom of the table body at q that
+    MuJoCo's ``mj_geomDistance`` finds within ``reach`` metres (``reach`` when none is nearer)."""
+    m, d = checker.model, checker.data
+    d.qpos[:] = q
+    mujoco.mj_forward(m, d)
+    best = reach
+    for g1 in np.flatnonzero(checker.arm):
+        if not (m.geom_contype[g1] or m.geom_conaffinity[g1]):
+            continue
+        for g2 in np.flatnonzero(checker.env):
+            best = min(best, mujoco.mj_geomDistance(m, d, int(g1), int(g2), reach, None))
+    return best
+
+
+def move_clearance(checker: SweepChecker, qa: np.ndarray, qb: np.ndarray, reach: float = 0.01) -> float:
+    """The least :func:`clearance` over the checked points of the move."""
+    qa, qb = np.asarray(qa, float), np.asarray(qb, float)
+    return min(clearance(checker, qa + t * (qb - qa), reach) for t in checker.points(qa, qb))

@@ -40,6 +40,7 @@ import numba
 import numpy as np
 
 from armtransfer.errors import ArmModelError, InvalidCellError, UnreachableTableError
+from armtransfer.ik import swept
 from armtransfer.ik.arcs import _cell, _sweep, _sweep_turn
 from armtransfer.ik.compile import joint_box, near_wall_mask
 from armtransfer.ik.labels import OFF_TABLE, cells_of_xy
@@ -207,6 +208,16 @@ class ContinuousArm(NoisyJointMoves):
         self.moves = 0
         """MuJoCo kinematics + collision calls made by :meth:`move` (blocked ones too)."""
         self._fast: tuple | None | bool = False  # False: not built yet; None: not available
+        # the swept check of a turn (``ik.swept``): every geom the joint carries, against the
+        # table and wall boxes, along the whole turn; from the end's kinematics, turned back
+        (self._sw_geoms, self._sw_sizes, self._sw_kinds, self._sw_offset, self._sw_boxes, self._sw_pairs,
+         self._sw_carried, aligned) = swept.shapes(scene, self.checker, self._jnt.astype(np.int64), scene.home)
+        if not aligned:
+            raise ArmModelError("the continuous arm needs a workspace of axis-aligned boxes (the table and walls)")
+        self._sw_frames = np.zeros((len(self._sw_geoms), 4, 3))
+        self._sw_joint = [self._jnt[j:j + 1].astype(np.int64) for j in range(self.dof)]
+        self._sw_anchor, self._sw_axis = np.zeros((1, 3)), np.zeros((1, 3))
+        self._sw_stack, self._sw_work = np.zeros((64, 4)), np.zeros((6, 3))
 
     # ------------------------------------------------------------------ placing the arm
 
@@ -332,8 +343,8 @@ class ContinuousArm(NoisyJointMoves):
         m, d = self.model, self.data
         mujoco.mj_kinematics(m, d)
         mujoco.mj_collision(m, d)
-        if d.ncon and self.checker.touches_now():  # the kinematics and contacts just computed
-            qpos[j] = old
+        if (d.ncon and self.checker.touches_now()) or not self._swept_clear(j, qpos[j] - old):
+            qpos[j] = old  # a contact at the end (the kinematics and contacts just computed), or along the turn
             return BLOCKED
         x, y, z = self._site_xpos[self._tip_id].tolist()
         cx, cy = round(x / self._cell_size) - self._lo, round(y / self._cell_size) - self._lo
@@ -370,7 +381,7 @@ class ContinuousArm(NoisyJointMoves):
         m, d = self.model, self.data
         mujoco.mj_kinematics(m, d)
         mujoco.mj_collision(m, d)
-        if d.ncon and self.checker.touches_now():
+        if (d.ncon and self.checker.touches_now()) or not self._swept_clear(j, new - old):
             qpos[j] = old
             return BLOCKED
         x, y, z = self._site_xpos[self._tip_id].tolist()
@@ -510,7 +521,19 @@ class ContinuousArm(NoisyJointMoves):
                 np.zeros(self.dof, np.int64), self.step, self._cell_size, self._lo, self._width, self._free,
                 self._near, np.array(self._clear, np.int64), np.array(self._clear_needed, np.int64), self._cos,
                 self._sin, self._m, probe, n_probe, bool(self._always_probe), np.zeros(3), np.zeros(1, np.int64),
-                np.zeros(1, np.int64))
+                np.zeros(1, np.int64), self.data.geom_xpos, self.data.geom_xmat, self.data.xaxis, self._sw_geoms,
+                self._sw_offset, self._sw_sizes, self._sw_kinds, self._sw_carried, self._sw_boxes, self._sw_pairs,
+                self._sw_frames, self._sw_anchor, self._sw_axis, self._sw_stack, self._sw_work)
+
+    def _swept_clear(self, j: int, theta: float) -> bool:
+        """Whether the turn of joint j by ``theta`` that ends at the configuration whose kinematics
+        MuJoCo just ran keeps every geom it carries clear of the table and walls (``ik.swept``)."""
+        d = self.data
+        swept.capture(d.geom_xpos, d.geom_xmat, self._sw_geoms, self._sw_offset, d.xanchor, d.xaxis,
+                      self._sw_joint[j], self._sw_frames, self._sw_anchor, self._sw_axis)
+        return swept.rotation_clear(self._sw_frames, self._sw_sizes, self._sw_kinds, self._sw_carried[j],
+                                    self._sw_anchor[0], self._sw_axis[0], -theta, self._sw_boxes, self._sw_pairs,
+                                    self._sw_stack, self._sw_work)
 
     def _probe_touches(self, a: int, old: float) -> bool:
         """MuJoCo contact at up to 3 points along the move from ``old`` (joint a // 2)."""

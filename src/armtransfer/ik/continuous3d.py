@@ -313,8 +313,9 @@ class SpatialContinuousArm(NoisyJointMoves):
         if self._sampled:
             qm = self._q.copy()
             qm[i] = new
-            nn = None if n is None else self._n.copy()
-            if nn is not None:
+            nn = None
+            if n is not None:
+                nn = self._n.copy()
                 nn[i] = n
             return self._go(qm, nn)
         return self._turn(i, old, new, n)

@@ -35,6 +35,7 @@ from llvmlite import ir
 from numba.core import types
 from numba.extending import intrinsic
 
+from armtransfer.ik import swept
 from armtransfer.ik.arcs import _sweep
 
 PYTHON = -3
@@ -175,7 +176,9 @@ def move(a, arm):
     """``ContinuousArm.move(a)`` on the arm's arrays ``arm`` (``ContinuousArm.fast_state``):
     the cell reached, :data:`BLOCKED`, or :data:`PYTHON` (nothing changed)."""
     (raw, qpos, site_xpos, xanchor, tip_id, jnt, q0, nn, nlo, nhi, step, cell_size, lo, width, free, near, clear,
-     clear_needed, cosb, sinb, m_arr, probe, n_probe, always_probe, tip, label, moves) = arm
+     clear_needed, cosb, sinb, m_arr, probe, n_probe, always_probe, tip, label, moves, geom_xpos, geom_xmat, xaxis,
+     sw_geoms, sw_offset, sw_sizes, sw_kinds, sw_carried, sw_boxes, sw_pairs, sw_frames, sw_anchor, sw_axis, sw_stack,
+     sw_work) = arm
     j = a >> 1
     n = nn[j] + 1 - 2 * (a & 1)
     moves[0] += 1
@@ -191,6 +194,12 @@ def move(a, arm):
         if t < 0:
             moves[0] -= 1
             return PYTHON
+        return BLOCKED
+    swept.capture(geom_xpos, geom_xmat, sw_geoms, sw_offset, xanchor, xaxis, jnt[j:j + 1], sw_frames, sw_anchor,
+                  sw_axis)
+    if not swept.rotation_clear(sw_frames, sw_sizes, sw_kinds, sw_carried[j], sw_anchor[0], sw_axis[0],
+                                -(qpos[j] - old), sw_boxes, sw_pairs, sw_stack, sw_work):
+        qpos[j] = old
         return BLOCKED
     x = site_xpos[tip_id, 0]
     y = site_xpos[tip_id, 1]

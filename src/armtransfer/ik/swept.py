@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import math
 
-import mujoco
 import numba
 import numpy as np
 
@@ -321,6 +320,8 @@ def shapes(scene, checker, joints: np.ndarray, q: np.ndarray) -> tuple:
     geoms as centre and half sizes; pairs [G, O]: which of them a geom's contact counts with
     (``ContactChecker``); carried [len(joints), G]: the geoms each joint turns; whether every
     box is an axis-aligned box, at the configuration ``q``)."""
+    import mujoco  # here: the compiled moves import this module without MuJoCo's bindings
+
     model = scene.model
     d = mujoco.MjData(model)
     d.qpos[:] = q
@@ -332,7 +333,7 @@ def shapes(scene, checker, joints: np.ndarray, q: np.ndarray) -> tuple:
     boxes = np.array([np.concatenate([d.geom_xpos[g], model.geom_size[g]]) for g in env]).reshape(-1, 6)
     counted = checker._env[:, None] & checker._moving[None, :]  # [env geom, arm geom]
     geoms = [g for g in range(model.ngeom) if checker._moving[g] and counted[env, g].any()]
-    pairs = np.ascontiguousarray(counted[np.ix_(env, geoms)].T).reshape(len(geoms), len(env))
+    pairs = np.ascontiguousarray(counted[np.ix_(env, np.array(geoms, np.int64))].T).reshape(len(geoms), len(env))
     # a capsule (a sphere: of length 0) is its own shape; any other geom, MuJoCo's box around it
     kind = model.geom_type
     capsule = [kind[g] in (mujoco.mjtGeom.mjGEOM_CAPSULE, mujoco.mjtGeom.mjGEOM_SPHERE) for g in geoms]
