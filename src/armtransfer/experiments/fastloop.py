@@ -111,11 +111,15 @@ def _stale_caches() -> None:
     from armtransfer.learning import jitcache, sarsa, tiles, traces
 
     arcs = Path(fastmove.__file__).with_name("arcs.py")
-    jitcache.invalidate_stale(fastmove.__name__, [fastmove._touches_now, fastmove._touches, fastmove.move],
-                              [arcs, Path(fastmove.__file__).with_name("swept.py")])
+    jitcache.invalidate_stale(fastmove.__name__, [fastmove._touches_now, fastmove._touches, fastmove.move,
+                                                  fastmove.planar_move],
+                              [arcs, Path(fastmove.__file__).with_name("swept.py"),
+                               Path(fastmove.__file__).with_name("handles.py")])
     swept = Path(fastmove3d.__file__).with_name("swept.py")
-    jitcache.invalidate_stale(fastmove3d.__name__, [fastmove3d.move], [swept, fastmove.__file__])
-    jitcache.invalidate_stale(__name__, [_run, _run3d], [fastmove.__file__, fastmove3d.__file__, swept, arcs,
+    handles = Path(fastmove3d.__file__).with_name("handles.py")
+    jitcache.invalidate_stale(fastmove3d.__name__, [fastmove3d.move, fastmove3d.spatial_move],
+                              [swept, handles, fastmove.__file__])
+    jitcache.invalidate_stale(__name__, [_run, _run3d], [fastmove.__file__, fastmove3d.__file__, swept, handles, arcs,
                                                          linear.__file__, tiles.__file__, traces.__file__,
                                                          sarsa.__file__])
 

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from typing import Any
 
 import mujoco
 import numba
@@ -42,6 +43,7 @@ import numpy as np
 from armtransfer.errors import ArmModelError, InvalidCellError, UnreachableTableError
 from armtransfer.ik import swept
 from armtransfer.ik.arcs import _cell, _sweep, _sweep_turn
+from armtransfer.ik.fastmove import PYTHON
 from armtransfer.ik.compile import joint_box, near_wall_mask
 from armtransfer.ik.labels import OFF_TABLE, cells_of_xy
 from armtransfer.ik.scene import ArmScene, ContactChecker
@@ -208,6 +210,9 @@ class ContinuousArm(NoisyJointMoves):
         self.moves = 0
         """MuJoCo kinematics + collision calls made by :meth:`move` (blocked ones too)."""
         self._fast: tuple | None | bool = False  # False: not built yet; None: not available
+        self._table: np.ndarray | None = None  # the compiled move's state by address (``ik.handles``)
+        self._kernel: Any = None
+        self._fresh = False  # the compiled move's arrays hold the arm's state (:meth:`fast_step`)
         # the swept check of a turn (``ik.swept``): every geom the joint carries, against the
         # table and wall boxes, along the whole turn; from the end's kinematics, turned back
         (self._sw_geoms, self._sw_sizes, self._sw_kinds, self._sw_offset, self._sw_boxes, self._sw_pairs,
@@ -217,7 +222,7 @@ class ContinuousArm(NoisyJointMoves):
         self._sw_frames = np.zeros((len(self._sw_geoms), 4, 3))
         self._sw_joint = [self._jnt[j:j + 1].astype(np.int64) for j in range(self.dof)]
         self._sw_anchor, self._sw_axis = np.zeros((1, 3)), np.zeros((1, 3))
-        self._sw_stack, self._sw_work = np.zeros((64, 4)), np.zeros((6, 3))
+        self._sw_stack, self._sw_work = np.zeros((64, 4)), np.zeros((7, 3))
 
     # ------------------------------------------------------------------ placing the arm
 
@@ -225,6 +230,7 @@ class ContinuousArm(NoisyJointMoves):
         """Put the arm at ``q`` (it becomes q0 of the moves that follow) and return its label.
         A configuration that touches something, or whose tool point is not over a free cell,
         is refused."""
+        self._fresh = False
         q = np.array(q, dtype=np.float64).reshape(-1)
         if q.shape != (self.dof,) or not np.all(np.isfinite(q)):
             raise ArmModelError(f"a configuration of this arm is {self.dof} finite joint angles, got {q.tolist()}")
@@ -252,6 +258,7 @@ class ContinuousArm(NoisyJointMoves):
 
     def reset(self) -> int:
         """Back to the configuration last set (:meth:`set_configuration`, :meth:`place`); its label."""
+        self._fresh = False
         if self._start is None:
             raise ArmModelError("place the arm (place or set_configuration) before resetting it")
         q, cell, tip = self._start
@@ -330,6 +337,7 @@ class ContinuousArm(NoisyJointMoves):
     def move(self, a: int) -> int:
         """Take action ``a`` (0 .. 2 * dof - 1): the cell under the tool point after the move,
         or ``BLOCKED`` when the move is blocked (the arm has not moved)."""
+        self._fresh = False
         if self._noisy:
             return self._move_noisy(a)
         j = a >> 1
@@ -354,7 +362,7 @@ class ContinuousArm(NoisyJointMoves):
             anchor = self._xanchor[self._jnt[j]]
             cell, close = _sweep(x, y, anchor[0], anchor[1], self._cos[a], self._sin[a], self._m[a],
                                  self._cell_size, self._lo, width, self._free, self._near)
-            if cell < 0 or ((close or self._always_probe) and self._probe_touches(a, old)):
+            if cell < 0 or (self._always_probe and self._probe_touches(a, old)):
                 qpos[j] = old
                 return BLOCKED
         elif self._always_probe and self._probe_touches(a, old):
@@ -392,7 +400,7 @@ class ContinuousArm(NoisyJointMoves):
             anchor = self._xanchor[self._jnt[j]]
             cell, close = _sweep_turn(x, y, anchor[0], anchor[1], -turn * self._axis_sign[j], self._m_noisy[a],
                                       self._cell_size, self._lo, width, self._free, self._near)
-            if cell < 0 or ((close or self._always_probe) and self._probe_touches(a, old)):
+            if cell < 0 or (self._always_probe and self._probe_touches(a, old)):
                 qpos[j] = old
                 return BLOCKED
         elif self._always_probe and self._probe_touches(a, old):
@@ -417,6 +425,7 @@ class ContinuousArm(NoisyJointMoves):
         ``sum_j |dq_j| * reach_j``) is over a wall or off the table; near a wall MuJoCo is also
         asked for contacts at up to 3 of those points. It leaves the lattice: :meth:`key` names
         such a configuration only with noise; :meth:`reset` goes back to the lattice's start."""
+        self._fresh = False
         turn = np.asarray(dq, dtype=np.float64).reshape(-1)
         if turn.shape != (self.dof,) or not np.all(np.isfinite(turn)):
             raise ArmModelError(f"a joint move of this arm is {self.dof} finite angles, got {dq!r}")
@@ -486,6 +495,33 @@ class ContinuousArm(NoisyJointMoves):
         state[25][0] = self.label
         state[26][0] = self.moves
         return state
+
+    def fast_step(self, a: int) -> int:
+        """:meth:`move` by the compiled move (``ik.handles.planar_move``; the same result), when
+        the arm has one."""
+        if self._noisy:
+            return self.move(a)
+        if not self._fresh:  # the arm moved in Python since: the arrays from its state
+            state = self.fast()
+            if state is None:
+                return self.move(a)
+            if self._table is None:
+                from armtransfer.ik import fastmove, handles
+
+                self._table = handles.of_state(fastmove.PLANAR, state)
+                self._kernel = fastmove.planar_move
+            self._fresh = True
+        v = self._kernel(a, self._table)
+        if v == PYTHON:
+            return self.move(a)
+        self.moves += 1
+        if v >= 0:
+            state = self._fast
+            self._n[a >> 1] = int(state[7][a >> 1])
+            t = state[24]
+            self._tip = (float(t[0]), float(t[1]), float(t[2]))
+            self.label = v
+        return v
 
     def fast_done(self) -> None:
         """Take back the arm's state from the compiled move's arrays."""

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -37,6 +38,7 @@ from armtransfer.errors import ArmModelError, InvalidCellError, UnreachableTable
 from armtransfer.ik.compile import joint_box
 from armtransfer.ik.continuous import BLOCKED, MAX_NOISE, NoisyJointMoves
 from armtransfer.ik import swept
+from armtransfer.ik.fastmove import PYTHON
 from armtransfer.ik.scene import ArmScene, ContactChecker
 from armtransfer.ik.voxels import (SpatialFK, _move_clear, choose_step, moved_joints, spatial_origin,
                                    voxel_of_point, workspace_voxels)
@@ -152,9 +154,11 @@ class SpatialContinuousArm(NoisyJointMoves):
         self._anchors = np.zeros((self.dof, 3))
         self._axes = np.zeros((self.dof, 3))
         self._work = np.zeros(3)
-        self._work2 = np.zeros((6, 3))
+        self._work2 = np.zeros((7, 3))
         self._stack = np.zeros((64, 4))
         self._fast: tuple | None | bool = False
+        self._table: np.ndarray | None = None  # the compiled move's state by address (``ik.handles``)
+        self._kernel: Any = None
 
     def _depth(self, body: int) -> int:
         k, n = int(body), 0
@@ -469,6 +473,29 @@ class SpatialContinuousArm(NoisyJointMoves):
         state[-2][0] = self.label
         state[-1][0] = self.moves
         return state
+
+    def fast_step(self, a: int) -> int:
+        """:meth:`move` by the compiled move (``ik.handles.spatial_move``; the same result), when
+        the arm has one."""
+        if self._table is None:
+            state = self.fast()
+            if state is None:
+                return self.move(a)
+            from armtransfer.ik import fastmove3d, handles
+
+            self._table = handles.of_state(fastmove3d.SPATIAL, state)
+            self._kernel = fastmove3d.spatial_move
+        elif self._noisy or self._off:
+            return self.move(a)
+        v = self._kernel(a, self._table)  # the arrays it reads are the arm's own
+        if v == PYTHON:
+            return self.move(a)
+        self.moves += 1
+        if v >= 0:
+            j = self._qidx[a >> 1]
+            self._full[j] = self._qpos[j]
+            self.label = v
+        return v
 
     def fast_done(self) -> None:
         """Take back the arm's state from the compiled move's arrays."""

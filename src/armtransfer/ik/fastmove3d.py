@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numba
 
-from armtransfer.ik import swept
+from armtransfer.ik import handles, swept
 from armtransfer.ik.fastmove import BLOCKED, PYTHON, _call, _touches_now
 
 
@@ -67,3 +67,21 @@ def move(a, arm):
     label[0] = v
     swept.capture(geom_xpos, geom_xmat, geoms, offset, xanchor, xaxis, joints, frames, anchors, axes)
     return v
+
+
+SPATIAL = handles.RAW + (" f8:1 f8:2 f8:2 f8:2 f8:2 f8:2 int i8:1 i8:1 f8:1 f8:1 i8:1 i8:1 i8:1 float f8:1 f8:1 float i8:1"
+                 " b:1 f8:1 f8:3 f8:2 i8:1 b:2 f8:2 b:2 i8:1 f8:2 f8:2 f8:2 f8:2 f8:1 f8:2 i8:1 i8:1")
+"""What :func:`spatial_move` reads: ``SpatialContinuousArm.fast``'s tuple, ``raw`` spread out."""
+
+
+@numba.njit(cache=True, nogil=True)
+def spatial_move(a, t):
+    """``ik.fastmove3d.move(a, arm)`` on the arm of the table ``t`` (:data:`SPATIAL`)."""
+    k = 48
+    arm = (handles._raw(t), handles._f1(t, k), handles._f2(t, k + 4), handles._f2(t, k + 8), handles._f2(t, k + 12), handles._f2(t, k + 16), handles._f2(t, k + 20),
+           t[k + 24], handles._i1(t, k + 28), handles._i1(t, k + 32), handles._f1(t, k + 36), handles._f1(t, k + 40), handles._i1(t, k + 44),
+           handles._i1(t, k + 48), handles._i1(t, k + 52), handles._float(t, k + 56), handles._f1(t, k + 60), handles._f1(t, k + 64), handles._float(t, k + 68),
+           handles._i1(t, k + 72), handles._b1(t, k + 76), handles._f1(t, k + 80), handles._f3(t, k + 84), handles._f2(t, k + 88), handles._i1(t, k + 92),
+           handles._b2(t, k + 96), handles._f2(t, k + 100), handles._b2(t, k + 104), handles._i1(t, k + 108), handles._f2(t, k + 112), handles._f2(t, k + 116),
+           handles._f2(t, k + 120), handles._f2(t, k + 124), handles._f1(t, k + 128), handles._f2(t, k + 132), handles._i1(t, k + 136), handles._i1(t, k + 140))
+    return move(a, arm)

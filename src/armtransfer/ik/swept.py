@@ -21,6 +21,13 @@ clear has a travel below :data:`RESOLUTION` (the geometry comes within RESOLUTIO
 So the resolution is the geometry's own: a geom far from every box is cleared by the distances
 at the two ends, a geom that grazes a box is checked more finely the closer it comes.
 
+Before the distances, two cheaper tests clear a geom and a box: the ball around the geom's
+centre that holds its shape, grown by its travel, misses the box; or along one world axis the
+shape's extent and the box's are apart by more than the shape's vertices can move along that
+axis in the turn (a point turning about an axis moves along world axis k at most at the
+amplitude of its k-th coordinate's oscillation: 0 along a vertical axis's own direction, so a
+planar arm's turn never nears the table top).
+
 The distance from a segment to a box is convex along the segment; it is found by golden-section
 search and lowered by the search's remaining bracket times the segment's length (a lower bound).
 """
@@ -259,6 +266,61 @@ def speed(f, size, kind, c, a):
 
 
 @numba.njit(cache=True, nogil=True)
+def _amplitudes(x, y, z, c, a, out):
+    """Per world axis k, the most |dp_k / dangle| of the point (x, y, z) turning about the axis a
+    through c, over any turn: p_k oscillates as cos and sin with amplitude sqrt(u_k^2 + w_k^2),
+    u = v - a (a . v), w = a x v, v = p - c. Kept as the running maximum in ``out``."""
+    vx = x - c[0]
+    vy = y - c[1]
+    vz = z - c[2]
+    d = a[0] * vx + a[1] * vy + a[2] * vz
+    ux = vx - a[0] * d
+    uy = vy - a[1] * d
+    uz = vz - a[2] * d
+    wx = a[1] * vz - a[2] * vy
+    wy = a[2] * vx - a[0] * vz
+    wz = a[0] * vy - a[1] * vx
+    out[0] = max(out[0], math.sqrt(ux * ux + wx * wx))
+    out[1] = max(out[1], math.sqrt(uy * uy + wy * wy))
+    out[2] = max(out[2], math.sqrt(uz * uz + wz * wz))
+
+
+@numba.njit(cache=True, nogil=True)
+def axis_speeds(f, size, kind, c, a, out):
+    """``out[k]``: the most a vertex of the geom's core (a capsule's segment ends, a box's corners)
+    moves along world axis k per radian of a turn about a through c; the shape's extent along k
+    is set by its vertices, so it moves no faster."""
+    out[0] = 0.0
+    out[1] = 0.0
+    out[2] = 0.0
+    if kind == 0:
+        for s in (-1.0, 1.0):
+            h = s * size[0]
+            _amplitudes(f[0, 0] + h * f[3, 0], f[0, 1] + h * f[3, 1], f[0, 2] + h * f[3, 2], c, a, out)
+        return
+    for s0 in (-1.0, 1.0):
+        for s1 in (-1.0, 1.0):
+            for s2 in (-1.0, 1.0):
+                x = f[0, 0] + s0 * size[0] * f[1, 0] + s1 * size[1] * f[2, 0] + s2 * size[2] * f[3, 0]
+                y = f[0, 1] + s0 * size[0] * f[1, 1] + s1 * size[1] * f[2, 1] + s2 * size[2] * f[3, 1]
+                z = f[0, 2] + s0 * size[0] * f[1, 2] + s1 * size[1] * f[2, 2] + s2 * size[2] * f[3, 2]
+                _amplitudes(x, y, z, c, a, out)
+
+
+@numba.njit(cache=True, nogil=True)
+def axis_gap(f, size, kind, b, k):
+    """The gap between the shape's extent along world axis k and the box's (0 or less: overlap)."""
+    if kind == 0:
+        lo = min(f[0, k] - size[0] * f[3, k], f[0, k] + size[0] * f[3, k]) - size[1]
+        hi = max(f[0, k] - size[0] * f[3, k], f[0, k] + size[0] * f[3, k]) + size[1]
+    else:
+        half = size[0] * abs(f[1, k]) + size[1] * abs(f[2, k]) + size[2] * abs(f[3, k])
+        lo = f[0, k] - half
+        hi = f[0, k] + half
+    return max(lo - (b[k] + b[3 + k]), (b[k] - b[3 + k]) - hi)
+
+
+@numba.njit(cache=True, nogil=True)
 def rotation_clear(frames, sizes, kinds, carried, c, a, theta, boxes, pairs, stack, work):
     """Whether turning the geoms ``carried`` (bool over the rows of ``frames``) by ``theta``
     about the axis ``a`` through ``c`` keeps every one of them clear of every box it may touch
@@ -270,12 +332,24 @@ def rotation_clear(frames, sizes, kinds, carried, c, a, theta, boxes, pairs, sta
         v, hold = speed(f, sizes[g], kinds[g], c, a)
         travel = abs(theta) * v
         reach = travel + hold + (sizes[g, 1] if kinds[g] == 0 else 0.0)
+        axes_done = False
         for o in range(boxes.shape[0]):
             if not pairs[g, o]:
                 continue
             b = boxes[o]
             # the ball around the geom's centre, grown by the travel, misses the box: clear
             if _point_box(f[0, 0], f[0, 1], f[0, 2], b) > reach:
+                continue
+            # separated along a world axis by more than the shape can move along it: clear
+            if not axes_done:
+                axis_speeds(f, sizes[g], kinds[g], c, a, work[6])
+                axes_done = True
+            apart = False
+            for k in range(3):
+                if axis_gap(f, sizes[g], kinds[g], b, k) > abs(theta) * work[6, k]:
+                    apart = True
+                    break
+            if apart:
                 continue
             if not _pair_clear(f, sizes[g], kinds[g], c, a, theta, travel, b, stack, work):
                 return False
