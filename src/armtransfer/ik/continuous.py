@@ -516,9 +516,10 @@ class ContinuousArm(NoisyJointMoves):
             return self.move(a)
         self.moves += 1
         if v >= 0:
-            state = self._fast
-            self._n[a >> 1] = int(state[7][a >> 1])
-            t = state[24]
+            arrays = self._fast
+            assert isinstance(arrays, tuple)
+            self._n[a >> 1] = int(arrays[7][a >> 1])
+            t = arrays[24]
             self._tip = (float(t[0]), float(t[1]), float(t[2]))
             self.label = v
         return v
