@@ -212,6 +212,10 @@ class ContinuousArm(NoisyJointMoves):
         self._fast: tuple | None | bool = False  # False: not built yet; None: not available
         self._table: np.ndarray | None = None  # the compiled move's state by address (``ik.handles``)
         self._kernel: Any = None
+        self._line_table: np.ndarray | None = None  # the compiled straight move's (``_line``)
+        self._line_keep: list = []
+        self._line_tip = np.zeros(3)
+        self._box_lo, self._box_hi = np.zeros(self.dof), np.zeros(self.dof)
         self._fresh = False  # the compiled move's arrays hold the arm's state (:meth:`fast_step`)
         # the swept check of a turn (``ik.swept``): every geom the joint carries, against the
         # table and wall boxes, along the whole turn; from the end's kinematics, turned back
@@ -246,6 +250,7 @@ class ContinuousArm(NoisyJointMoves):
             raise InvalidCellError("the arm's tool point is not over a free cell at this configuration")
         lo, hi = joint_box(self.scene, q)
         self._box = (lo.tolist(), hi.tolist())
+        self._box_lo[:], self._box_hi[:] = lo, hi
         self._q0 = q.tolist()
         self._n = [0] * self.dof
         self._nlo = np.ceil((lo - q) / self.step - 1e-9).astype(np.int64).tolist()
@@ -424,14 +429,60 @@ class ContinuousArm(NoisyJointMoves):
         joint space (spaced so that the tip moves at most half a cell between them, by
         ``sum_j |dq_j| * reach_j``) is over a wall or off the table; near a wall MuJoCo is also
         asked for contacts at up to 3 of those points. It leaves the lattice: :meth:`key` names
-        such a configuration only with noise; :meth:`reset` goes back to the lattice's start."""
-        self._fresh = False
+        such a configuration only with noise; :meth:`reset` goes back to the lattice's start.
+        Every geom is also swept against the table and walls along the line (``ik.fastline``,
+        compiled; a move whose contacts the compiled code cannot read is checked here in
+        Python, by the tool points and probes alone)."""
         turn = np.asarray(dq, dtype=np.float64).reshape(-1)
         if turn.shape != (self.dof,) or not np.all(np.isfinite(turn)):
             raise ArmModelError(f"a joint move of this arm is {self.dof} finite angles, got {dq!r}")
         if self._noisy:
             turn = turn * (1.0 + np.array([self._next_eps() for _ in range(self.dof)]))
+        return self._move_by(turn)
+
+    def _line(self) -> np.ndarray | None:
+        """The table ``ik.fastline.line_move`` reads, or None (no compiled move)."""
+        if self._line_table is not None:
+            return self._line_table
+        from armtransfer.ik import fastline, handles
+
+        if self._fast is False:
+            self._fast = self._build_fast()
+        if not isinstance(self._fast, tuple):
+            return None
+        model, d, n_g = self.model, self.data, len(self._sw_geoms)
+        reach, tip_reach = swept.reaches(model, self.scene.home.astype(float), self._sw_geoms, self._sw_sizes,
+                                         self._sw_offset, self._tip_id)
+        w = self._width
+        items = list(self._fast[0]) + [
+            self._qpos, self._site_xpos, d.geom_xpos, d.geom_xmat, d.xanchor, d.xaxis, int(self._tip_id), 0,
+            self._cell_size, np.array([self._lo, self._lo + w - 1, w, w * w], np.int64),
+            np.ascontiguousarray(self._free, dtype=np.bool_), np.array(self._clear, np.int64),
+            bool(self._always_probe), self._box_lo, self._box_hi, tip_reach, reach, self._sw_geoms, self._sw_offset,
+            self._sw_sizes, self._sw_kinds, self._sw_boxes, self._sw_pairs, np.zeros((n_g, 4, 3)), False,
+            np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(0),
+            self._line_tip, np.zeros(1, np.int64), np.zeros(model.nq), np.zeros((n_g, 4, 3)),
+            np.zeros((fastline.MAX_POINTS, n_g)), np.zeros(n_g), np.zeros((7, 3)), np.zeros((64, 4)),
+            np.zeros((n_g, 4, 3)), np.zeros((0, 3)), True, np.zeros((n_g, len(self._sw_boxes)), np.bool_)]
+        self._line_keep = items
+        self._line_table = handles.table(fastline.LINE, items)
+        return self._line_table
+
+    def _move_by(self, turn: np.ndarray) -> int:
+        """:meth:`move_by` of a checked turn (noise applied)."""
+        self._fresh = False
         self.moves += 1
+        line = self._line()
+        if line is not None:
+            from armtransfer.ik import fastline
+
+            v = fastline.line_move(line, turn)
+            if v != PYTHON:
+                if v >= 0:
+                    t = self._line_tip.tolist()
+                    self._tip = (t[0], t[1], t[2])
+                    self.label = v
+                return v
         qpos = self._qpos
         old = qpos.copy()
         new = old + turn

@@ -123,30 +123,8 @@ class SpatialContinuousArm(NoisyJointMoves):
         (self._geoms, self._sizes, self._kinds, self._offset, self._boxes, self._pairs, self._carried,
          aligned) = arrays
         geoms = self._geoms.tolist()
-        d = mujoco.MjData(model)
-        d.qpos[:] = self.origin
-        mujoco.mj_kinematics(model, d)
-        parent = model.body_parentid
-        below = np.zeros((model.njnt, model.nbody), bool)
-        for b in range(model.nbody):
-            k = b
-            while k > 0:
-                below[model.jnt_bodyid == k, b] = True
-                k = parent[k]
-        # reach[q, g]: a bound on the distance of geom g's core from joint q's axis in any
-        # configuration (the anchors below it, one to the next, then to the core's ends)
-        frames = np.empty((len(geoms), 4, 3))
-        swept.capture(d.geom_xpos, d.geom_xmat, self._geoms, self._offset, d.xanchor, d.xaxis, self._joints, frames,
-                      np.empty((self.dof, 3)), np.empty((self.dof, 3)))
-        self._reach = np.zeros((model.nq, len(geoms)))
-        for gi, g in enumerate(geoms):
-            chain = [j for j in range(model.njnt) if below[j, model.geom_bodyid[g]]]
-            chain.sort(key=lambda j: (self._depth(model.jnt_bodyid[j]), j))
-            for a, j in enumerate(chain):
-                path = sum(float(np.linalg.norm(d.xanchor[chain[k + 1]] - d.xanchor[chain[k]]))
-                           for k in range(a, len(chain) - 1))
-                self._reach[model.jnt_qposadr[j], gi] = path + float(np.linalg.norm(
-                    frames[gi, 0] - d.xanchor[chain[-1]])) + float(np.linalg.norm(self._sizes[gi]))
+        self._reach, self._tip_reach = swept.reaches(model, self.origin, self._geoms, self._sizes, self._offset,
+                                                     self._tip_id)
         self._sampled = bool(checker.can_self_collide or not aligned)
         """Self-contacts or a workspace not made of axis-aligned boxes: the moves are checked by
         MuJoCo at points of the move instead (``ik.voxels._move_clear``), in Python."""
@@ -159,12 +137,9 @@ class SpatialContinuousArm(NoisyJointMoves):
         self._fast: tuple | None | bool = False
         self._table: np.ndarray | None = None  # the compiled move's state by address (``ik.handles``)
         self._kernel: Any = None
-
-    def _depth(self, body: int) -> int:
-        k, n = int(body), 0
-        while k > 0:
-            k, n = int(self.model.body_parentid[k]), n + 1
-        return n
+        self._line_table: np.ndarray | None = None  # the compiled straight move's (``_line``)
+        self._line_keep: list = []
+        self._line_turn = np.zeros(0)
 
     # ------------------------------------------------------------------ configurations
 
@@ -374,7 +349,25 @@ class SpatialContinuousArm(NoisyJointMoves):
             raise ArmModelError(f"a joint move of this arm is {self.dof} finite angles, got {dq!r}")
         if self._noisy:
             turn = turn * (1.0 + np.array([self._next_eps() for _ in range(self.dof)]))
+        return self._move_by(turn)
+
+    def _move_by(self, turn: np.ndarray) -> int:
+        """:meth:`move_by` of a checked turn (noise applied): by ``ik.fastline.line_move`` when
+        the arm has it (the same rule as :meth:`_go`, compiled)."""
         self.moves += 1
+        line = self._line()
+        if line is not None:
+            from armtransfer.ik import fastline
+
+            whole = self._line_turn
+            whole[self._qidx] = turn
+            v = fastline.line_move(line, whole)
+            if v != PYTHON:
+                if v >= 0:
+                    self._full[:] = self._qpos
+                    self.label = v
+                    self._off = True
+                return v
         qm = self._q + turn
         if np.any(qm < self._lo) or np.any(qm > self._hi):
             return BLOCKED
@@ -382,6 +375,34 @@ class SpatialContinuousArm(NoisyJointMoves):
         if label >= 0:
             self._off = True
         return label
+
+    def _line(self) -> np.ndarray | None:
+        """The table ``ik.fastline.line_move`` reads, or None (moves checked by sampling, or no
+        compiled move)."""
+        if self._line_table is not None or self._sampled or self._start is None:
+            return self._line_table
+        from armtransfer.ik import fastline, handles
+
+        if self._fast is False:
+            self._fast = self._build_fast()
+        if not isinstance(self._fast, tuple):
+            return None
+        model, d, n_g = self.model, self.data, len(self._geoms)
+        lo = np.full(model.nq, -np.inf)
+        hi = np.full(model.nq, np.inf)
+        lo[self._qidx], hi[self._qidx] = self._lo, self._hi
+        self._line_turn = np.zeros(model.nq)
+        items = list(self._fast[0]) + [
+            self._qpos, self._site_xpos, d.geom_xpos, d.geom_xmat, d.xanchor, d.xaxis, self._tip_id, self.levels,
+            self.cell, np.array(self._shape[:4], np.int64), self._vfree, np.zeros(1, np.int64), False, lo, hi,
+            self._tip_reach, self._reach, self._geoms, self._offset, self._sizes, self._kinds, self._boxes,
+            self._pairs, self._frames, True, self._joints, self._anchors, self._axes, np.array(self._qidx, np.int64),
+            self._q, self._tip, np.zeros(1, np.int64), np.zeros(model.nq), np.zeros((n_g, 4, 3)),
+            np.zeros((fastline.MAX_POINTS, n_g)), np.zeros(n_g), np.zeros((7, 3)), np.zeros((64, 4)),
+            np.zeros((n_g, 4, 3)), np.zeros((2 * self.dof, 3)), False, np.zeros((n_g, len(self._boxes)), np.bool_)]
+        self._line_keep = items
+        self._line_table = handles.table(fastline.LINE, items)
+        return self._line_table
 
     def _go(self, qm: np.ndarray, n: np.ndarray | None) -> int:
         """The straight joint move to ``qm``: MuJoCo at its end, the tool point at points at most
@@ -454,7 +475,8 @@ class SpatialContinuousArm(NoisyJointMoves):
         swept.capture(d.geom_xpos, d.geom_xmat, self._geoms, self._offset, d.xanchor, d.xaxis, self._joints,
                       frames, np.empty_like(self._anchors), np.empty_like(self._axes))
         out = np.empty(len(self._geoms))
-        swept.clearances(frames, self._sizes, self._kinds, self._boxes, self._pairs, self._work2, out)
+        swept.clearances(frames, self._sizes, self._kinds, self._boxes, self._pairs, self._work2,
+                         np.full(len(self._geoms), np.inf), out)
         return out
 
     # ------------------------------------------------------------------ the compiled move

@@ -375,15 +375,24 @@ def capture(geom_xpos, geom_xmat, geoms, offset, xanchor, xaxis, joints, frames,
 
 
 @numba.njit(cache=True, nogil=True)
-def clearances(frames, sizes, kinds, boxes, pairs, work, out):
-    """``out[g]``: the least D of geom g to the boxes it may touch (inf: none)."""
+def clearances(frames, sizes, kinds, boxes, pairs, work, cap, out):
+    """``out[g]``: a lower bound on geom g's least D to the boxes it may touch (inf: none),
+    exact (``shape_gap``) where it is below ``cap[g]``: the largest gap along a world axis first,
+    the distance search only for a box that gap leaves nearer than the cap and the best so far."""
     for g in range(frames.shape[0]):
         best = np.inf
         for o in range(boxes.shape[0]):
-            if pairs[g, o]:
-                d = shape_gap(frames[g], sizes[g], kinds[g], boxes[o], work)
-                if d < best:
-                    best = d
+            if not pairs[g, o]:
+                continue
+            lb = max(axis_gap(frames[g], sizes[g], kinds[g], boxes[o], 0),
+                     axis_gap(frames[g], sizes[g], kinds[g], boxes[o], 1),
+                     axis_gap(frames[g], sizes[g], kinds[g], boxes[o], 2))
+            if lb >= best:
+                continue
+            if lb <= cap[g]:
+                lb = max(lb, shape_gap(frames[g], sizes[g], kinds[g], boxes[o], work))
+            if lb < best:
+                best = lb
         out[g] = best
 
 
@@ -425,3 +434,46 @@ def shapes(scene, checker, joints: np.ndarray, q: np.ndarray) -> tuple:
     carried = np.ascontiguousarray(below[np.ix_(np.asarray(joints, np.int64), model.geom_bodyid[geoms])]
                                    ).reshape(len(joints), len(geoms))
     return (np.array(geoms, np.int64), sizes, kinds, offset, boxes, pairs, carried, bool(aligned))
+
+
+def reaches(model, q: np.ndarray, geoms: np.ndarray, sizes: np.ndarray, offset: np.ndarray,
+            site: int) -> tuple[np.ndarray, np.ndarray]:
+    """(reach [nq, G], tip_reach [nq]): bounds, in any configuration, on the distance from joint
+    q's axis of any point of geom g's shape, and of the site ``site``: the distances from the
+    joint's anchor to the next joint's anchor below it, and so on (each fixed in a body), then to
+    the shape's centre, plus the shape's half diagonal. Measured at the configuration ``q``."""
+    import mujoco  # here: the compiled moves import this module without MuJoCo's bindings
+
+    d = mujoco.MjData(model)
+    d.qpos[:] = q
+    mujoco.mj_kinematics(model, d)
+    frames = np.empty((len(geoms), 4, 3))
+    capture(d.geom_xpos, d.geom_xmat, np.asarray(geoms, np.int64), offset, d.xanchor, d.xaxis,
+            np.zeros(0, np.int64), frames, np.zeros((0, 3)), np.zeros((0, 3)))
+
+    def depth(body: int) -> int:
+        n = 0
+        while body > 0:
+            body, n = int(model.body_parentid[body]), n + 1
+        return n
+
+    def bound(body: int, centre: np.ndarray, radius: float, out: np.ndarray) -> None:
+        chain = []
+        b = body
+        while b > 0:
+            chain += [j for j in range(model.njnt) if model.jnt_bodyid[j] == b]
+            b = int(model.body_parentid[b])
+        chain.sort(key=lambda j: (depth(int(model.jnt_bodyid[j])), j))
+        for a, j in enumerate(chain):
+            path = sum(float(np.linalg.norm(d.xanchor[chain[k + 1]] - d.xanchor[chain[k]]))
+                       for k in range(a, len(chain) - 1))
+            out[model.jnt_qposadr[j]] = path + float(np.linalg.norm(centre - d.xanchor[chain[-1]])) + radius
+
+    reach = np.zeros((model.nq, len(geoms)))
+    for gi, g in enumerate(geoms):
+        col = np.zeros(model.nq)
+        bound(int(model.geom_bodyid[g]), frames[gi, 0], float(np.linalg.norm(sizes[gi])), col)
+        reach[:, gi] = col
+    tip = np.zeros(model.nq)
+    bound(int(model.site_bodyid[site]), d.site_xpos[site].copy(), 0.0, tip)
+    return reach, tip

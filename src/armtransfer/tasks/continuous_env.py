@@ -115,20 +115,28 @@ class ContinuousArmRoomsEnv(gym.Env):
         return obs, reward, terminated, False, {"label": label, "blocked": moved < 0}
 
     def _step_box(self, action):
-        dof = self.arm.dof
+        arm = self.arm
+        dof = arm.dof
         try:
             a = np.asarray(action, dtype=np.float64)
         except (TypeError, ValueError):
             a = np.full(1, np.nan)
-        if a.shape != (dof,) or not np.all(np.isfinite(a)) or np.any(np.abs(a) > 1.0):
+        if a.shape != (dof,) or not (np.abs(a) <= 1.0).all():  # NaN fails the comparison too
             raise InvalidActionError(f"action must be {dof} finite numbers in [-1, 1] (the action space "
-                                     f"{self.action_space}: joint turns in steps of {self.arm.step:g} rad), "
+                                     f"{self.action_space}: joint turns in steps of {arm.step:g} rad), "
                                      f"got {action!r}")
-        moved = self.arm.move_by(a * self.arm.step)
-        label = self.arm.label
+        turn = a * arm.step
+        if arm.noise > 0.0:
+            moved = arm.move_by(turn)
+        else:
+            moved = arm._move_by(turn)  # move_by without checking the turn again
+        label = arm.label
         terminated = label == self.goal_cell
         reward = self.step_reward + (self.goal_reward if terminated else 0.0)
-        return self._obs(), reward, terminated, False, {"label": label, "blocked": moved < 0}
+        obs = np.empty(self._obs_size)
+        obs[:dof] = arm.q
+        obs[dof:] = arm.tip()
+        return obs, reward, terminated, False, {"label": label, "blocked": moved < 0}
 
     def render(self):
         if self.render_mode == "ansi":
