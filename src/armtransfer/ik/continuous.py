@@ -454,16 +454,22 @@ class ContinuousArm(NoisyJointMoves):
         reach, tip_reach = swept.reaches(model, self.scene.home.astype(float), self._sw_geoms, self._sw_sizes,
                                          self._sw_offset, self._tip_id)
         w = self._width
+        jnt = self._jnt.astype(np.int64)
+        tip_carried, ordered = swept.chain_tables(model, jnt, self._tip_id)
+        if not ordered:
+            return None
+        nq = model.nq
         items = list(self._fast[0]) + [
             self._qpos, self._site_xpos, d.geom_xpos, d.geom_xmat, d.xanchor, d.xaxis, int(self._tip_id), 0,
             self._cell_size, np.array([self._lo, self._lo + w - 1, w, w * w], np.int64),
             np.ascontiguousarray(self._free, dtype=np.bool_), np.array(self._clear, np.int64),
             bool(self._always_probe), self._box_lo, self._box_hi, tip_reach, reach, self._sw_geoms, self._sw_offset,
             self._sw_sizes, self._sw_kinds, self._sw_boxes, self._sw_pairs, np.zeros((n_g, 4, 3)), False,
-            np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, np.int64), np.zeros(0),
-            self._line_tip, np.zeros(1, np.int64), np.zeros(model.nq), np.zeros((n_g, 4, 3)),
-            np.zeros((fastline.MAX_POINTS, n_g)), np.zeros(n_g), np.zeros((7, 3)), np.zeros((64, 4)),
-            np.zeros((n_g, 4, 3)), np.zeros((0, 3)), True, np.zeros((n_g, len(self._sw_boxes)), np.bool_)]
+            np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), self._line_tip,
+            np.zeros(1, np.int64), np.zeros(nq), np.zeros((n_g, 4, 3)), np.zeros((fastline.MAX_POINTS, n_g)),
+            np.zeros(n_g), np.zeros((7, 3)), np.zeros((64, 4)), True, np.zeros((n_g, len(self._sw_boxes)), np.bool_),
+            np.arange(nq, dtype=np.int64), jnt, self._sw_carried, tip_carried, np.zeros((nq, 3)), np.zeros((nq, 3)),
+            np.zeros((n_g, 4, 3)), np.zeros(3), np.zeros(nq), np.zeros(nq), np.zeros(3)]
         self._line_keep = items
         self._line_table = handles.table(fastline.LINE, items)
         return self._line_table

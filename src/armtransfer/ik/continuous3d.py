@@ -392,14 +392,19 @@ class SpatialContinuousArm(NoisyJointMoves):
         hi = np.full(model.nq, np.inf)
         lo[self._qidx], hi[self._qidx] = self._lo, self._hi
         self._line_turn = np.zeros(model.nq)
+        tip_carried, ordered = swept.chain_tables(model, self._joints, self._tip_id)
+        if not ordered:
+            return None
+        dof = self.dof
         items = list(self._fast[0]) + [
             self._qpos, self._site_xpos, d.geom_xpos, d.geom_xmat, d.xanchor, d.xaxis, self._tip_id, self.levels,
             self.cell, np.array(self._shape[:4], np.int64), self._vfree, np.zeros(1, np.int64), False, lo, hi,
             self._tip_reach, self._reach, self._geoms, self._offset, self._sizes, self._kinds, self._boxes,
-            self._pairs, self._frames, True, self._joints, self._anchors, self._axes, np.array(self._qidx, np.int64),
-            self._q, self._tip, np.zeros(1, np.int64), np.zeros(model.nq), np.zeros((n_g, 4, 3)),
-            np.zeros((fastline.MAX_POINTS, n_g)), np.zeros(n_g), np.zeros((7, 3)), np.zeros((64, 4)),
-            np.zeros((n_g, 4, 3)), np.zeros((2 * self.dof, 3)), False, np.zeros((n_g, len(self._boxes)), np.bool_)]
+            self._pairs, self._frames, True, self._joints, self._anchors, self._axes, self._q, self._tip,
+            np.zeros(1, np.int64), np.zeros(model.nq), np.zeros((n_g, 4, 3)), np.zeros((fastline.MAX_POINTS, n_g)),
+            np.zeros(n_g), np.zeros((7, 3)), np.zeros((64, 4)), False, np.zeros((n_g, len(self._boxes)), np.bool_),
+            np.array(self._qidx, np.int64), self._joints, self._carried, tip_carried, np.zeros((dof, 3)),
+            np.zeros((dof, 3)), np.zeros((n_g, 4, 3)), np.zeros(3), np.zeros(dof), np.zeros(dof), np.zeros(3)]
         self._line_keep = items
         self._line_table = handles.table(fastline.LINE, items)
         return self._line_table

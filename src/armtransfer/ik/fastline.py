@@ -15,7 +15,10 @@ boxes (``ik.swept``), is Lipschitz in t with constant rate_g = sum_j |turn_j| * 
 (``reach``: a bound on the distance of g's shape from joint j's axis in any configuration; a
 planar arm's geoms keep their heights, so a box apart from a geom in height is left out). D is
 computed at the start (a spatial arm: from the frames its last move left; a planar arm: from
-MuJoCo's kinematics there), at each tool point and at the end, from the kinematics run there;
+MuJoCo's kinematics there) and at the end, then at the middles of the intervals split; the shapes and the tool point
+along the line come from the start's by the product of exponentials (each joint's turn about its
+axis at the start, the deepest first), without MuJoCo, so all of this runs before MuJoCo is
+asked, once, at the end;
 an interval [t0, t1] is clear when D_g(t0) + D_g(t1) > (t1 - t0) * rate_g for every g, else it is
 split at its middle (kinematics there) until its largest travel is under ``swept.RESOLUTION``
 (then the move is blocked), as ``ik.swept`` does for a turn. An arm that can touch itself is also
@@ -36,9 +39,9 @@ MAX_POINTS = 128
 """The most configurations of one move whose clearances are kept (more: the move is blocked)."""
 
 LINE = handles.RAW + (" f8:1 f8:2 f8:2 f8:2 f8:2 f8:2 int int float i8:1 b:1 i8:1 bool f8:1 f8:1 f8:1 f8:2 i8:1 f8:2"
-                      " f8:2 i8:1 f8:2 b:2 f8:3 bool i8:1 f8:2 f8:2 i8:1 f8:1 f8:1 i8:1 f8:1 f8:3 f8:2 f8:1"
-                      " f8:2 f8:2 f8:3 f8:2 bool b:2")
-"""What :func:`line_move` reads (see ``tables``)."""
+                      " f8:2 i8:1 f8:2 b:2 f8:3 bool i8:1 f8:2 f8:2 f8:1 f8:1 i8:1 f8:1 f8:3 f8:2 f8:1 f8:2 f8:2"
+                      " bool b:2 i8:1 i8:1 b:2 b:1 f8:2 f8:2 f8:3 f8:1 f8:1 f8:1 f8:1")
+"""What :func:`line_move` reads (the arms' ``_line`` build it)."""
 
 
 @numba.njit(cache=True, nogil=True)
@@ -57,12 +60,54 @@ def _label(p, levels, cell, grid, free):
     return c
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _rot(p, c0, c1, c2, a, cs, sn):
+    """Turn the point p (in place) by the angle of cosine cs and sine sn about the axis a through
+    (c0, c1, c2)."""
+    vx = p[0] - c0
+    vy = p[1] - c1
+    vz = p[2] - c2
+    d = (a[0] * vx + a[1] * vy + a[2] * vz) * (1.0 - cs)
+    p[0] = c0 + vx * cs + (a[1] * vz - a[2] * vy) * sn + a[0] * d
+    p[1] = c1 + vy * cs + (a[2] * vx - a[0] * vz) * sn + a[1] * d
+    p[2] = c2 + vz * cs + (a[0] * vy - a[1] * vx) * sn + a[2] * d
+
+
 @numba.njit(cache=True, nogil=True)
-def _clear_at(geom_xpos, geom_xmat, geoms, offset, sizes, kinds, boxes, pairs, frames, work, cap, out):
-    """``out[g]``: geom g's least D to the boxes at the configuration whose kinematics just ran."""
-    dummy = np.zeros((0, 3))
-    swept.capture(geom_xpos, geom_xmat, geoms, offset, dummy, dummy, np.zeros(0, np.int64), frames, dummy, dummy)
-    swept.clearances(frames, sizes, kinds, boxes, pairs, work, cap, out)
+def _pose(tt, turn, movers, a0, x0, carried, tip_carried, frames0, tip0, cs, sn, fr, tip_out):
+    """The geoms' frames and the tool point at the fraction ``tt`` of the straight move, from the
+    start's (``frames0``, ``tip0``, the movers' anchors ``a0`` and axes ``x0``): the product of
+    exponentials, each mover's turn about its axis at the start, the deepest first."""
+    m = movers.shape[0]
+    for i in range(m):
+        ang = tt * turn[movers[i]]
+        cs[i] = math.cos(ang)
+        sn[i] = math.sin(ang)
+    for g in range(frames0.shape[0]):
+        for r in range(4):
+            for d in range(3):
+                fr[g, r, d] = frames0[g, r, d]
+        for i in range(m - 1, -1, -1):
+            if carried[i, g] and turn[movers[i]] != 0.0:
+                _rot(fr[g, 0], a0[i, 0], a0[i, 1], a0[i, 2], x0[i], cs[i], sn[i])
+                for r in range(1, 4):
+                    _rot(fr[g, r], 0.0, 0.0, 0.0, x0[i], cs[i], sn[i])
+    for d in range(3):
+        tip_out[d] = tip0[d]
+    for i in range(m - 1, -1, -1):
+        if tip_carried[i] and turn[movers[i]] != 0.0:
+            _rot(tip_out, a0[i, 0], a0[i, 1], a0[i, 2], x0[i], cs[i], sn[i])
+
+
+@numba.njit(cache=True, nogil=True)
+def _tip_at(tt, turn, movers, a0, x0, tip_carried, tip0, tip_out):
+    """The tool point alone at the fraction ``tt`` of the move (as :func:`_pose`)."""
+    for d in range(3):
+        tip_out[d] = tip0[d]
+    for i in range(movers.shape[0] - 1, -1, -1):
+        if tip_carried[i] and turn[movers[i]] != 0.0:
+            ang = tt * turn[movers[i]]
+            _rot(tip_out, a0[i, 0], a0[i, 1], a0[i, 2], x0[i], math.cos(ang), math.sin(ang))
 
 
 @numba.njit(cache=True, nogil=True)
@@ -99,36 +144,113 @@ def line_move(t, turn):
     joints = handles._i1(t, k + 100)
     anchors = handles._f2(t, k + 104)
     axes = handles._f2(t, k + 108)
-    qidx = handles._i1(t, k + 112)
-    q = handles._f1(t, k + 116)
-    tip = handles._f1(t, k + 120)
-    label = handles._i1(t, k + 124)
-    old = handles._f1(t, k + 128)
-    fr = handles._f3(t, k + 132)
-    dstore = handles._f2(t, k + 136)
-    rate = handles._f1(t, k + 140)
-    work = handles._f2(t, k + 144)
-    stack = handles._f2(t, k + 148)
-    fr_end = handles._f3(t, k + 152)
-    end_axes = handles._f2(t, k + 156)
-    flat = t[k + 160] != 0
-    act = handles._b2(t, k + 164)
-    dof = joints.shape[0]
+    q = handles._f1(t, k + 112)
+    tip = handles._f1(t, k + 116)
+    label = handles._i1(t, k + 120)
+    old = handles._f1(t, k + 124)
+    fr = handles._f3(t, k + 128)
+    dstore = handles._f2(t, k + 132)
+    rate = handles._f1(t, k + 136)
+    work = handles._f2(t, k + 140)
+    stack = handles._f2(t, k + 144)
+    flat = t[k + 148] != 0
+    act = handles._b2(t, k + 152)
+    movers = handles._i1(t, k + 156)
+    mover_jnt = handles._i1(t, k + 160)
+    carried = handles._b2(t, k + 164)
+    tip_carried = handles._b1(t, k + 168)
+    a0 = handles._f2(t, k + 172)
+    x0 = handles._f2(t, k + 176)
+    fr0 = handles._f3(t, k + 180)
+    tip0 = handles._f1(t, k + 184)
+    cs = handles._f1(t, k + 188)
+    sn = handles._f1(t, k + 192)
+    ptip = handles._f1(t, k + 196)
 
     nq = qpos.shape[0]
     n_g = geoms.shape[0]
+    m = movers.shape[0]
     for j in range(nq):
         old[j] = qpos[j]
         v = qpos[j] + turn[j]
         if v < box_lo[j] or v > box_hi[j]:
             return BLOCKED
+    # the start: the shapes, tool point and the movers' axes the arm's last move left, or MuJoCo's
+    # kinematics there
+    if stored:
+        for g in range(n_g):
+            for r in range(4):
+                for d in range(3):
+                    fr0[g, r, d] = frames[g, r, d]
+        for d in range(3):
+            tip0[d] = tip[d]
+        for i in range(m):
+            for d in range(3):
+                a0[i, d] = anchors[i, d]
+                x0[i, d] = axes[i, d]
+    else:
+        _call(raw[0], raw[2], raw[3])
+        swept.capture(geom_xpos, geom_xmat, geoms, offset, xanchor, xaxis, mover_jnt, fr0, a0, x0)
+        for d in range(3):
+            tip0[d] = site_xpos[tip_id, d]
+    sweep = 0.0
+    for j in range(nq):
+        sweep += abs(turn[j]) * tip_reach[j]
     for g in range(n_g):
         r = 0.0
         for j in range(nq):
             r += abs(turn[j]) * reach[j, g]
         rate[g] = r
-    if stored:  # the start's clearances, from the shapes the arm's last move left
-        swept.clearances(frames, sizes, kinds, boxes, pairs, work, rate, dstore[0])
+    # the end, predicted: the tool point over a free cell or in a free voxel
+    _pose(1.0, turn, movers, a0, x0, carried, tip_carried, fr0, tip0, cs, sn, fr, ptip)
+    end = _label(ptip, levels, cell, grid, free)
+    if end < 0:
+        return BLOCKED
+    # a planar arm's geoms keep their heights: a box apart from a geom in height stays apart
+    for g in range(n_g):
+        for o in range(boxes.shape[0]):
+            act[g, o] = pairs[g, o] and (not flat or swept.axis_gap(fr0[g], sizes[g], kinds[g], boxes[o], 2) <= 0.0)
+    swept.clearances(fr, sizes, kinds, boxes, act, work, rate, dstore[1])
+    swept.clearances(fr0, sizes, kinds, boxes, act, work, rate, dstore[0])
+    for g in range(n_g):
+        if dstore[0, g] <= 0.0 or dstore[1, g] <= 0.0:
+            return BLOCKED
+    n = max(1, int(math.ceil(2.0 * sweep / cell)))
+    if levels == 0 and clear[end] >= int(math.ceil(sweep / cell)) + 3 and not always_probe:
+        n = 0
+    for kk in range(1, n + 1):  # the tool points
+        _tip_at(kk / (n + 1), turn, movers, a0, x0, tip_carried, tip0, ptip)
+        if _label(ptip, levels, cell, grid, free) < 0:
+            return BLOCKED
+    # the swept check: [0, 1] cleared, or split
+    pts = 2
+    stack[0, 0], stack[0, 1], stack[0, 2], stack[0, 3] = 0.0, 1.0, 0, 1
+    depth = 1
+    while depth > 0:
+        depth -= 1
+        t0, t1 = stack[depth, 0], stack[depth, 1]
+        ia, ib = int(stack[depth, 2]), int(stack[depth, 3])
+        worst = 0.0
+        for g in range(n_g):
+            span = (t1 - t0) * rate[g]
+            if dstore[ia, g] + dstore[ib, g] <= span and span > worst:
+                worst = span
+        if worst == 0.0:
+            continue
+        if worst < swept.RESOLUTION or pts >= MAX_POINTS or depth + 2 > stack.shape[0]:
+            return BLOCKED
+        tm = 0.5 * (t0 + t1)
+        im = pts
+        pts += 1
+        _pose(tm, turn, movers, a0, x0, carried, tip_carried, fr0, tip0, cs, sn, fr, ptip)
+        swept.clearances(fr, sizes, kinds, boxes, act, work, rate, dstore[im])
+        for g in range(n_g):
+            if dstore[im, g] <= 0.0:
+                return BLOCKED
+        stack[depth, 0], stack[depth, 1], stack[depth, 2], stack[depth, 3] = tm, t1, im, ib
+        stack[depth + 1, 0], stack[depth + 1, 1], stack[depth + 1, 2], stack[depth + 1, 3] = t0, tm, ia, im
+        depth += 2
+    # MuJoCo at the end: no contact, and the tool point it computes over a free cell or voxel
     for j in range(nq):
         qpos[j] = old[j] + turn[j]
     _call(raw[0], raw[2], raw[3])
@@ -144,90 +266,11 @@ def line_move(t, turn):
     ex = site_xpos[tip_id, 0]
     ey = site_xpos[tip_id, 1]
     ez = site_xpos[tip_id, 2]
-    # the end's shapes (a spatial arm keeps them, with its joints' anchors and axes) and clearances
-    swept.capture(geom_xpos, geom_xmat, geoms, offset, xanchor, xaxis, joints, fr_end, end_axes[0:dof],
-                  end_axes[dof:2 * dof])
-    # a planar arm's geoms keep their heights: a box apart from a geom in height stays apart
-    for g in range(n_g):
-        for o in range(boxes.shape[0]):
-            act[g, o] = pairs[g, o] and (not flat or swept.axis_gap(fr_end[g], sizes[g], kinds[g], boxes[o], 2) <= 0.0)
-    swept.clearances(fr_end, sizes, kinds, boxes, act, work, rate, dstore[1])
-    sweep = 0.0
-    for j in range(nq):
-        sweep += abs(turn[j]) * tip_reach[j]
-    n = max(1, int(math.ceil(2.0 * sweep / cell)))
-    if levels == 0 and clear[end] >= int(math.ceil(sweep / cell)) + 3 and not always_probe:
-        n = 0
-    if not stored:  # the start's clearances, from MuJoCo's kinematics there
-        qpos[:] = old
-        _call(raw[0], raw[2], raw[3])
-        _clear_at(geom_xpos, geom_xmat, geoms, offset, sizes, kinds, boxes, act, fr, work, rate, dstore[0])
-    pts = 2
-    ok = True
-    for g in range(n_g):
-        if dstore[0, g] <= 0.0 or dstore[1, g] <= 0.0:
-            ok = False
-    # the tool points, each a point of the swept check too
-    prev_t = 0.0
-    prev_i = 0
-    kk = 1
-    while ok and kk <= n + 1:
-        if kk <= n:
-            tk = kk / (n + 1)
-            for j in range(nq):
-                qpos[j] = old[j] + tk * turn[j]
-            _call(raw[0], raw[2], raw[3])
-            if _label(site_xpos[tip_id], levels, cell, grid, free) < 0:
-                ok = False
-                break
-            if pts >= MAX_POINTS:
-                ok = False
-                break
-            cur = pts
-            pts += 1
-            _clear_at(geom_xpos, geom_xmat, geoms, offset, sizes, kinds, boxes, act, fr, work, rate, dstore[cur])
-            for g in range(n_g):
-                if dstore[cur, g] <= 0.0:
-                    ok = False
-            if not ok:
-                break
-        else:
-            tk = 1.0
-            cur = 1
-        # the interval [prev_t, tk]: cleared, or split
-        stack[0, 0], stack[0, 1], stack[0, 2], stack[0, 3] = prev_t, tk, prev_i, cur
-        depth = 1
-        while ok and depth > 0:
-            depth -= 1
-            t0, t1 = stack[depth, 0], stack[depth, 1]
-            ia, ib = int(stack[depth, 2]), int(stack[depth, 3])
-            worst = 0.0
-            for g in range(n_g):
-                span = (t1 - t0) * rate[g]
-                if dstore[ia, g] + dstore[ib, g] <= span and span > worst:
-                    worst = span
-            if worst == 0.0:
-                continue
-            if worst < swept.RESOLUTION or pts >= MAX_POINTS or depth + 2 > stack.shape[0]:
-                ok = False
-                break
-            tm = 0.5 * (t0 + t1)
-            for j in range(nq):
-                qpos[j] = old[j] + tm * turn[j]
-            _call(raw[0], raw[2], raw[3])
-            im = pts
-            pts += 1
-            _clear_at(geom_xpos, geom_xmat, geoms, offset, sizes, kinds, boxes, act, fr, work, rate, dstore[im])
-            for g in range(n_g):
-                if dstore[im, g] <= 0.0:
-                    ok = False
-            stack[depth, 0], stack[depth, 1], stack[depth, 2], stack[depth, 3] = tm, t1, im, ib
-            stack[depth + 1, 0], stack[depth + 1, 1], stack[depth + 1, 2], stack[depth + 1, 3] = t0, tm, ia, im
-            depth += 2
-        prev_t = tk
-        prev_i = cur
-        kk += 1
-    if ok and always_probe and n > 0:
+    if stored:  # the end's state for the next move (the kinematics just run)
+        swept.capture(geom_xpos, geom_xmat, geoms, offset, xanchor, xaxis, joints, frames, anchors, axes)
+        for i in range(m):
+            q[i] = qpos[movers[i]]
+    if always_probe and n > 0:  # an arm that can touch itself: MuJoCo at up to 3 tool points
         probes = min(n, 3)
         q_try = old.copy()
         last = -1
@@ -242,20 +285,10 @@ def line_move(t, turn):
             if h != 0:
                 qpos[:] = old
                 return PYTHON if h < 0 else BLOCKED
-    if not ok:
-        qpos[:] = old
-        return BLOCKED
-    for j in range(nq):
-        qpos[j] = old[j] + turn[j]
-    # the end's state
+        for j in range(nq):
+            qpos[j] = old[j] + turn[j]
     tip[0] = ex
     tip[1] = ey
     tip[2] = ez
     label[0] = end
-    if stored:
-        frames[:] = fr_end
-        anchors[:] = end_axes[0:dof]
-        axes[:] = end_axes[dof:2 * dof]
-        for i in range(qidx.shape[0]):
-            q[i] = qpos[qidx[i]]
     return end
