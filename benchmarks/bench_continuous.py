@@ -166,6 +166,9 @@ def _arm_rates(spec: str, rounds: int, steps: int, approx: runs.Approximation) -
     m, d = arm.model, mujoco.MjData(arm.model)
     acts = np.random.default_rng(0).integers(0, arm.n_actions, steps).tolist()
     turns = list(np.random.default_rng(0).uniform(-1.0, 1.0, (steps, arm.dof)).astype(np.float32))
+    for e, a in ((env, acts[0]), (box, turns[0])):  # compile (or load) the environments' moves first
+        e.reset(seed=0)
+        e.step(a)
     per: dict[str, list[float]] = {k: [] for k in ("bare", "arm", "learner", "learner_python", "env", "env_box")}
     rows = list(qs)
     for r in range(rounds):

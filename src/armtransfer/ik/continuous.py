@@ -214,6 +214,7 @@ class ContinuousArm(NoisyJointMoves):
         self._kernel: Any = None
         self._line_table: np.ndarray | None = None  # the compiled straight move's (``_line``)
         self._line_keep: list = []
+        self._line_move: Any = None
         self._line_tip = np.zeros(3)
         self._box_lo, self._box_hi = np.zeros(self.dof), np.zeros(self.dof)
         self._fresh = False  # the compiled move's arrays hold the arm's state (:meth:`fast_step`)
@@ -469,8 +470,9 @@ class ContinuousArm(NoisyJointMoves):
             np.zeros(1, np.int64), np.zeros(nq), np.zeros((n_g, 4, 3)), np.zeros((fastline.MAX_POINTS, n_g)),
             np.zeros(n_g), np.zeros((7, 3)), np.zeros((64, 4)), True, np.zeros((n_g, len(self._sw_boxes)), np.bool_),
             np.arange(nq, dtype=np.int64), jnt, self._sw_carried, tip_carried, np.zeros((nq, 3)), np.zeros((nq, 3)),
-            np.zeros((n_g, 4, 3)), np.zeros(3), np.zeros(nq), np.zeros(nq), np.zeros(3)]
+            np.zeros((n_g, 4, 3)), np.zeros(3), np.zeros(nq), np.zeros(nq), np.zeros(3), np.zeros(n_g, np.bool_)]
         self._line_keep = items
+        self._line_move = fastline.line_move
         self._line_table = handles.table(fastline.LINE, items)
         return self._line_table
 
@@ -478,11 +480,9 @@ class ContinuousArm(NoisyJointMoves):
         """:meth:`move_by` of a checked turn (noise applied)."""
         self._fresh = False
         self.moves += 1
-        line = self._line()
+        line = self._line_table if self._line_table is not None else self._line()
         if line is not None:
-            from armtransfer.ik import fastline
-
-            v = fastline.line_move(line, turn)
+            v = self._line_move(line, turn)
             if v != PYTHON:
                 if v >= 0:
                     t = self._line_tip.tolist()

@@ -139,6 +139,7 @@ class SpatialContinuousArm(NoisyJointMoves):
         self._kernel: Any = None
         self._line_table: np.ndarray | None = None  # the compiled straight move's (``_line``)
         self._line_keep: list = []
+        self._line_move: Any = None
         self._line_turn = np.zeros(0)
 
     # ------------------------------------------------------------------ configurations
@@ -355,13 +356,12 @@ class SpatialContinuousArm(NoisyJointMoves):
         """:meth:`move_by` of a checked turn (noise applied): by ``ik.fastline.line_move`` when
         the arm has it (the same rule as :meth:`_go`, compiled)."""
         self.moves += 1
-        line = self._line()
+        line = self._line_table if self._line_table is not None else self._line()
         if line is not None:
-            from armtransfer.ik import fastline
-
             whole = self._line_turn
-            whole[self._qidx] = turn
-            v = fastline.line_move(line, whole)
+            for i, j in enumerate(self._qidx):
+                whole[j] = turn[i]
+            v = self._line_move(line, whole)
             if v != PYTHON:
                 if v >= 0:
                     self._full[:] = self._qpos
@@ -404,8 +404,9 @@ class SpatialContinuousArm(NoisyJointMoves):
             np.zeros(1, np.int64), np.zeros(model.nq), np.zeros((n_g, 4, 3)), np.zeros((fastline.MAX_POINTS, n_g)),
             np.zeros(n_g), np.zeros((7, 3)), np.zeros((64, 4)), False, np.zeros((n_g, len(self._boxes)), np.bool_),
             np.array(self._qidx, np.int64), self._joints, self._carried, tip_carried, np.zeros((dof, 3)),
-            np.zeros((dof, 3)), np.zeros((n_g, 4, 3)), np.zeros(3), np.zeros(dof), np.zeros(dof), np.zeros(3)]
+            np.zeros((dof, 3)), np.zeros((n_g, 4, 3)), np.zeros(3), np.zeros(dof), np.zeros(dof), np.zeros(3), np.zeros(n_g, np.bool_)]
         self._line_keep = items
+        self._line_move = fastline.line_move
         self._line_table = handles.table(fastline.LINE, items)
         return self._line_table
 
@@ -481,7 +482,7 @@ class SpatialContinuousArm(NoisyJointMoves):
                       frames, np.empty_like(self._anchors), np.empty_like(self._axes))
         out = np.empty(len(self._geoms))
         swept.clearances(frames, self._sizes, self._kinds, self._boxes, self._pairs, self._work2,
-                         np.full(len(self._geoms), np.inf), out)
+                         np.full(len(self._geoms), np.inf), np.ones(len(self._geoms), np.bool_), out)
         return out
 
     # ------------------------------------------------------------------ the compiled move

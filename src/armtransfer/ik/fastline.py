@@ -20,7 +20,7 @@ along the line come from the start's by the product of exponentials (each joint'
 axis at the start, the deepest first), without MuJoCo, so all of this runs before MuJoCo is
 asked, once, at the end;
 an interval [t0, t1] is clear when D_g(t0) + D_g(t1) > (t1 - t0) * rate_g for every g, else it is
-split at its middle (kinematics there) until its largest travel is under ``swept.RESOLUTION``
+split at its middle (where only the geoms not yet cleared are computed) (kinematics there) until its largest travel is under ``swept.RESOLUTION``
 (then the move is blocked), as ``ik.swept`` does for a turn. An arm that can touch itself is also
 asked for contacts at up to 3 of the tool points.
 """
@@ -40,7 +40,7 @@ MAX_POINTS = 128
 
 LINE = handles.RAW + (" f8:1 f8:2 f8:2 f8:2 f8:2 f8:2 int int float i8:1 b:1 i8:1 bool f8:1 f8:1 f8:1 f8:2 i8:1 f8:2"
                       " f8:2 i8:1 f8:2 b:2 f8:3 bool i8:1 f8:2 f8:2 f8:1 f8:1 i8:1 f8:1 f8:3 f8:2 f8:1 f8:2 f8:2"
-                      " bool b:2 i8:1 i8:1 b:2 b:1 f8:2 f8:2 f8:3 f8:1 f8:1 f8:1 f8:1")
+                      " bool b:2 i8:1 i8:1 b:2 b:1 f8:2 f8:2 f8:3 f8:1 f8:1 f8:1 f8:1 b:1")
 """What :func:`line_move` reads (the arms' ``_line`` build it)."""
 
 
@@ -74,7 +74,7 @@ def _rot(p, c0, c1, c2, a, cs, sn):
 
 
 @numba.njit(cache=True, nogil=True)
-def _pose(tt, turn, movers, a0, x0, carried, tip_carried, frames0, tip0, cs, sn, fr, tip_out):
+def _pose(tt, turn, movers, a0, x0, carried, tip_carried, frames0, tip0, cs, sn, fr, tip_out, need):
     """The geoms' frames and the tool point at the fraction ``tt`` of the straight move, from the
     start's (``frames0``, ``tip0``, the movers' anchors ``a0`` and axes ``x0``): the product of
     exponentials, each mover's turn about its axis at the start, the deepest first."""
@@ -84,6 +84,8 @@ def _pose(tt, turn, movers, a0, x0, carried, tip_carried, frames0, tip0, cs, sn,
         cs[i] = math.cos(ang)
         sn[i] = math.sin(ang)
     for g in range(frames0.shape[0]):
+        if not need[g]:
+            continue
         for r in range(4):
             for d in range(3):
                 fr[g, r, d] = frames0[g, r, d]
@@ -166,6 +168,7 @@ def line_move(t, turn):
     cs = handles._f1(t, k + 188)
     sn = handles._f1(t, k + 192)
     ptip = handles._f1(t, k + 196)
+    need = handles._b1(t, k + 200)
 
     nq = qpos.shape[0]
     n_g = geoms.shape[0]
@@ -202,7 +205,9 @@ def line_move(t, turn):
             r += abs(turn[j]) * reach[j, g]
         rate[g] = r
     # the end, predicted: the tool point over a free cell or in a free voxel
-    _pose(1.0, turn, movers, a0, x0, carried, tip_carried, fr0, tip0, cs, sn, fr, ptip)
+    for g in range(n_g):
+        need[g] = True
+    _pose(1.0, turn, movers, a0, x0, carried, tip_carried, fr0, tip0, cs, sn, fr, ptip, need)
     end = _label(ptip, levels, cell, grid, free)
     if end < 0:
         return BLOCKED
@@ -210,8 +215,8 @@ def line_move(t, turn):
     for g in range(n_g):
         for o in range(boxes.shape[0]):
             act[g, o] = pairs[g, o] and (not flat or swept.axis_gap(fr0[g], sizes[g], kinds[g], boxes[o], 2) <= 0.0)
-    swept.clearances(fr, sizes, kinds, boxes, act, work, rate, dstore[1])
-    swept.clearances(fr0, sizes, kinds, boxes, act, work, rate, dstore[0])
+    swept.clearances(fr, sizes, kinds, boxes, act, work, rate, need, dstore[1])
+    swept.clearances(fr0, sizes, kinds, boxes, act, work, rate, need, dstore[0])
     for g in range(n_g):
         if dstore[0, g] <= 0.0 or dstore[1, g] <= 0.0:
             return BLOCKED
@@ -233,7 +238,8 @@ def line_move(t, turn):
         worst = 0.0
         for g in range(n_g):
             span = (t1 - t0) * rate[g]
-            if dstore[ia, g] + dstore[ib, g] <= span and span > worst:
+            need[g] = dstore[ia, g] + dstore[ib, g] <= span
+            if need[g] and span > worst:
                 worst = span
         if worst == 0.0:
             continue
@@ -242,8 +248,9 @@ def line_move(t, turn):
         tm = 0.5 * (t0 + t1)
         im = pts
         pts += 1
-        _pose(tm, turn, movers, a0, x0, carried, tip_carried, fr0, tip0, cs, sn, fr, ptip)
-        swept.clearances(fr, sizes, kinds, boxes, act, work, rate, dstore[im])
+        # a geom cleared over [t0, t1] is cleared over both halves: inf at the middle
+        _pose(tm, turn, movers, a0, x0, carried, tip_carried, fr0, tip0, cs, sn, fr, ptip, need)
+        swept.clearances(fr, sizes, kinds, boxes, act, work, rate, need, dstore[im])
         for g in range(n_g):
             if dstore[im, g] <= 0.0:
                 return BLOCKED

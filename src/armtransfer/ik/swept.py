@@ -375,16 +375,29 @@ def capture(geom_xpos, geom_xmat, geoms, offset, xanchor, xaxis, joints, frames,
 
 
 @numba.njit(cache=True, nogil=True)
-def clearances(frames, sizes, kinds, boxes, pairs, work, cap, out):
-    """``out[g]``: a lower bound on geom g's least D to the boxes it may touch (inf: none),
-    exact (``shape_gap``) where it is below ``cap[g]``: the largest gap along a world axis first,
-    the distance search only for a box that gap leaves nearer than the cap and the best so far."""
+def clearances(frames, sizes, kinds, boxes, pairs, work, cap, need, out):
+    """``out[g]``: a lower bound on geom g's least D to the boxes it may touch (inf: none, or g
+    not in ``need``), exact (``shape_gap``) where it is below ``cap[g]``: the largest gap along a
+    world axis first, the distance search only for a box that gap leaves nearer than the cap and
+    the best so far."""
     for g in range(frames.shape[0]):
         best = np.inf
+        if not need[g]:
+            out[g] = best
+            continue
+        f = frames[g]
+        hold = (sizes[g, 0] + sizes[g, 1]) if kinds[g] == 0 else \
+            math.sqrt(sizes[g, 0] * sizes[g, 0] + sizes[g, 1] * sizes[g, 1] + sizes[g, 2] * sizes[g, 2])
         for o in range(boxes.shape[0]):
             if not pairs[g, o]:
                 continue
-            lb = max(axis_gap(frames[g], sizes[g], kinds[g], boxes[o], 0),
+            # the ball around the centre that holds the shape: its distance is a lower bound too
+            lb = _point_box(f[0, 0], f[0, 1], f[0, 2], boxes[o]) - hold
+            if lb >= best or lb > cap[g]:
+                if lb < best:
+                    best = lb
+                continue
+            lb = max(lb, axis_gap(frames[g], sizes[g], kinds[g], boxes[o], 0),
                      axis_gap(frames[g], sizes[g], kinds[g], boxes[o], 1),
                      axis_gap(frames[g], sizes[g], kinds[g], boxes[o], 2))
             if lb >= best:

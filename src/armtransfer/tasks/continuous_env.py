@@ -15,6 +15,7 @@ reward is paid on (``armtransfer.wrappers.TransferReward`` works on this environ
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import gymnasium as gym
@@ -68,6 +69,7 @@ class ContinuousArmRoomsEnv(gym.Env):
         self._obs_size = arm.dof + 3
         self._move = getattr(arm, "fast_step", arm.move)  # the compiled move, the same result, when the arm has one
         self._n_actions = int(arm.n_actions)
+        self._turn = np.zeros(arm.dof)  # a box action's joint turns (radians)
         self.robot = cell_robot(layout, int(getattr(arm, "levels", 1)))
         """The cells as a robot (states = cells; a spatial arm's: the voxels): what
         ``TransferReward`` pays transfer by."""
@@ -118,14 +120,17 @@ class ContinuousArmRoomsEnv(gym.Env):
         arm = self.arm
         dof = arm.dof
         try:
-            a = np.asarray(action, dtype=np.float64)
+            values = np.asarray(action, dtype=np.float64).tolist()
         except (TypeError, ValueError):
-            a = np.full(1, np.nan)
-        if a.shape != (dof,) or not (np.abs(a) <= 1.0).all():  # NaN fails the comparison too
+            values = [math.nan]
+        if not (isinstance(values, list) and len(values) == dof
+                and all(isinstance(v, float) and -1.0 <= v <= 1.0 for v in values)):  # NaN fails too
             raise InvalidActionError(f"action must be {dof} finite numbers in [-1, 1] (the action space "
                                      f"{self.action_space}: joint turns in steps of {arm.step:g} rad), "
                                      f"got {action!r}")
-        turn = a * arm.step
+        turn = self._turn
+        turn[:] = values
+        turn *= arm.step
         if arm.noise > 0.0:
             moved = arm.move_by(turn)
         else:
