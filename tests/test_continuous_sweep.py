@@ -62,6 +62,34 @@ def test_no_accepted_spatial_move_penetrates_and_the_checker_sees_blocked_ones()
             q[arm.moved[a // 2]] += (1 - 2 * (a % 2)) * arm.step
             refused.append(chk.move_depth(before, q))
     assert max(refused) > 1e-3
+    # box moves (several joints at once, the Box environment's): none accepted penetrates either
+    arm.reset()
+    depths, n = _depths(arm, _walk(arm, 150, 2, box=True))
+    assert n > 50 and max(depths) <= LIMIT
+
+
+@pytest.mark.parametrize("spec", ["planar3", "ur5e_like"])
+def test_the_environments_compiled_move_is_the_arms_python_move(spec):
+    """``fast_step`` (the compiled move, called by address, that ``ContinuousArmRooms-v0`` steps
+    by) walks the configurations, labels, tool points and move counts of ``move``, resets and
+    Python moves in between."""
+    arms = [continuous_arm(spec, layout=SMALL) if spec.endswith("like") else continuous_arm(spec) for _ in range(2)]
+    start = SMALL.cell(0, 2) if spec.endswith("like") else TABLE_I[1].cells(arms[0].layout)[0]
+    for a in arms:
+        a.place(start)
+    slow, fast = arms
+    blocked = 0
+    for k, a in enumerate(np.random.default_rng(4).integers(slow.n_actions, size=1500).tolist()):
+        if k % 400 == 399:
+            slow.reset(), fast.reset()
+        if k % 300 == 0:
+            slow.move(1), fast.move(1)
+        v = slow.move(a)
+        assert v == fast.fast_step(a)
+        assert slow.q.tobytes() == fast.q.tobytes() and slow.tip() == fast.tip() and slow.key() == fast.key()
+        assert slow.moves == fast.moves and slow.label == fast.label
+        blocked += v == BLOCKED
+    assert 0 < blocked < 1500
 
 
 @pytest.mark.slow

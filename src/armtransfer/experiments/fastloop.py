@@ -119,6 +119,9 @@ def _stale_caches() -> None:
     handles = Path(fastmove3d.__file__).with_name("handles.py")
     jitcache.invalidate_stale(fastmove3d.__name__, [fastmove3d.move, fastmove3d.spatial_move],
                               [swept, handles, fastmove.__file__])
+    from armtransfer.ik import fastline
+
+    jitcache.invalidate_stale(fastline.__name__, [fastline.line_move], [swept, handles, fastmove.__file__])
     jitcache.invalidate_stale(__name__, [_run, _run3d], [fastmove.__file__, fastmove3d.__file__, swept, handles, arcs,
                                                          linear.__file__, tiles.__file__, traces.__file__,
                                                          sarsa.__file__])
