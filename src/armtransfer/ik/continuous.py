@@ -8,9 +8,12 @@ enumerated or stored. A move is blocked, and the arm stays where it was, when
 - it leaves the joint limits (an unlimited joint: pi either side of where the arm started);
 - MuJoCo reports a contact that ``ik.scene.ContactChecker`` counts (the table, a wall, the
   arm itself) at the configuration reached;
+- a geom the moved joint carries would touch the table or a wall anywhere along the turn
+  (``ik.swept``, from MuJoCo's kinematics at the end, turned back);
 - the tool point, at the configuration reached or at any of the points the move's arc passes
   (spaced at most half a cell apart, as ``ik.compile``'s joint model spaces them), is over a
-  wall cell or off the table; near a wall, MuJoCo is also asked at up to 3 of those points.
+  wall cell or off the table; an arm that can touch itself is also asked for contacts at up to
+  3 of those points.
 
 The label is the cell under the tool point (``ik.labels.cells_of_xy``'s rule: the tip's
 (x, y) divided by the cell size and rounded half to even). The configuration is kept as
@@ -428,12 +431,13 @@ class ContinuousArm(NoisyJointMoves):
         ``BLOCKED`` (the arm has not moved) when it leaves the joint box, MuJoCo reports a
         contact at its end, or the tool point at its end or at points along the straight line in
         joint space (spaced so that the tip moves at most half a cell between them, by
-        ``sum_j |dq_j| * reach_j``) is over a wall or off the table; near a wall MuJoCo is also
-        asked for contacts at up to 3 of those points. It leaves the lattice: :meth:`key` names
-        such a configuration only with noise; :meth:`reset` goes back to the lattice's start.
-        Every geom is also swept against the table and walls along the line (``ik.fastline``,
-        compiled; a move whose contacts the compiled code cannot read is checked here in
-        Python, by the tool points and probes alone)."""
+        ``sum_j |dq_j| * reach_j``) is over a wall or off the table, or a geom would touch the
+        table or a wall anywhere along the line (``ik.fastline``, compiled; an arm that can touch
+        itself is also asked for contacts at up to 3 of the tool points). It leaves the lattice:
+        :meth:`key` names such a configuration only with noise; :meth:`reset` goes back to the
+        lattice's start. A move whose contacts the compiled code cannot read (more than
+        ``ik.fastmove.CONTACTS``) is checked here in Python, by the tool points and MuJoCo at up
+        to 3 of them near a wall."""
         turn = np.asarray(dq, dtype=np.float64).reshape(-1)
         if turn.shape != (self.dof,) or not np.all(np.isfinite(turn)):
             raise ArmModelError(f"a joint move of this arm is {self.dof} finite angles, got {dq!r}")

@@ -3,13 +3,17 @@
 The continuous counterpart of a spatial arm's ``joint`` robot (``ik.voxels``): the same three
 moved joints (the origin's best-conditioned, ``ik.voxels.moved_joints``), the others held at
 the same origin (``ik.voxels.spatial_origin``), the same step (``ik.voxels.choose_step``
-unless given) and the same move rule, but no lattice laid out: every move runs MuJoCo.
-Action ``2i`` turns moved joint i by +delta, ``2i+1`` by -delta (``q1+`` ... as the joint
-robot names them). A move is blocked, and the arm stays, when it leaves the joint box (an
-unlimited joint: pi either side of the origin), when MuJoCo reports a contact that
-``ik.scene.ContactChecker`` counts at its end or at points along the straight joint move (at
-most half a cell of tool travel apart), or when the tool point at any of them is outside the
-workspace or in a solid voxel (``ik.voxels._move_clear``, the joint robot's own test).
+unless given), but no lattice laid out. Action ``2i`` turns moved joint i by +delta, ``2i+1``
+by -delta (``q1+`` ... as the joint robot names them). A move is blocked, and the arm stays,
+when it leaves the joint box (an unlimited joint: pi either side of the origin), when the tool
+point at its end or at points of its arc at most half a cell of travel apart is outside the
+workspace or in a solid voxel, when a geom the turn carries would touch the table or a wall
+anywhere along it (``ik.swept``), or when MuJoCo reports a contact that
+``ik.scene.ContactChecker`` counts at its end. The arc and the sweep are computed from the state
+the last move left (the geoms' frames, the moved joints' anchors and axes), before MuJoCo is
+asked; MuJoCo then runs once, at the end. An arm that can touch itself, or a workspace not made
+of axis-aligned boxes, is checked by MuJoCo at the tool points instead
+(``ik.voxels._move_clear``, the joint robot's own test). ``ik.fastmove3d`` compiles the move.
 
 ``q`` is the moved joints' angles (the held joints are not the learner's: they never change);
 the label is the voxel of the tool point (``ik.voxels.voxel_of_point``), so a task's cells are
