@@ -4,7 +4,7 @@
     python benchmarks/bench_continuous.py --fast --out DIR     # a smoke run (seconds; the source's
                                                                # shortest path instead of its learned one)
 
-(a) Step rate, one core, planar3's continuous arm (``ik.continuous``) with the linear learner
+(a) Step rate, one core, each arm of ``--arms``' continuous arm (``ik.continuous``) with the linear learner
 (``learning.linear``, 8 tilings): each round runs the learner on Table I task 1 without transfer
 for ``--rate-steps`` steps, and, in the same round, the bare loop the arm cannot do without
 (MuJoCo's ``mj_kinematics`` + ``mj_collision`` on the same model, as many calls) and the arm
@@ -89,25 +89,70 @@ def pairs(directory: Path, fast: bool, chosen: list[str], noise: float = 0.0) ->
 # ----------------------------------------------------------------------------- (a) step rate
 
 
-RATE_ARMS = ("planar3", "gen:planar:6:0")
-"""The arms whose step rate is measured: planar3 and a generated 6-joint planar arm (hashed tiles:
-its dense tiles would be 2.7e7 features)."""
+RATE_ARMS = ("planar3", "gen:planar:6:0", "ur5e_like", "panda_like.xml")
+"""The arms whose step rate is measured: planar3, a generated 6-joint planar arm (hashed tiles:
+its dense tiles would be 2.7e7 features), the spatial ``ur5e_like`` (``ik.continuous3d``) and
+a 7-joint arm file, ``panda_like``'s MJCF file loaded as a file with its mount (spatial arms:
+hashed tiles, ``experiments.continuous.approximation_for``)."""
 HASHED_BITS = 16
 
 
+def rate_arm(spec: str):
+    """The continuous arm named by ``spec`` (``panda_like.xml``: the built-in panda_like's file
+    loaded by path with its mount and tool point)."""
+    if spec == "panda_like.xml":
+        from armtransfer.models import ARMS
+
+        info = ARMS["panda_like"]
+        return continuous_arm(None, xml_path=info.xml_path, tip_site=info.tip_site, base_pos=info.mount_pos,
+                              base_yaw=info.mount_yaw)
+    return continuous_arm(spec)
+
+
+def _visited(arm, goal: int, coding, steps: int) -> np.ndarray:
+    """The whole configurations the arm is at after each of ``steps`` steps of the learner
+    (Python loop, a fixed seed): what the bare loop runs MuJoCo on."""
+    out = np.empty((steps, arm.model.nq))
+    k = [0]
+    move = arm.move
+
+    class Recording:
+        n_actions = arm.n_actions
+        q = arm.q
+
+        def reset(self):
+            return arm.reset()
+
+        def key(self):
+            return arm.key()
+
+        def move(self, a):
+            v = move(a)
+            if k[0] < steps:
+                out[k[0]] = arm.data.qpos
+                k[0] += 1
+            return v
+
+    config = LearnerConfig(max_episodes=1_000_000, max_total_steps=steps, max_episode_steps=steps)
+    linear.learn(Recording(), goal, coding, config, np.random.default_rng(12345))
+    return out[:k[0]]
+
+
 def _arm_rates(spec: str, rounds: int, steps: int, approx: runs.Approximation) -> dict:
-    """One arm's rates, every loop in each round: bare MuJoCo, the arm alone, the arm with the
-    learner (the compiled episode, ``experiments.fastloop``, and the Python loop), the
-    Gymnasium environment."""
-    import gymnasium as gym
+    """One arm's rates, every loop in each round: bare MuJoCo (``mj_kinematics`` +
+    ``mj_collision`` on a data of the arm's model, from Python, at the configurations the
+    learner visits), the arm alone, the arm with the learner (the compiled episode,
+    ``experiments.fastloop``, and the Python loop), the two Gymnasium environments."""
     import mujoco
 
     from armtransfer.experiments import fastloop
     from armtransfer.tasks.continuous_env import ContinuousArmRoomsEnv
 
-    arm = continuous_arm(spec)
+    arm = rate_arm(spec)
     start, goal = TABLE_I[1].cells(arm.layout)
     arm.place(start)
+    if getattr(arm, "levels", 0) and not approx.table_bits:
+        approx = runs.approximation_for(arm)
     if arm.dof > 4 and not approx.table_bits:
         approx = dataclasses.replace(approx, table_bits=HASHED_BITS)
     coding = approx.coding(arm)
@@ -115,16 +160,26 @@ def _arm_rates(spec: str, rounds: int, steps: int, approx: runs.Approximation) -
     config = LearnerConfig(max_episodes=1_000_000, max_total_steps=steps, max_episode_steps=steps)
     for by in (fast, None):  # compile (or load) the kernels first
         linear.learn(arm, goal, coding, LearnerConfig(max_total_steps=2000), np.random.default_rng(0), steps_by=by)
-    env = ContinuousArmRoomsEnv(continuous_arm(spec), TABLE_I[1])
-    m, d = arm.model, arm.data
+    qs = _visited(arm, goal, coding, steps)
+    env = ContinuousArmRoomsEnv(rate_arm(spec), TABLE_I[1])
+    box = ContinuousArmRoomsEnv(rate_arm(spec), TABLE_I[1], actions="box")
+    m, d = arm.model, mujoco.MjData(arm.model)
     acts = np.random.default_rng(0).integers(0, arm.n_actions, steps).tolist()
-    per: dict[str, list[float]] = {k: [] for k in ("bare", "arm", "learner", "learner_python", "env")}
+    turns = list(np.random.default_rng(0).uniform(-1.0, 1.0, (steps, arm.dof)).astype(np.float32))
+    for e, a in ((env, acts[0]), (box, turns[0])):  # compile (or load) the environments' moves first
+        e.reset(seed=0)
+        e.step(a)
+    per: dict[str, list[float]] = {k: [] for k in ("bare", "arm", "learner", "learner_python", "env", "env_box")}
+    rows = list(qs)
     for r in range(rounds):
+        qpos = d.qpos
+        kin, col = mujoco.mj_kinematics, mujoco.mj_collision
         t = time.perf_counter()
-        for _ in range(steps):
-            mujoco.mj_kinematics(m, d)
-            mujoco.mj_collision(m, d)
-        per["bare"].append(steps / (time.perf_counter() - t))
+        for q in rows:
+            qpos[:] = q
+            kin(m, d)
+            col(m, d)
+        per["bare"].append(len(rows) / (time.perf_counter() - t))
         arm.reset()
         move = arm.move
         t = time.perf_counter()
@@ -136,17 +191,20 @@ def _arm_rates(spec: str, rounds: int, steps: int, approx: runs.Approximation) -
             t = time.perf_counter()
             linear.learn(arm, goal, coding, config, np.random.default_rng(r), steps_by=by)
             per[key].append((arm.moves - moves) / (time.perf_counter() - t))
-        env.reset(seed=r)
-        step = env.step
-        t = time.perf_counter()
-        for a in acts:
-            if step(a)[2]:
-                env.reset()
-        per["env"].append(steps / (time.perf_counter() - t))
+        for key, e, actions in (("env", env, acts), ("env_box", box, turns)):
+            e.reset(seed=r)
+            step = e.step
+            t = time.perf_counter()
+            for a in actions:
+                if step(a)[2]:
+                    e.reset()
+            per[key].append(steps / (time.perf_counter() - t))
+    ratios = {k: [v / b for v, b in zip(per[k], per["bare"])] for k in per if k != "bare"}
     med = {k: statistics.median(v) for k, v in per.items()}
-    return {"dof": arm.dof, "compiled": fast is not None, "per_round": per, "median_steps_per_s": med,
-            "ratio_to_bare": {k: med[k] / med["bare"] for k in med if k != "bare"},
-            "features": coding.size, "tilings": approx.tilings, "table_bits": approx.table_bits}
+    return {"dof": arm.dof, "joints": int(arm.model.nq), "compiled": fast is not None, "per_round": per,
+            "median_steps_per_s": med, "ratio_to_bare": {k: statistics.median(v) for k, v in ratios.items()},
+            "ratio_per_round": ratios, "features": coding.size, "tilings": approx.tilings,
+            "table_bits": approx.table_bits}
 
 
 def step_rate(rounds: int, steps: int, approx: runs.Approximation, arms=RATE_ARMS) -> dict:
@@ -240,11 +298,12 @@ def markdown(result: dict) -> str:
     lines = [f"Command: `{result['command']}`; {result['machine']}; {result['date']}; {result.get('load', '')}.",
              "", "Step rate (one core, Table I task 1, medians of "
              f"{rate['rounds']} rounds of {rate['steps_per_round']:,} steps, every loop in every round):", "",
-             "| arm | loop | steps/s | ratio to bare MuJoCo |", "|---|---|---:|---:|"]
+             "| arm | loop | steps/s | ratio to bare MuJoCo (median of per-round ratios) |", "|---|---|---:|---:|"]
     names = {"bare": "bare `mj_kinematics` + `mj_collision`", "arm": "continuous arm alone (random actions)",
              "learner": "arm + linear SARSA(lambda), compiled episode",
              "learner_python": "arm + linear SARSA(lambda), Python loop",
-             "env": "Gymnasium environment (random actions)"}
+             "env": "`ContinuousArmRooms-v0` step (random actions)",
+             "env_box": "`ContinuousArmRoomsBox-v0` step (random actions)"}
     for spec, r in rate["arms"].items():
         med = r["median_steps_per_s"]
         coding = (f"{r['tilings']} tilings, " + (f"hashed, 2^{r['table_bits']}" if r["table_bits"] else "dense")
@@ -252,7 +311,8 @@ def markdown(result: dict) -> str:
         for key, name in names.items():
             ratio = "1" if key == "bare" else f"{r['ratio_to_bare'][key]:.2f}"
             extra = f" ({coding})" if key.startswith("learner") else ""
-            lines.append(f"| {spec} ({r['dof']} joints) | {name}{extra} | {_n(med[key])} | {ratio} |")
+            lines.append(f"| {spec} ({r.get('joints', r['dof'])} joints, {r['dof']} moved) | {name}{extra} | "
+                         f"{_n(med[key])} | {ratio} |")
     lines.append("")
     cfg = result["config"]
     if not result["table_one"]:
@@ -335,7 +395,11 @@ def _run(args) -> int:
     source_config = LearnerConfig()
     load = os.getloadavg()
     print("step rate ...", file=sys.stderr, flush=True)
-    rate = step_rate(args.rounds, args.rate_steps, approx, RATE_ARMS[:1] if args.fast else RATE_ARMS)
+    arms = [a for a in args.arms if a not in RATE_ARMS]
+    if arms:
+        raise InvalidParameterError(f"unknown arm {arms[0]!r}; valid arms: {', '.join(RATE_ARMS)}")
+    chosen_arms = tuple(dict.fromkeys(args.arms))
+    rate = step_rate(args.rounds, args.rate_steps, approx, chosen_arms[:1] if args.fast else chosen_arms)
     table: list[dict] = []
     if not args.rate_only:
         print("Table I ...", file=sys.stderr, flush=True)
@@ -368,6 +432,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--pairs", nargs="+", default=list(PAIRS), help=f"pairs (default: all): {', '.join(PAIRS)}")
     p.add_argument("--rounds", type=int, default=5)
     p.add_argument("--rate-steps", type=int, default=100_000)
+    p.add_argument("--arms", nargs="+", default=list(RATE_ARMS), help=f"the arms of (a) (default: all): "
+                   f"{', '.join(RATE_ARMS)}")
     p.add_argument("--tilings", type=int, default=runs.Approximation().tilings)
     p.add_argument("--width", type=float, default=runs.Approximation().width, help="tile width in joint steps")
     p.add_argument("--table-bits", type=int, default=0, metavar="K",

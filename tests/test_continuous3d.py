@@ -150,3 +150,48 @@ def test_a_bring_your_own_7_joint_file_learns_in_its_continuous_joint_space(tmp_
     for m in ("none", "pseudo"):
         steps = out["results"][m]["exploration_steps"]
         assert len(steps) == 2 and all(s is not None and s > 0 for s in steps), (m, steps)
+
+
+def test_the_compiled_spatial_move_and_episode_are_the_python_ones_exactly(arm):
+    """Noise 0: ``ik.fastmove3d.move`` walks the same configurations, labels and blocked moves as
+    ``SpatialContinuousArm.move`` on 2,000 random actions, and a learner's trial gives the same
+    bytes with the compiled episode (``experiments.fastloop``) as with the Python loop."""
+    from armtransfer.experiments import continuous as runs
+    from armtransfer.experiments import fastloop
+    from armtransfer.ik import fastmove3d
+    from armtransfer.learning import linear
+    from armtransfer.learning.config import LearnerConfig
+
+    start, goal = SMALL.cell(2, 2), SMALL.free_cell(-3, -3, what="goal")
+    twin = continuous_arm("ur5e_like", layout=SMALL)
+    arm.place(start)
+    twin.place(start)
+    acts = np.random.default_rng(7).integers(arm.n_actions, size=2000).tolist()
+    state = twin.fast()
+    assert state is not None
+    blocked, before = 0, arm.moves
+    for a in acts:
+        v = arm.move(a)
+        w = fastmove3d.move(a, state)
+        assert v == w and np.array_equal(arm.q, twin.q) and np.array_equal(arm._tip, twin._tip)
+        blocked += v == BLOCKED
+    twin.fast_done()
+    assert 0 < blocked < len(acts) and twin.moves == arm.moves - before and twin.label == arm.label
+
+    arm.place(start)
+    coding = runs.approximation_for(arm).coding(arm)
+    steps_by = fastloop.episode_steps(arm)
+    assert steps_by is not None
+    config = LearnerConfig(max_total_steps=6000, max_episode_steps=1500, max_episodes=8)
+
+    def trial(by):
+        moves = arm.moves
+        res = linear.learn(arm, goal, coding, config, np.random.default_rng(3), steps_by=by)
+        return res, arm.moves - moves, arm.key()
+
+    (fast, fast_moves, fast_key), (slow, slow_moves, slow_key) = trial(steps_by), trial(None)
+    assert fast_moves == slow_moves > 6000 and fast_key == slow_key
+    assert np.array_equal(fast.episode_steps, slow.episode_steps) and len(fast.episode_steps) > 1
+    assert np.array_equal(fast.greedy_lengths, slow.greedy_lengths)
+    assert (fast.exploration_steps, fast.converged, fast.total_steps, fast.episodes) == \
+        (slow.exploration_steps, slow.converged, slow.total_steps, slow.episodes)

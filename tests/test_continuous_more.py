@@ -47,7 +47,7 @@ def test_a_continuous_result_says_continuous_once_and_shows_a_table(result):
 
 
 def test_the_environment_reports_the_tool_point_of_the_moves_own_kinematics():
-    """One MuJoCo kinematics per step: the observation's tool point is the move's, and it is the
+    """At most one MuJoCo kinematics per step: the observation's tool point is the move's, and it is the
     point a fresh kinematics call gives (the old observation), bit for bit, on a seeded rollout
     with blocked moves and resets."""
     import gymnasium as gym
@@ -71,7 +71,9 @@ def test_the_environment_reports_the_tool_point_of_the_moves_own_kinematics():
         in_move.append(len(calls) - before)
         return out
 
-    arm.move = counted_move
+    compiled = env._move
+    assert compiled == arm.fast_step
+    env._move = counted_move  # the Python move, whose MuJoCo calls can be counted
     rng = np.random.default_rng(5)
     blocked = 0
     for episode in range(3):
@@ -86,11 +88,19 @@ def test_the_environment_reports_the_tool_point_of_the_moves_own_kinematics():
             finally:
                 mujoco.mj_kinematics = real
             blocked += info["blocked"]
-            assert per_step == in_move[-1] <= 4  # the move's own (with up to 3 probes near a wall)
+            assert per_step == in_move[-1] <= 1  # the move's own (the swept check asks MuJoCo nothing)
             assert obs.tobytes() == np.concatenate([arm.q, arm.tool_point()]).tobytes()
             if terminated:
                 break
     assert blocked > 0
+    env._move = compiled  # the compiled move (MuJoCo called from numba): the same observations
+    obs, _ = env.reset(seed=0)
+    for _ in range(400):
+        obs, _, terminated, _, info = env.step(int(rng.integers(env.action_space.n)))
+        assert obs.tobytes() == np.concatenate([arm.q, arm.tool_point()]).tobytes()
+        blocked += info["blocked"]
+        if terminated:
+            break
 
 
 def _planar3(noise=0.0):

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numba
 
-from armtransfer.ik import fastmove
+from armtransfer.ik import fastmove, fastmove3d
 from armtransfer.learning import linear
 
 REACHED, LIMIT, REFILL, PYTHON = range(4)
@@ -42,18 +42,40 @@ def _run(arm, w, q, lower, width, offsets, dims, strides, per_tiling, table, fea
     return LIMIT, a, label, best, steps
 
 
+@numba.njit(cache=True, nogil=True)
+def _run3d(arm, w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa, tr_e, pos, p, c, u,
+           bonus, traj_index, phi, paid, low, a, label, best, steps, limit, goal):
+    """:func:`_run` with the spatial arm's move (``ik.fastmove3d.move``)."""
+    while steps < limit:
+        if c[linear.I_U] > low:
+            return REFILL, a, label, best, steps
+        label2 = fastmove3d.move(a, arm)
+        if label2 == fastmove.PYTHON:
+            return PYTHON, a, label, best, steps
+        if label2 < 0:
+            label2 = label
+        steps += 1
+        a, best = linear._update(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa,
+                                 tr_e, pos, p, c, u, bonus, traj_index, phi, paid, a, label, label2, goal, best)
+        if label2 == goal:
+            return REACHED, a, label2, best, steps
+        label = label2
+    return LIMIT, a, label, best, steps
+
+
 def episode_steps(arm) -> linear.EpisodeSteps | None:
-    """``learn``'s ``steps_by`` for ``arm`` (an ``ik.continuous.ContinuousArm``), or None when
-    the arm has no compiled move."""
+    """``learn``'s ``steps_by`` for ``arm`` (an ``ik.continuous.ContinuousArm`` or an
+    ``ik.continuous3d.SpatialContinuousArm``), or None when the arm has no compiled move."""
     if not hasattr(arm, "fast") or arm.fast() is None:
         return None
+    kernel = _run3d if hasattr(arm, "vox") else _run
 
     def run(L: linear._Learner, a: int, label: int, best: float, limit: int, goal: int) -> tuple[int, int, float, bool]:
         steps = 0
         bonus, traj_index, phi, paid = L.rewards
         while True:
             state = arm.fast()
-            why, a, label, best, steps = _run(state, L.w, arm.q, *L.coding, L.feats, L.qrow, L.tr_sa, L.tr_e, L.pos,
+            why, a, label, best, steps = kernel(state, L.w, arm.q, *L.coding, L.feats, L.qrow, L.tr_sa, L.tr_e, L.pos,
                                               L.p, L.c, L.u, bonus, traj_index, phi, paid, L.low, a, label, best,
                                               steps, limit, goal)
             arm.fast_done()
@@ -89,9 +111,20 @@ def _stale_caches() -> None:
     from armtransfer.learning import jitcache, sarsa, tiles, traces
 
     arcs = Path(fastmove.__file__).with_name("arcs.py")
-    jitcache.invalidate_stale(fastmove.__name__, [fastmove._touches_now, fastmove._touches, fastmove.move], [arcs])
-    jitcache.invalidate_stale(__name__, [_run], [fastmove.__file__, arcs, linear.__file__, tiles.__file__,
-                                                 traces.__file__, sarsa.__file__])
+    jitcache.invalidate_stale(fastmove.__name__, [fastmove._touches_now, fastmove._touches, fastmove.move,
+                                                  fastmove.planar_move],
+                              [arcs, Path(fastmove.__file__).with_name("swept.py"),
+                               Path(fastmove.__file__).with_name("handles.py")])
+    swept = Path(fastmove3d.__file__).with_name("swept.py")
+    handles = Path(fastmove3d.__file__).with_name("handles.py")
+    jitcache.invalidate_stale(fastmove3d.__name__, [fastmove3d.move, fastmove3d.spatial_move],
+                              [swept, handles, fastmove.__file__])
+    from armtransfer.ik import fastline
+
+    jitcache.invalidate_stale(fastline.__name__, [fastline.line_move], [swept, handles, fastmove.__file__])
+    jitcache.invalidate_stale(__name__, [_run, _run3d], [fastmove.__file__, fastmove3d.__file__, swept, handles, arcs,
+                                                         linear.__file__, tiles.__file__, traces.__file__,
+                                                         sarsa.__file__])
 
 
 _stale_caches()

@@ -8,9 +8,12 @@ enumerated or stored. A move is blocked, and the arm stays where it was, when
 - it leaves the joint limits (an unlimited joint: pi either side of where the arm started);
 - MuJoCo reports a contact that ``ik.scene.ContactChecker`` counts (the table, a wall, the
   arm itself) at the configuration reached;
+- a geom the moved joint carries would touch the table or a wall anywhere along the turn
+  (``ik.swept``, from MuJoCo's kinematics at the end, turned back);
 - the tool point, at the configuration reached or at any of the points the move's arc passes
   (spaced at most half a cell apart, as ``ik.compile``'s joint model spaces them), is over a
-  wall cell or off the table; near a wall, MuJoCo is also asked at up to 3 of those points.
+  wall cell or off the table; an arm that can touch itself is also asked for contacts at up to
+  3 of those points.
 
 The label is the cell under the tool point (``ik.labels.cells_of_xy``'s rule: the tip's
 (x, y) divided by the cell size and rounded half to even). The configuration is kept as
@@ -34,13 +37,16 @@ from __future__ import annotations
 
 import itertools
 import math
+from typing import Any
 
 import mujoco
 import numba
 import numpy as np
 
 from armtransfer.errors import ArmModelError, InvalidCellError, UnreachableTableError
+from armtransfer.ik import swept
 from armtransfer.ik.arcs import _cell, _sweep, _sweep_turn
+from armtransfer.ik.fastmove import PYTHON
 from armtransfer.ik.compile import joint_box, near_wall_mask
 from armtransfer.ik.labels import OFF_TABLE, cells_of_xy
 from armtransfer.ik.scene import ArmScene, ContactChecker
@@ -207,6 +213,24 @@ class ContinuousArm(NoisyJointMoves):
         self.moves = 0
         """MuJoCo kinematics + collision calls made by :meth:`move` (blocked ones too)."""
         self._fast: tuple | None | bool = False  # False: not built yet; None: not available
+        self._table: np.ndarray | None = None  # the compiled move's state by address (``ik.handles``)
+        self._kernel: Any = None
+        self._line_table: np.ndarray | None = None  # the compiled straight move's (``_line``)
+        self._line_keep: list = []
+        self._line_move: Any = None
+        self._line_tip = np.zeros(3)
+        self._box_lo, self._box_hi = np.zeros(self.dof), np.zeros(self.dof)
+        self._fresh = False  # the compiled move's arrays hold the arm's state (:meth:`fast_step`)
+        # the swept check of a turn (``ik.swept``): every geom the joint carries, against the
+        # table and wall boxes, along the whole turn; from the end's kinematics, turned back
+        (self._sw_geoms, self._sw_sizes, self._sw_kinds, self._sw_offset, self._sw_boxes, self._sw_pairs,
+         self._sw_carried, aligned) = swept.shapes(scene, self.checker, self._jnt.astype(np.int64), scene.home)
+        if not aligned:
+            raise ArmModelError("the continuous arm needs a workspace of axis-aligned boxes (the table and walls)")
+        self._sw_frames = np.zeros((len(self._sw_geoms), 4, 3))
+        self._sw_joint = [self._jnt[j:j + 1].astype(np.int64) for j in range(self.dof)]
+        self._sw_anchor, self._sw_axis = np.zeros((1, 3)), np.zeros((1, 3))
+        self._sw_stack, self._sw_work = np.zeros((64, 4)), np.zeros((7, 3))
 
     # ------------------------------------------------------------------ placing the arm
 
@@ -214,6 +238,7 @@ class ContinuousArm(NoisyJointMoves):
         """Put the arm at ``q`` (it becomes q0 of the moves that follow) and return its label.
         A configuration that touches something, or whose tool point is not over a free cell,
         is refused."""
+        self._fresh = False
         q = np.array(q, dtype=np.float64).reshape(-1)
         if q.shape != (self.dof,) or not np.all(np.isfinite(q)):
             raise ArmModelError(f"a configuration of this arm is {self.dof} finite joint angles, got {q.tolist()}")
@@ -229,6 +254,7 @@ class ContinuousArm(NoisyJointMoves):
             raise InvalidCellError("the arm's tool point is not over a free cell at this configuration")
         lo, hi = joint_box(self.scene, q)
         self._box = (lo.tolist(), hi.tolist())
+        self._box_lo[:], self._box_hi[:] = lo, hi
         self._q0 = q.tolist()
         self._n = [0] * self.dof
         self._nlo = np.ceil((lo - q) / self.step - 1e-9).astype(np.int64).tolist()
@@ -241,6 +267,7 @@ class ContinuousArm(NoisyJointMoves):
 
     def reset(self) -> int:
         """Back to the configuration last set (:meth:`set_configuration`, :meth:`place`); its label."""
+        self._fresh = False
         if self._start is None:
             raise ArmModelError("place the arm (place or set_configuration) before resetting it")
         q, cell, tip = self._start
@@ -319,6 +346,7 @@ class ContinuousArm(NoisyJointMoves):
     def move(self, a: int) -> int:
         """Take action ``a`` (0 .. 2 * dof - 1): the cell under the tool point after the move,
         or ``BLOCKED`` when the move is blocked (the arm has not moved)."""
+        self._fresh = False
         if self._noisy:
             return self._move_noisy(a)
         j = a >> 1
@@ -332,8 +360,8 @@ class ContinuousArm(NoisyJointMoves):
         m, d = self.model, self.data
         mujoco.mj_kinematics(m, d)
         mujoco.mj_collision(m, d)
-        if d.ncon and self.checker.touches_now():  # the kinematics and contacts just computed
-            qpos[j] = old
+        if (d.ncon and self.checker.touches_now()) or not self._swept_clear(j, qpos[j] - old):
+            qpos[j] = old  # a contact at the end (the kinematics and contacts just computed), or along the turn
             return BLOCKED
         x, y, z = self._site_xpos[self._tip_id].tolist()
         cx, cy = round(x / self._cell_size) - self._lo, round(y / self._cell_size) - self._lo
@@ -343,7 +371,7 @@ class ContinuousArm(NoisyJointMoves):
             anchor = self._xanchor[self._jnt[j]]
             cell, close = _sweep(x, y, anchor[0], anchor[1], self._cos[a], self._sin[a], self._m[a],
                                  self._cell_size, self._lo, width, self._free, self._near)
-            if cell < 0 or ((close or self._always_probe) and self._probe_touches(a, old)):
+            if cell < 0 or (self._always_probe and self._probe_touches(a, old)):
                 qpos[j] = old
                 return BLOCKED
         elif self._always_probe and self._probe_touches(a, old):
@@ -370,7 +398,7 @@ class ContinuousArm(NoisyJointMoves):
         m, d = self.model, self.data
         mujoco.mj_kinematics(m, d)
         mujoco.mj_collision(m, d)
-        if d.ncon and self.checker.touches_now():
+        if (d.ncon and self.checker.touches_now()) or not self._swept_clear(j, new - old):
             qpos[j] = old
             return BLOCKED
         x, y, z = self._site_xpos[self._tip_id].tolist()
@@ -381,7 +409,7 @@ class ContinuousArm(NoisyJointMoves):
             anchor = self._xanchor[self._jnt[j]]
             cell, close = _sweep_turn(x, y, anchor[0], anchor[1], -turn * self._axis_sign[j], self._m_noisy[a],
                                       self._cell_size, self._lo, width, self._free, self._near)
-            if cell < 0 or ((close or self._always_probe) and self._probe_touches(a, old)):
+            if cell < 0 or (self._always_probe and self._probe_touches(a, old)):
                 qpos[j] = old
                 return BLOCKED
         elif self._always_probe and self._probe_touches(a, old):
@@ -403,15 +431,68 @@ class ContinuousArm(NoisyJointMoves):
         ``BLOCKED`` (the arm has not moved) when it leaves the joint box, MuJoCo reports a
         contact at its end, or the tool point at its end or at points along the straight line in
         joint space (spaced so that the tip moves at most half a cell between them, by
-        ``sum_j |dq_j| * reach_j``) is over a wall or off the table; near a wall MuJoCo is also
-        asked for contacts at up to 3 of those points. It leaves the lattice: :meth:`key` names
-        such a configuration only with noise; :meth:`reset` goes back to the lattice's start."""
+        ``sum_j |dq_j| * reach_j``) is over a wall or off the table, or a geom would touch the
+        table or a wall anywhere along the line (``ik.fastline``, compiled; an arm that can touch
+        itself is also asked for contacts at up to 3 of the tool points). It leaves the lattice:
+        :meth:`key` names such a configuration only with noise; :meth:`reset` goes back to the
+        lattice's start. A move whose contacts the compiled code cannot read (more than
+        ``ik.fastmove.CONTACTS``) is checked here in Python, by the tool points and MuJoCo at up
+        to 3 of them near a wall."""
         turn = np.asarray(dq, dtype=np.float64).reshape(-1)
         if turn.shape != (self.dof,) or not np.all(np.isfinite(turn)):
             raise ArmModelError(f"a joint move of this arm is {self.dof} finite angles, got {dq!r}")
         if self._noisy:
             turn = turn * (1.0 + np.array([self._next_eps() for _ in range(self.dof)]))
+        return self._move_by(turn)
+
+    def _line(self) -> np.ndarray | None:
+        """The table ``ik.fastline.line_move`` reads, or None (no compiled move)."""
+        if self._line_table is not None:
+            return self._line_table
+        from armtransfer.ik import fastline, handles
+
+        if self._fast is False:
+            self._fast = self._build_fast()
+        if not isinstance(self._fast, tuple):
+            return None
+        model, d, n_g = self.model, self.data, len(self._sw_geoms)
+        reach, tip_reach = swept.reaches(model, self.scene.home.astype(float), self._sw_geoms, self._sw_sizes,
+                                         self._sw_offset, self._tip_id)
+        w = self._width
+        jnt = self._jnt.astype(np.int64)
+        tip_carried, ordered = swept.chain_tables(model, jnt, self._tip_id)
+        if not ordered:
+            return None
+        nq = model.nq
+        items = list(self._fast[0]) + [
+            self._qpos, self._site_xpos, d.geom_xpos, d.geom_xmat, d.xanchor, d.xaxis, int(self._tip_id), 0,
+            self._cell_size, np.array([self._lo, self._lo + w - 1, w, w * w], np.int64),
+            np.ascontiguousarray(self._free, dtype=np.bool_), np.array(self._clear, np.int64),
+            bool(self._always_probe), self._box_lo, self._box_hi, tip_reach, reach, self._sw_geoms, self._sw_offset,
+            self._sw_sizes, self._sw_kinds, self._sw_boxes, self._sw_pairs, np.zeros((n_g, 4, 3)), False,
+            np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), self._line_tip,
+            np.zeros(1, np.int64), np.zeros(nq), np.zeros((n_g, 4, 3)), np.zeros((fastline.MAX_POINTS, n_g)),
+            np.zeros(n_g), np.zeros((7, 3)), np.zeros((64, 4)), True, np.zeros((n_g, len(self._sw_boxes)), np.bool_),
+            np.arange(nq, dtype=np.int64), jnt, self._sw_carried, tip_carried, np.zeros((nq, 3)), np.zeros((nq, 3)),
+            np.zeros((n_g, 4, 3)), np.zeros(3), np.zeros(nq), np.zeros(nq), np.zeros(3), np.zeros(n_g, np.bool_)]
+        self._line_keep = items
+        self._line_move = fastline.line_move
+        self._line_table = handles.table(fastline.LINE, items)
+        return self._line_table
+
+    def _move_by(self, turn: np.ndarray) -> int:
+        """:meth:`move_by` of a checked turn (noise applied)."""
+        self._fresh = False
         self.moves += 1
+        line = self._line_table if self._line_table is not None else self._line()
+        if line is not None:
+            v = self._line_move(line, turn)
+            if v != PYTHON:
+                if v >= 0:
+                    t = self._line_tip.tolist()
+                    self._tip = (t[0], t[1], t[2])
+                    self.label = v
+                return v
         qpos = self._qpos
         old = qpos.copy()
         new = old + turn
@@ -476,6 +557,34 @@ class ContinuousArm(NoisyJointMoves):
         state[26][0] = self.moves
         return state
 
+    def fast_step(self, a: int) -> int:
+        """:meth:`move` by the compiled move (``ik.handles.planar_move``; the same result), when
+        the arm has one."""
+        if self._noisy:
+            return self.move(a)
+        if not self._fresh:  # the arm moved in Python since: the arrays from its state
+            state = self.fast()
+            if state is None:
+                return self.move(a)
+            if self._table is None:
+                from armtransfer.ik import fastmove, handles
+
+                self._table = handles.of_state(fastmove.PLANAR, state)
+                self._kernel = fastmove.planar_move
+            self._fresh = True
+        v = self._kernel(a, self._table)
+        if v == PYTHON:
+            return self.move(a)
+        self.moves += 1
+        if v >= 0:
+            arrays = self._fast
+            assert isinstance(arrays, tuple)
+            self._n[a >> 1] = int(arrays[7][a >> 1])
+            t = arrays[24]
+            self._tip = (float(t[0]), float(t[1]), float(t[2]))
+            self.label = v
+        return v
+
     def fast_done(self) -> None:
         """Take back the arm's state from the compiled move's arrays."""
         state = self._fast
@@ -510,7 +619,19 @@ class ContinuousArm(NoisyJointMoves):
                 np.zeros(self.dof, np.int64), self.step, self._cell_size, self._lo, self._width, self._free,
                 self._near, np.array(self._clear, np.int64), np.array(self._clear_needed, np.int64), self._cos,
                 self._sin, self._m, probe, n_probe, bool(self._always_probe), np.zeros(3), np.zeros(1, np.int64),
-                np.zeros(1, np.int64))
+                np.zeros(1, np.int64), self.data.geom_xpos, self.data.geom_xmat, self.data.xaxis, self._sw_geoms,
+                self._sw_offset, self._sw_sizes, self._sw_kinds, self._sw_carried, self._sw_boxes, self._sw_pairs,
+                self._sw_frames, self._sw_anchor, self._sw_axis, self._sw_stack, self._sw_work)
+
+    def _swept_clear(self, j: int, theta: float) -> bool:
+        """Whether the turn of joint j by ``theta`` that ends at the configuration whose kinematics
+        MuJoCo just ran keeps every geom it carries clear of the table and walls (``ik.swept``)."""
+        d = self.data
+        swept.capture(d.geom_xpos, d.geom_xmat, self._sw_geoms, self._sw_offset, d.xanchor, d.xaxis,
+                      self._sw_joint[j], self._sw_frames, self._sw_anchor, self._sw_axis)
+        return swept.rotation_clear(self._sw_frames, self._sw_sizes, self._sw_kinds, self._sw_carried[j],
+                                    self._sw_anchor[0], self._sw_axis[0], -theta, self._sw_boxes, self._sw_pairs,
+                                    self._sw_stack, self._sw_work)
 
     def _probe_touches(self, a: int, old: float) -> bool:
         """MuJoCo contact at up to 3 points along the move from ``old`` (joint a // 2)."""

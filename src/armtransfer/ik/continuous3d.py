@@ -3,13 +3,17 @@
 The continuous counterpart of a spatial arm's ``joint`` robot (``ik.voxels``): the same three
 moved joints (the origin's best-conditioned, ``ik.voxels.moved_joints``), the others held at
 the same origin (``ik.voxels.spatial_origin``), the same step (``ik.voxels.choose_step``
-unless given) and the same move rule, but no lattice laid out: every move runs MuJoCo.
-Action ``2i`` turns moved joint i by +delta, ``2i+1`` by -delta (``q1+`` ... as the joint
-robot names them). A move is blocked, and the arm stays, when it leaves the joint box (an
-unlimited joint: pi either side of the origin), when MuJoCo reports a contact that
-``ik.scene.ContactChecker`` counts at its end or at points along the straight joint move (at
-most half a cell of tool travel apart), or when the tool point at any of them is outside the
-workspace or in a solid voxel (``ik.voxels._move_clear``, the joint robot's own test).
+unless given), but no lattice laid out. Action ``2i`` turns moved joint i by +delta, ``2i+1``
+by -delta (``q1+`` ... as the joint robot names them). A move is blocked, and the arm stays,
+when it leaves the joint box (an unlimited joint: pi either side of the origin), when the tool
+point at its end or at points of its arc at most half a cell of travel apart is outside the
+workspace or in a solid voxel, when a geom the turn carries would touch the table or a wall
+anywhere along it (``ik.swept``), or when MuJoCo reports a contact that
+``ik.scene.ContactChecker`` counts at its end. The arc and the sweep are computed from the state
+the last move left (the geoms' frames, the moved joints' anchors and axes), before MuJoCo is
+asked; MuJoCo then runs once, at the end. An arm that can touch itself, or a workspace not made
+of axis-aligned boxes, is checked by MuJoCo at the tool points instead
+(``ik.voxels._move_clear``, the joint robot's own test). ``ik.fastmove3d`` compiles the move.
 
 ``q`` is the moved joints' angles (the held joints are not the learner's: they never change);
 the label is the voxel of the tool point (``ik.voxels.voxel_of_point``), so a task's cells are
@@ -29,6 +33,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -36,6 +41,8 @@ import numpy as np
 from armtransfer.errors import ArmModelError, InvalidCellError, UnreachableTableError
 from armtransfer.ik.compile import joint_box
 from armtransfer.ik.continuous import BLOCKED, MAX_NOISE, NoisyJointMoves
+from armtransfer.ik import swept
+from armtransfer.ik.fastmove import PYTHON
 from armtransfer.ik.scene import ArmScene, ContactChecker
 from armtransfer.ik.voxels import (SpatialFK, _move_clear, choose_step, moved_joints, spatial_origin,
                                    voxel_of_point, workspace_voxels)
@@ -71,6 +78,7 @@ class SpatialContinuousArm(NoisyJointMoves):
         self.levels = self.vox.levels
         """Labels are voxel ids of this many levels (``learning.cells`` pays by them)."""
         self.checker = ContactChecker(scene)
+        self.model = scene.model
         self._fk = SpatialFK(scene)
         self.origin = spatial_origin(scene)
         jac = self._fk.jacobian(self.origin)
@@ -97,9 +105,46 @@ class SpatialContinuousArm(NoisyJointMoves):
         self._off = False  # a box move left the lattice
         self._tip = np.full(3, np.nan)
         self.label = -1
-        self._start: tuple[np.ndarray, int, np.ndarray] | None = None
+        self._start: tuple | None = None
         self.moves = 0
-        """MuJoCo kinematics + collision checks made by :meth:`move` and :meth:`move_by` (blocked ones too)."""
+        """Moves asked of :meth:`move` and :meth:`move_by` (blocked ones too)."""
+        self._setup_sweep()
+
+    def _setup_sweep(self) -> None:
+        """The arrays of the swept check (``ik.swept``) and of the move's MuJoCo call."""
+        model, checker = self.model, self.checker
+        self.data = checker.data
+        self._qpos = self.data.qpos
+        self._site_xpos = self.data.site_xpos
+        self._tip_id = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, self.scene.tip))
+        self._qidx = [int(j) for j in self.moved]
+        by_adr = {int(model.jnt_qposadr[j]): j for j in range(model.njnt)}
+        self._joints = np.array([by_adr[j] for j in self._qidx], np.int64)
+        lay = self.vox.layout
+        self._shape = (int(lay.lo), int(lay.hi), int(lay.width), int(lay.n_cells), int(self.vox.levels))
+        self._vfree = np.ascontiguousarray(self.vox.free, dtype=np.bool_)
+        arrays = swept.shapes(self.scene, checker, self._joints, self.origin)
+        (self._geoms, self._sizes, self._kinds, self._offset, self._boxes, self._pairs, self._carried,
+         aligned) = arrays
+        geoms = self._geoms.tolist()
+        self._reach, self._tip_reach = swept.reaches(model, self.origin, self._geoms, self._sizes, self._offset,
+                                                     self._tip_id)
+        self._sampled = bool(checker.can_self_collide or not aligned)
+        """Self-contacts or a workspace not made of axis-aligned boxes: the moves are checked by
+        MuJoCo at points of the move instead (``ik.voxels._move_clear``), in Python."""
+        self._frames = np.zeros((len(geoms), 4, 3))
+        self._anchors = np.zeros((self.dof, 3))
+        self._axes = np.zeros((self.dof, 3))
+        self._work = np.zeros(3)
+        self._work2 = np.zeros((7, 3))
+        self._stack = np.zeros((64, 4))
+        self._fast: tuple | None | bool = False
+        self._table: np.ndarray | None = None  # the compiled move's state by address (``ik.handles``)
+        self._kernel: Any = None
+        self._line_table: np.ndarray | None = None  # the compiled straight move's (``_line``)
+        self._line_keep: list = []
+        self._line_move: Any = None
+        self._line_turn = np.zeros(0)
 
     # ------------------------------------------------------------------ configurations
 
@@ -119,7 +164,7 @@ class SpatialContinuousArm(NoisyJointMoves):
         self._full[list(self.moved)] = qm
         if n is not None:
             self._n[:] = n
-        self._tip = tip
+        self._tip[:] = tip
         self.label = label
 
     def set_configuration(self, q: np.ndarray) -> int:
@@ -140,17 +185,20 @@ class SpatialContinuousArm(NoisyJointMoves):
         on = bool(np.array_equal(self._q0 + n * self.step, qm))
         self._off = not on
         self._set(qm, n if on else np.zeros(self.dof, np.int64), tip, v)
-        self._start = (qm.copy(), v, tip.copy())
+        self._capture()  # the kinematics ``_voxel`` ran at this configuration
+        self._start = (qm.copy(), v, tip.copy(), (self._frames.copy(), self._anchors.copy(), self._axes.copy()))
         return v
 
     def reset(self) -> int:
         """Back to the configuration last set (:meth:`set_configuration`, :meth:`place`); its voxel."""
         if self._start is None:
             raise ArmModelError("place the arm (place or set_configuration) before resetting it")
-        qm, v, tip = self._start
+        qm, v, tip, (frames, anchors, axes) = self._start
         n = np.rint((qm - self._q0) / self.step).astype(np.int64)
         self._off = not bool(np.array_equal(self._q0 + n * self.step, qm))
         self._set(qm, n, tip.copy(), v)
+        self._qpos[:] = self._full
+        self._frames[:], self._anchors[:], self._axes[:] = frames, anchors, axes
         return v
 
     @property
@@ -234,31 +282,96 @@ class SpatialContinuousArm(NoisyJointMoves):
         i, sign = a >> 1, 1 - 2 * (a & 1)
         self.moves += 1
         n = None
-        qm = self._q.copy()
+        old = float(self._q[i])
         if self._noisy:
-            qm[i] += sign * self.step * (1.0 + self._next_eps())
+            new = old + sign * self.step * (1.0 + self._next_eps())
         elif self._off:
-            qm[i] += sign * self.step
+            new = old + sign * self.step
         else:
-            n = self._n.copy()
-            n[i] += sign
-            if n[i] < self._nlo[i] or n[i] > self._nhi[i]:
+            n = int(self._n[i]) + sign
+            if n < self._nlo[i] or n > self._nhi[i]:
                 return BLOCKED
-            qm[i] = self._q0[i] + n[i] * self.step
-        if qm[i] < self._lo[i] or qm[i] > self._hi[i]:
+            new = float(self._q0[i] + n * self.step)
+        if new < self._lo[i] or new > self._hi[i]:
             return BLOCKED
-        return self._go(qm, n)
+        if self._sampled:
+            qm = self._q.copy()
+            qm[i] = new
+            nn = None
+            if n is not None:
+                nn = self._n.copy()
+                nn[i] = n
+            return self._go(qm, nn)
+        return self._turn(i, old, new, n)
+
+    def _turn(self, i: int, old: float, new: float, n: int | None) -> int:
+        """Moved joint i from ``old`` to ``new``: the tool point's arc through free voxels, the
+        swept check (``ik.swept``), both on the state the last move left; then MuJoCo at the end."""
+        theta = new - old
+        c, ax = self._anchors[i], self._axes[i]
+        sh = self._shape
+        if swept.tip_arc(self._tip, c, ax, theta, self.cell, sh[0], sh[1], sh[2], sh[3], sh[4], self._vfree,
+                         self._work) < 0:
+            return BLOCKED
+        if not swept.rotation_clear(self._frames, self._sizes, self._kinds, self._carried[i], c, ax, theta,
+                                    self._boxes, self._pairs, self._stack, self._work2):
+            return BLOCKED
+        m, d = self.model, self.data
+        qpos = self._qpos
+        j = self._qidx[i]
+        qpos[j] = new
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_collision(m, d)
+        if d.ncon and self.checker.touches_now():
+            qpos[j] = old
+            return BLOCKED
+        tip = self._site_xpos[self._tip_id]
+        v = swept.voxel(tip, self.cell, sh[0], sh[1], sh[2], sh[3], sh[4])
+        if v < 0 or not self._vfree[v]:
+            qpos[j] = old
+            return BLOCKED
+        self._q[i] = new
+        self._full[j] = new
+        if n is not None:
+            self._n[i] = n
+        self._tip[:] = tip
+        self.label = v
+        self._capture()
+        return v
+
+    def _capture(self) -> None:
+        """The swept check's state at the configuration whose kinematics MuJoCo last ran on data."""
+        d = self.data
+        swept.capture(d.geom_xpos, d.geom_xmat, self._geoms, self._offset, d.xanchor, d.xaxis, self._joints,
+                      self._frames, self._anchors, self._axes)
 
     def move_by(self, dq: np.ndarray) -> int:
         """Turn every moved joint at once, joint i by ``dq[i]`` radians (times 1 + eps_i with
-        noise): the voxel after the move, or ``BLOCKED``. It leaves the lattice (:meth:`key` is
-        then q; :meth:`reset` goes back to the start)."""
+        noise), along the straight line in joint space: the voxel after the move, or ``BLOCKED``.
+        It leaves the lattice (:meth:`key` is then q; :meth:`reset` goes back to the start)."""
         turn = np.asarray(dq, dtype=np.float64).reshape(-1)
         if turn.shape != (self.dof,) or not np.all(np.isfinite(turn)):
             raise ArmModelError(f"a joint move of this arm is {self.dof} finite angles, got {dq!r}")
         if self._noisy:
             turn = turn * (1.0 + np.array([self._next_eps() for _ in range(self.dof)]))
+        return self._move_by(turn)
+
+    def _move_by(self, turn: np.ndarray) -> int:
+        """:meth:`move_by` of a checked turn (noise applied): by ``ik.fastline.line_move`` when
+        the arm has it (the same rule as :meth:`_go`, compiled)."""
         self.moves += 1
+        line = self._line_table if self._line_table is not None else self._line()
+        if line is not None:
+            whole = self._line_turn
+            for i, j in enumerate(self._qidx):
+                whole[j] = turn[i]
+            v = self._line_move(line, whole)
+            if v != PYTHON:
+                if v >= 0:
+                    self._full[:] = self._qpos
+                    self.label = v
+                    self._off = True
+                return v
         qm = self._q + turn
         if np.any(qm < self._lo) or np.any(qm > self._hi):
             return BLOCKED
@@ -267,16 +380,182 @@ class SpatialContinuousArm(NoisyJointMoves):
             self._off = True
         return label
 
+    def _line(self) -> np.ndarray | None:
+        """The table ``ik.fastline.line_move`` reads, or None (moves checked by sampling, or no
+        compiled move)."""
+        if self._line_table is not None or self._sampled or self._start is None:
+            return self._line_table
+        from armtransfer.ik import fastline, handles
+
+        if self._fast is False:
+            self._fast = self._build_fast()
+        if not isinstance(self._fast, tuple):
+            return None
+        model, d, n_g = self.model, self.data, len(self._geoms)
+        lo = np.full(model.nq, -np.inf)
+        hi = np.full(model.nq, np.inf)
+        lo[self._qidx], hi[self._qidx] = self._lo, self._hi
+        self._line_turn = np.zeros(model.nq)
+        tip_carried, ordered = swept.chain_tables(model, self._joints, self._tip_id)
+        if not ordered:
+            return None
+        dof = self.dof
+        items = list(self._fast[0]) + [
+            self._qpos, self._site_xpos, d.geom_xpos, d.geom_xmat, d.xanchor, d.xaxis, self._tip_id, self.levels,
+            self.cell, np.array(self._shape[:4], np.int64), self._vfree, np.zeros(1, np.int64), False, lo, hi,
+            self._tip_reach, self._reach, self._geoms, self._offset, self._sizes, self._kinds, self._boxes,
+            self._pairs, self._frames, True, self._joints, self._anchors, self._axes, self._q, self._tip,
+            np.zeros(1, np.int64), np.zeros(model.nq), np.zeros((n_g, 4, 3)), np.zeros((fastline.MAX_POINTS, n_g)),
+            np.zeros(n_g), np.zeros((7, 3)), np.zeros((64, 4)), False, np.zeros((n_g, len(self._boxes)), np.bool_),
+            np.array(self._qidx, np.int64), self._joints, self._carried, tip_carried, np.zeros((dof, 3)),
+            np.zeros((dof, 3)), np.zeros((n_g, 4, 3)), np.zeros(3), np.zeros(dof), np.zeros(dof), np.zeros(3), np.zeros(n_g, np.bool_)]
+        self._line_keep = items
+        self._line_move = fastline.line_move
+        self._line_table = handles.table(fastline.LINE, items)
+        return self._line_table
+
     def _go(self, qm: np.ndarray, n: np.ndarray | None) -> int:
+        """The straight joint move to ``qm``: MuJoCo at its end, the tool point at points at most
+        half a cell apart in free voxels, and the swept check along the line (``_line_clear``)."""
         old = self._full.copy()
         new = self._full_of(qm)
         v, tip = self._voxel(new)
-        if v < 0 or not _move_clear(self.checker, self._fk, old, new, self._tip, tip, self.cell, self.vox):
+        if v < 0:
+            self.data.qpos[:] = old
+            return BLOCKED
+        ok = self._line_clear(old, new, tip)
+        if ok:
+            ok = _move_clear(self.checker, self._fk, old, new, self._tip, tip, self.cell, self.vox) \
+                if self._sampled else self._tip_line_clear(old, new, tip)
+        self.data.qpos[:] = new if ok else old
+        mujoco.mj_kinematics(self.model, self.data)
+        if not ok:
             return BLOCKED
         if n is None and not self._noisy and not self._off:
             self._off = True
         self._set(qm, n, tip, v)
+        self._capture()
         return v
+
+    def _tip_line_clear(self, qa: np.ndarray, qb: np.ndarray, pb: np.ndarray) -> bool:
+        """The tool point at points of the straight move at most half a cell of its travel apart
+        (``ik.voxels._move_clear``'s points) in free voxels (kinematics only)."""
+        m = max(1, int(math.ceil(2.0 * float(np.linalg.norm(pb - self._tip)) / self.cell)))
+        for t in np.arange(1, m + 1) / (m + 1):
+            tip = self._fk.tip(qa + (qb - qa) * t)
+            v = voxel_of_point(tip, self.cell, self.vox)
+            if v < 0 or not self.vox.free[v]:
+                return False
+        return True
+
+    def _line_clear(self, qa: np.ndarray, qb: np.ndarray, pb: np.ndarray) -> bool:
+        """The swept check of a straight joint move qa -> qb (several joints at once): D_g(t), the
+        least clearance of geom g to the boxes (``swept``), is Lipschitz in t with constant
+        sum_j |qb_j - qa_j| * reach[j, g] (``reach``: a bound on the distance of g's core from
+        joint j's axis in any configuration); intervals are split as in ``ik.swept``, the cores at
+        a point from MuJoCo's kinematics there."""
+        if not len(self._geoms):
+            return True
+        rate = np.abs(qb - qa) @ self._reach  # per geom: metres per unit t
+        d0 = self._clearances(qa)
+        d1 = self._clearances(qb)
+        todo = [(0.0, 1.0, d0, d1)]
+        evals = 2
+        while todo:
+            t0, t1, da, db = todo.pop()
+            bad = (da + db <= (t1 - t0) * rate)
+            if not bad.any():
+                continue
+            if float(((t1 - t0) * rate)[bad].max()) < swept.RESOLUTION or evals >= swept.MAX_EVALS:
+                return False
+            tm = 0.5 * (t0 + t1)
+            dm = self._clearances(qa + (qb - qa) * tm)
+            evals += 1
+            if np.any(dm <= 0.0):
+                return False
+            todo += [(tm, t1, dm, db), (t0, tm, da, dm)]
+        return bool(np.all(d0 > 0.0) and np.all(d1 > 0.0))
+
+    def _clearances(self, full: np.ndarray) -> np.ndarray:
+        """Per swept geom, its least D to the boxes at the whole configuration ``full``."""
+        d = self._fk.data
+        d.qpos[:] = full
+        mujoco.mj_kinematics(self.model, d)
+        frames = np.empty_like(self._frames)
+        swept.capture(d.geom_xpos, d.geom_xmat, self._geoms, self._offset, d.xanchor, d.xaxis, self._joints,
+                      frames, np.empty_like(self._anchors), np.empty_like(self._axes))
+        out = np.empty(len(self._geoms))
+        swept.clearances(frames, self._sizes, self._kinds, self._boxes, self._pairs, self._work2,
+                         np.full(len(self._geoms), np.inf), np.ones(len(self._geoms), np.bool_), out)
+        return out
+
+    # ------------------------------------------------------------------ the compiled move
+
+    def fast(self) -> tuple | None:
+        """The arm's arrays for ``ik.fastmove3d.move`` (the compiled :meth:`move`), or None when
+        there is none (actuation noise, off the lattice, moves checked by sampling, or MuJoCo's
+        memory not as ``ik.fastmove.layout`` expects). Call :meth:`fast_done` after moving with it."""
+        if self._noisy or self._off or self._sampled or self._start is None:
+            return None
+        if self._fast is False:
+            self._fast = self._build_fast()
+        if not isinstance(self._fast, tuple):
+            return None
+        state = self._fast
+        state[-2][0] = self.label
+        state[-1][0] = self.moves
+        return state
+
+    def fast_step(self, a: int) -> int:
+        """:meth:`move` by the compiled move (``ik.handles.spatial_move``; the same result), when
+        the arm has one."""
+        if self._table is None:
+            state = self.fast()
+            if state is None:
+                return self.move(a)
+            from armtransfer.ik import fastmove3d, handles
+
+            self._table = handles.of_state(fastmove3d.SPATIAL, state)
+            self._kernel = fastmove3d.spatial_move
+        elif self._noisy or self._off:
+            return self.move(a)
+        v = self._kernel(a, self._table)  # the arrays it reads are the arm's own
+        if v == PYTHON:
+            return self.move(a)
+        self.moves += 1
+        if v >= 0:
+            j = self._qidx[a >> 1]
+            self._full[j] = self._qpos[j]
+            self.label = v
+        return v
+
+    def fast_done(self) -> None:
+        """Take back the arm's state from the compiled move's arrays."""
+        state = self._fast
+        assert isinstance(state, tuple)
+        self.label = int(state[-2][0])
+        self.moves = int(state[-1][0])
+        self._full[self._qidx] = self._q
+
+    def _build_fast(self) -> tuple | None:
+        from armtransfer.ik import fastmove
+
+        c = self.checker
+        g = np.arange(self.model.ngeom)
+        g1, g2 = (x.ravel() for x in np.meshgrid(g, g, indexing="ij"))
+        counts = ((c._env[g1] & c._moving[g2]) | (c._env[g2] & c._moving[g1]) | c._own(g1, g2))
+        full = np.tile(self._full, (400, 1))
+        full[:, self._qidx] = np.random.default_rng(0).uniform(self._lo, self._hi, (400, self.dof))
+        raw = fastmove.layout(self.model, self.data, counts.reshape(self.model.ngeom, self.model.ngeom), full)
+        if raw is None:
+            return None
+        d = self.data
+        return (raw, self._qpos, self._site_xpos, d.geom_xpos, d.geom_xmat, d.xanchor, d.xaxis, self._tip_id,
+                np.array(self._qidx, np.int64), self._joints, self._q, self._q0, self._n, self._nlo, self._nhi,
+                self.step, self._lo, self._hi, self.cell, np.array(self._shape, np.int64), self._vfree, self._tip,
+                self._frames, self._sizes, self._kinds, self._carried, self._boxes, self._pairs, self._geoms,
+                self._offset, self._anchors, self._axes, self._stack, self._work, self._work2,
+                np.zeros(1, np.int64), np.zeros(1, np.int64))
 
     def tip(self) -> tuple[float, float, float]:
         """The tool point (x, y, z) the last move or placement computed: no MuJoCo call."""

@@ -35,6 +35,7 @@ from llvmlite import ir
 from numba.core import types
 from numba.extending import intrinsic
 
+from armtransfer.ik import handles, swept
 from armtransfer.ik.arcs import _sweep
 
 PYTHON = -3
@@ -175,7 +176,9 @@ def move(a, arm):
     """``ContinuousArm.move(a)`` on the arm's arrays ``arm`` (``ContinuousArm.fast_state``):
     the cell reached, :data:`BLOCKED`, or :data:`PYTHON` (nothing changed)."""
     (raw, qpos, site_xpos, xanchor, tip_id, jnt, q0, nn, nlo, nhi, step, cell_size, lo, width, free, near, clear,
-     clear_needed, cosb, sinb, m_arr, probe, n_probe, always_probe, tip, label, moves) = arm
+     clear_needed, cosb, sinb, m_arr, probe, n_probe, always_probe, tip, label, moves, geom_xpos, geom_xmat, xaxis,
+     sw_geoms, sw_offset, sw_sizes, sw_kinds, sw_carried, sw_boxes, sw_pairs, sw_frames, sw_anchor, sw_axis, sw_stack,
+     sw_work) = arm
     j = a >> 1
     n = nn[j] + 1 - 2 * (a & 1)
     moves[0] += 1
@@ -192,6 +195,12 @@ def move(a, arm):
             moves[0] -= 1
             return PYTHON
         return BLOCKED
+    swept.capture(geom_xpos, geom_xmat, sw_geoms, sw_offset, xanchor, xaxis, jnt[j:j + 1], sw_frames, sw_anchor,
+                  sw_axis)
+    if not swept.rotation_clear(sw_frames, sw_sizes, sw_kinds, sw_carried[j], sw_anchor[0], sw_axis[0],
+                                -(qpos[j] - old), sw_boxes, sw_pairs, sw_stack, sw_work):
+        qpos[j] = old
+        return BLOCKED
     x = site_xpos[tip_id, 0]
     y = site_xpos[tip_id, 1]
     z = site_xpos[tip_id, 2]
@@ -206,7 +215,7 @@ def move(a, arm):
         if cell < 0:
             qpos[j] = old
             return BLOCKED
-        probe_now = close or always_probe
+        probe_now = always_probe  # the swept check has covered the table and walls
     else:
         probe_now = always_probe
     if probe_now:
@@ -232,3 +241,23 @@ def move(a, arm):
     tip[2] = z
     label[0] = cell
     return cell
+
+
+PLANAR = handles.RAW + (" f8:1 f8:2 f8:2 int i8:1 f8:1 i8:1 i8:1 i8:1 float float int int b:1 b:1 i8:1 i8:1 f8:2 f8:2 i8:1"
+                " f8:2 i8:1 bool f8:1 i8:1 i8:1 f8:2 f8:2 f8:2 i8:1 f8:2 f8:2 i8:1 b:2 f8:2 b:2 f8:3 f8:2 f8:2 f8:2"
+                " f8:2")
+"""What :func:`planar_move` reads: ``ContinuousArm.fast``'s tuple, ``raw`` spread out."""
+
+
+@numba.njit(cache=True, nogil=True)
+def planar_move(a, t):
+    """``ik.fastmove.move(a, arm)`` on the arm of the table ``t`` (:data:`PLANAR`)."""
+    k = 48
+    arm = (handles._raw(t), handles._f1(t, k), handles._f2(t, k + 4), handles._f2(t, k + 8), t[k + 12], handles._i1(t, k + 16), handles._f1(t, k + 20),
+           handles._i1(t, k + 24), handles._i1(t, k + 28), handles._i1(t, k + 32), handles._float(t, k + 36), handles._float(t, k + 40), t[k + 44],
+           t[k + 48], handles._b1(t, k + 52), handles._b1(t, k + 56), handles._i1(t, k + 60), handles._i1(t, k + 64), handles._f2(t, k + 68),
+           handles._f2(t, k + 72), handles._i1(t, k + 76), handles._f2(t, k + 80), handles._i1(t, k + 84), t[k + 88] != 0, handles._f1(t, k + 92),
+           handles._i1(t, k + 96), handles._i1(t, k + 100), handles._f2(t, k + 104), handles._f2(t, k + 108), handles._f2(t, k + 112), handles._i1(t, k + 116),
+           handles._f2(t, k + 120), handles._f2(t, k + 124), handles._i1(t, k + 128), handles._b2(t, k + 132), handles._f2(t, k + 136), handles._b2(t, k + 140),
+           handles._f3(t, k + 144), handles._f2(t, k + 148), handles._f2(t, k + 152), handles._f2(t, k + 156), handles._f2(t, k + 160))
+    return move(a, arm)

@@ -4,9 +4,10 @@
 
 The observation is a ``Box``: the joint configuration q followed by the tool point (x, y, z)
 in metres; the action is ``Discrete(2 * dof)``: joint j turned by +delta (``2j``) or -delta
-(``2j+1``), as the ``joint`` action model. Every step runs MuJoCo once (``ik.continuous``; the tool point
-observed is that of the move's own kinematics, ``ContinuousArm.tip``): a move
-that is blocked leaves the arm where it was (``info["blocked"]``). Each step costs
+(``2j+1``), as the ``joint`` action model. Every step runs MuJoCo at most once (``ik.continuous``,
+``ik.continuous3d``, by the arm's compiled move, ``fast_step``, when it has one: the same
+result; the tool point observed is that of the move's own kinematics, ``ContinuousArm.tip``): a
+move that is blocked leaves the arm where it was (``info["blocked"]``). Each step costs
 ``step_reward``; reaching the goal cell pays ``goal_reward`` and ends the episode.
 ``info["label"]`` is the cell under the tool point, which is what a transferred trajectory's
 reward is paid on (``armtransfer.wrappers.TransferReward`` works on this environment).
@@ -14,6 +15,7 @@ reward is paid on (``armtransfer.wrappers.TransferReward`` works on this environ
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import gymnasium as gym
@@ -65,6 +67,9 @@ class ContinuousArmRoomsEnv(gym.Env):
         self.action_space: spaces.Space = (spaces.Discrete(arm.n_actions) if actions == "discrete" else
                                            spaces.Box(-1.0, 1.0, (arm.dof,), dtype=np.float32))
         self._obs_size = arm.dof + 3
+        self._move = getattr(arm, "fast_step", arm.move)  # the compiled move, the same result, when the arm has one
+        self._n_actions = int(arm.n_actions)
+        self._turn = np.zeros(arm.dof)  # a box action's joint turns (radians)
         self.robot = cell_robot(layout, int(getattr(arm, "levels", 1)))
         """The cells as a robot (states = cells; a spatial arm's: the voxels): what
         ``TransferReward`` pays transfer by."""
@@ -92,31 +97,51 @@ class ContinuousArmRoomsEnv(gym.Env):
     def step(self, action):
         if self.actions == "box":
             return self._step_box(action)
-        if isinstance(action, (bool, np.bool_)) or not self.action_space.contains(action):
-            raise InvalidActionError(
-                f"action must be an integer in 0..{self.arm.n_actions - 1} (the action space {self.action_space}), "
-                f"got {action!r}")
-        moved = self.arm.move(int(action))
-        label = self.arm.label
+        kind = type(action)
+        if not ((kind is int or kind is np.int64 or (isinstance(action, (int, np.integer))
+                                                   and not isinstance(action, (bool, np.bool_))))
+                and 0 <= action < self._n_actions):
+            if isinstance(action, (bool, np.bool_)) or not self.action_space.contains(action):
+                raise InvalidActionError(
+                    f"action must be an integer in 0..{self.arm.n_actions - 1} (the action space "
+                    f"{self.action_space}), got {action!r}")
+        moved = self._move(int(action))
+        arm = self.arm
+        label = arm.label
         terminated = label == self.goal_cell
         reward = self.step_reward + (self.goal_reward if terminated else 0.0)
-        return self._obs(), reward, terminated, False, {"label": label, "blocked": moved < 0}
+        obs = np.empty(self._obs_size)  # q, then the tool point of the move's own kinematics
+        dof = arm.dof
+        obs[:dof] = arm.q
+        obs[dof:] = arm.tip()
+        return obs, reward, terminated, False, {"label": label, "blocked": moved < 0}
 
     def _step_box(self, action):
-        dof = self.arm.dof
+        arm = self.arm
+        dof = arm.dof
         try:
-            a = np.asarray(action, dtype=np.float64)
+            values = np.asarray(action, dtype=np.float64).tolist()
         except (TypeError, ValueError):
-            a = np.full(1, np.nan)
-        if a.shape != (dof,) or not np.all(np.isfinite(a)) or np.any(np.abs(a) > 1.0):
+            values = [math.nan]
+        if not (isinstance(values, list) and len(values) == dof
+                and all(isinstance(v, float) and -1.0 <= v <= 1.0 for v in values)):  # NaN fails too
             raise InvalidActionError(f"action must be {dof} finite numbers in [-1, 1] (the action space "
-                                     f"{self.action_space}: joint turns in steps of {self.arm.step:g} rad), "
+                                     f"{self.action_space}: joint turns in steps of {arm.step:g} rad), "
                                      f"got {action!r}")
-        moved = self.arm.move_by(a * self.arm.step)
-        label = self.arm.label
+        turn = self._turn
+        turn[:] = values
+        turn *= arm.step
+        if arm.noise > 0.0:
+            moved = arm.move_by(turn)
+        else:
+            moved = arm._move_by(turn)  # move_by without checking the turn again
+        label = arm.label
         terminated = label == self.goal_cell
         reward = self.step_reward + (self.goal_reward if terminated else 0.0)
-        return self._obs(), reward, terminated, False, {"label": label, "blocked": moved < 0}
+        obs = np.empty(self._obs_size)
+        obs[:dof] = arm.q
+        obs[dof:] = arm.tip()
+        return obs, reward, terminated, False, {"label": label, "blocked": moved < 0}
 
     def render(self):
         if self.render_mode == "ansi":
