@@ -92,9 +92,9 @@ def run(args: argparse.Namespace) -> int:
     from armtransfer.learning.methods import probe_on, refuse_run_time
 
     # a plugin's fault stops the run here, in one line, before its store is opened
-    probe_on(plan.methods, [robots(p.case.target, p.case.world) for p in plan.pairs])
+    probe_on(plan.methods, [robots(p.case.target, p.case.world) for p in plan.pairs], args.probe_timeout)
     refuse_run_time(plan.methods, "a benchmark's runs")  # every case's task checked before anything is written
-    probe_learners(plan, robots)
+    probe_learners(plan, robots, args.probe_timeout)
     t0 = time.perf_counter()
     store = ResultStore.open_for(out, Sweep(plan.name, plan.spec(), ()))
     try:
@@ -112,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def probe_learners(plan: benchmark.Plan, robots: benchmark.Robots) -> None:
+def probe_learners(plan: benchmark.Plan, robots: benchmark.Robots, seconds: float = 60.0) -> None:
     """Every outside learner of ``plan`` made, learning a few steps and predicting on the first
     case of each of its target robots (``learner_trial.probe``): a learner's fault is one line
     now, before the store is opened; a learner registered in this process only is refused (the
@@ -134,7 +134,7 @@ def probe_learners(plan: benchmark.Plan, robots: benchmark.Robots) -> None:
                                   "package declaring it under the entry-point group armtransfer.learners "
                                   "(docs/extending.md)")
             target = robots(pair.case.target, pair.case.world)
-            learner_trial.probe(learner, target, list(pair.start), list(pair.goal))
+            learner_trial.probe(learner, target, list(pair.start), list(pair.goal), seconds)
 
 
 def _run_into(store: ResultStore, plan: benchmark.Plan, robots: dict, args: argparse.Namespace) -> int:

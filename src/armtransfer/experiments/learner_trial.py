@@ -36,7 +36,7 @@ import numpy as np
 from armtransfer.errors import ArmTransferError, PluginError
 from armtransfer.experiments.stats import learning_metrics
 from armtransfer.learning import learners as registry
-from armtransfer.learning import methods
+from armtransfer.learning import methods, plugin_calls
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.learners import Learner
 from armtransfer.learning.trajectory import Trajectory
@@ -133,13 +133,9 @@ class Monitor(gym.Wrapper):
 
 
 def _call(said: str, what: str, fn: Any, *args: Any, **kwargs: Any) -> Any:
-    """``fn(*args)``; whatever it raises is the learner's fault, in one line naming it."""
-    try:
-        return fn(*args, **kwargs)
-    except PluginError:
-        raise
-    except (Exception, SystemExit) as err:  # noqa: BLE001 - a plugin's bug, said in one line
-        raise PluginError(f"{said}: its {what} raised {type(err).__name__}: {err}".splitlines()[0]) from None
+    """``fn(*args)``; whatever it raises is the learner's fault, in one line naming it
+    (``plugin_calls.call``)."""
+    return plugin_calls.call(said, what, fn, *args, **kwargs)
 
 
 def case_env(target: DiscreteRobot, start: list[int], goal: list[int], wind: float,
@@ -239,20 +235,27 @@ def trial(learner: Learner, run: dict, target: DiscreteRobot,
             "K": None if term is None else float(term.K), "evaluations": evals}, stream
 
 
-def probe(learner: Learner, target: DiscreteRobot, start: list[int], goal: list[int]) -> None:
+def probe(learner: Learner, target: DiscreteRobot, start: list[int], goal: list[int],
+          seconds: float = plugin_calls.PROBE_SECONDS) -> None:
     """``learner`` made on the case's environment (no reward term), learning :data:`PROBE_STEPS`
-    steps, then predicting greedily a few steps: a learner that raises or acts outside the action
-    space is refused now, in one line, before a benchmark writes anything."""
+    steps, then predicting greedily a few steps, in a child process under a time limit of
+    ``seconds`` (``plugin_calls.within``): a learner that raises anything, acts outside the action
+    space or does not return in time is refused now, in one line naming it and the call, before
+    anything is learned or written."""
     said = f"{where(learner)}, on robot {target.name}"
-    config = LearnerConfig()
-    env = Monitor(gym.wrappers.TimeLimit(case_env(target, start, goal, 0.0, config),
-                                         max_episode_steps=MAX_EPISODE_STEPS), said)
-    env.reset(seed=0)
-    model = _call(said, "make", learner.make, env, 0)
-    if model is None or not all(callable(getattr(model, m, None)) for m in ("learn", "predict")):
-        raise PluginError(f"{said}: its make returned {type(model).__name__}, not a model with learn and predict")
-    _call(said, "learn", model.learn, PROBE_STEPS)
-    greedy_episode(model, case_env(target, start, goal, 0.0, config), 4, said)
+
+    def work() -> None:
+        config = LearnerConfig()
+        env = Monitor(gym.wrappers.TimeLimit(case_env(target, start, goal, 0.0, config),
+                                             max_episode_steps=MAX_EPISODE_STEPS), said)
+        env.reset(seed=0)
+        model = _call(said, "make", learner.make, env, 0)
+        if model is None or not all(callable(getattr(model, m, None)) for m in ("learn", "predict")):
+            raise PluginError(f"{said}: its make returned {type(model).__name__}, not a model with learn and predict")
+        _call(said, "learn", model.learn, PROBE_STEPS)
+        greedy_episode(model, case_env(target, start, goal, 0.0, config), 4, said)
+
+    plugin_calls.within(seconds, f"{said}: its probe", work)
 
 
 def refuse_methods(learner: Learner, names: list[str] | tuple[str, ...]) -> None:

@@ -53,7 +53,6 @@ import hashlib
 import itertools
 import json
 import os
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -65,6 +64,7 @@ from armtransfer.errors import ArmTransferError
 from armtransfer.io import read_input
 from armtransfer.tasks.arms import ARM_NAME, ARM_NAME_FORM
 from armtransfer.learning import methods as _methods
+from armtransfer.learning.method import MAX_K
 from armtransfer.learning import presets as _presets
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.lazy_registry import Names
@@ -272,7 +272,7 @@ def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, ba
         _check_number(f"{w}: seeds", s, 0, 2**63 - 1, integer=True)
     for k in spec["K"]:
         if k != "auto":
-            _check_number(f"{w}: K", k, 0, 1e9)
+            _check_number(f"{w}: K", k, 0, MAX_K)
     for key, lo, hi in (("epsilon", 0, 1), ("lam", 0, 1), ("gamma", 0, 1), ("wind", 0, 1), ("alpha", 1e-12, 1)):
         for v in spec[key]:
             _check_number(f"{w}: {key}", v, lo, hi)
@@ -436,12 +436,12 @@ def load(path: str | os.PathLike, max_runs: int = MAX_RUNS) -> Sweep:
     p = Path(path)
     where = f"sweep file {str(p)!r}"
     data = read_input(p, "sweep file", SweepFileError)
+    from armtransfer.io import parse_toml_bytes
+
     try:
-        raw = tomllib.loads(data.decode("utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
-        raise SweepFileError(f"{where} is not valid TOML: {str(err).splitlines()[0]}") from None
-    except RecursionError:
-        raise SweepFileError(f"{where} nests too deeply to be a sweep file") from None
+        raw = parse_toml_bytes(data)
+    except ValueError as err:
+        raise SweepFileError(f"{where} {err}") from None
     spec = normalise(raw, where, max_runs, base=p.parent)
     return Sweep(spec["name"], spec, tuple(expand(spec)))
 

@@ -14,11 +14,31 @@ registered later.
 
 from __future__ import annotations
 
+import os
 import threading
+import warnings
 from collections.abc import Callable, Iterator, MutableMapping, Sequence
 from typing import Generic, TypeVar, overload
 
 V = TypeVar("V")
+
+SKIP_ENV = "ARMTRANSFER_NO_PLUGINS"
+"""Set to 1, no installed plugin is read (0 or unset: they are). Any other value is refused."""
+
+
+class PluginWarning(UserWarning):
+    """An installed plugin that cannot be used is left out (one line naming it and how to remove it)."""
+
+
+def plugins_skipped() -> bool:
+    """Whether :data:`SKIP_ENV` says to read no installed plugin (a bad value: one line)."""
+    from armtransfer.errors import InvalidParameterError
+
+    value = os.environ.get(SKIP_ENV, "").strip()
+    if value not in ("", "0", "1"):
+        raise InvalidParameterError(f"environment variable {SKIP_ENV} must be 1 (read no installed plugin) or 0, "
+                                    f"got {value[:40]!r}")
+    return value == "1"
 
 
 class Registry(MutableMapping[str, V], Generic[V]):
@@ -26,6 +46,8 @@ class Registry(MutableMapping[str, V], Generic[V]):
 
     def __init__(self, builtin: dict[str, V], load: Callable[["Registry[V]"], None] | None = None) -> None:
         self._entries: dict[str, V] = dict(builtin)
+        self.broken: dict[str, tuple[str, str]] = {}
+        """Installed plugins left out: their name -> (the one-line error naming them, the warning)."""
         self.builtin: frozenset[str] = frozenset(builtin)
         self._load = load
         self._state = "unloaded"  # -> "loading" -> "loaded"
@@ -57,7 +79,18 @@ class Registry(MutableMapping[str, V], Generic[V]):
 
     def __getitem__(self, name: str) -> V:
         self.ensure_loaded()
+        if name not in self._entries and isinstance(name, str) and name in self.broken:
+            from armtransfer.errors import PluginError
+
+            raise PluginError(self.broken[name][0])
         return self._entries[name]
+
+    def leave_out(self, name: str, error: str, warning: str) -> None:
+        """Record the installed plugin ``name`` as broken: looking it up raises ``error``; the
+        command line prints ``warning`` (a Python user gets it as a :class:`PluginWarning`)."""
+        self._entries.pop(name, None)
+        self.broken[name] = (error, warning)
+        warnings.warn(warning, PluginWarning, stacklevel=2)
 
     def __setitem__(self, name: str, value: V) -> None:
         self.ensure_loaded()
@@ -146,19 +179,55 @@ def read_entry_points(group: str, registry: Registry[V], kind: str, check: Calla
     from armtransfer.errors import PluginError
 
     found: dict[str, V] = {}
+    if plugins_skipped():
+        return found
+    claimed: dict[str, str] = {}  # a name -> the plugin that declared it first
     for ep in sorted(entry_points(group=group), key=lambda e: (e.name, e.value)):
         where = describe_entry_point(ep, group)
         try:
-            obj = ep.load()
-        except (Exception, SystemExit) as err:  # noqa: BLE001 - any failure to import is the plugin's, in one line
-            raise PluginError(f"{where} fails to import: {type(err).__name__}: {err}".splitlines()[0]) from None
-        entry = check(obj, where)
-        name = named(entry)
-        if name != ep.name:
-            raise PluginError(f"{where} is a {kind} named {name!r}; name the entry point as the {kind}")
-        taken = registry.peek()
-        if name in taken or name in found:
-            other = getattr(taken[name] if name in taken else found[name], "origin")
-            raise PluginError(f"{where} is named {name!r}, as a {kind} of {other} is; rename one of them")
-        found[name] = with_origin(entry, where)
+            entry = _read_one(ep, where, check, registry, kind, named, found, claimed)
+        except PluginError as err:
+            ep_name = str(getattr(ep, "name", "?"))
+            found.pop(ep_name, None)
+            registry.leave_out(ep_name, str(err), left_out(where, str(err), ep))
+            continue
+        found[ep.name] = with_origin(entry, where)
     return found
+
+
+def _read_one(ep: object, where: str, check: Callable[[object, str], V], registry: Registry[V], kind: str,
+              named: Callable[[V], str], found: dict[str, V], claimed: dict[str, str]) -> V:
+    from armtransfer.errors import PluginError
+    from armtransfer.learning.plugin_calls import fault
+
+    ep_name = str(getattr(ep, "name", "?"))
+    first = claimed.setdefault(ep_name, where)
+    if first != where:  # two plugins declare one name: neither is used
+        raise PluginError(f"{where} is named {ep_name!r}, as a {kind} of {first} is; rename one of them")
+    try:
+        obj = ep.load()  # type: ignore[attr-defined]
+    except KeyboardInterrupt:
+        raise
+    except BaseException as err:  # noqa: BLE001 - any failure to import is the plugin's, in one line
+        raise PluginError(f"{where} fails to import: {fault(err)}") from None
+    entry = check(obj, where)
+    name = named(entry)
+    if name != ep_name:
+        raise PluginError(f"{where} is a {kind} named {name!r}; name the entry point as the {kind}")
+    taken = registry.peek()
+    if name in taken:
+        other = getattr(taken[name], "origin")
+        raise PluginError(f"{where} is named {name!r}, as a {kind} of {other} is; rename one of them")
+    return entry
+
+
+def left_out(where: str, error: str, ep: object) -> str:
+    """The one warning line of a plugin left out: what is wrong and how to remove it."""
+    dist = getattr(ep, "dist", None)
+    try:
+        remove = f"pip uninstall {dist.metadata['Name']}" if dist is not None else "uninstall its distribution"
+    except Exception:  # noqa: BLE001 - a distribution without a name
+        remove = "uninstall its distribution"
+    said = error[len(where):].lstrip(": ") if error.startswith(where) else error
+    return (f"{where} is left out ({said}); remove it with '{remove}', or set {SKIP_ENV}=1 to read no "
+            "installed plugin")

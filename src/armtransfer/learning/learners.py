@@ -145,9 +145,17 @@ def get(name: str) -> Learner:
 
 
 def parse(names: str | list[str] | tuple[str, ...]) -> tuple[str, ...]:
-    """Learner names from ``NAME[,NAME...]`` (or a list of them), each checked, in order, once."""
+    """Learner names from ``NAME[,NAME...]`` (or a list of them), each checked, in order; an
+    empty name (``sarsa,``) or a name given twice is a one-line error."""
     items = names.split(",") if isinstance(names, str) else [n for part in names for n in str(part).split(",")]
-    items = [n.strip() for n in items if n.strip()]
-    if not items:
+    items = [n.strip() for n in items]
+    if not any(items):
         raise InvalidParameterError(f"no learner named; valid learners: {', '.join(LEARNERS)}")
-    return tuple(dict.fromkeys(get(n).name for n in items))
+    if not all(items):
+        raise InvalidParameterError(f"an empty learner name in {names!r}; give NAME[,NAME...], valid learners: "
+                                    f"{', '.join(LEARNERS)}")
+    found = [get(n).name for n in items]
+    twice = next((n for i, n in enumerate(found) if n in found[:i]), None)
+    if twice is not None:
+        raise InvalidParameterError(f"learner {twice!r} is named twice in {names!r}; name each learner once")
+    return tuple(found)
