@@ -111,8 +111,8 @@ def within(seconds: float, said: str, work: Callable[[], None]) -> None:
 
 def _overran(last: str, said: str, seconds: float) -> PluginError:
     who = last or said
-    return PluginError(f"{who} did not return within {seconds:g} s, the probe's time limit (it is named by "
-                       f"{TIMEOUT_OPTION}, or probe_timeout= in Python)")
+    return PluginError(f"{who} did not return within {seconds:g} s, the probe's time limit ({TIMEOUT_OPTION}, or "
+                       "probe_timeout= in Python, sets it)")
 
 
 def _in_child(seconds: float, said: str, work: Callable[[], None]) -> None:
