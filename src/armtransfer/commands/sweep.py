@@ -8,7 +8,7 @@ import os
 from armtransfer.commands import common
 from armtransfer.experiments.execute import learner_config, robot_specs
 from armtransfer.tasks.catalog import custom_task
-from armtransfer.parallel.executors import ExecutorError, _check_reachable, _import_ray, run_local, run_ray
+from armtransfer.parallel.executors import ExecutorError, _check_reachable, check_address, _import_ray, run_local, run_ray
 from armtransfer.tasks.specs import resolve
 from armtransfer.experiments import sweep as sweeps
 from armtransfer.experiments.store import ResultStore
@@ -45,6 +45,8 @@ def check_executor_options(args: argparse.Namespace) -> None:
     """The executor options that do not apply to the chosen executor are an error."""
     if args.address is not None and args.executor != "ray":
         raise ExecutorError("--address goes with --executor ray (the local executor has no address)")
+    if args.address is not None:
+        check_address(args.address)  # before anything uses it
     if args.address and args.workers is not None:
         raise ExecutorError("--workers does not apply to a Ray cluster (--address): its CPUs are the cluster's; "
                             "--workers sizes the local pool or a local Ray instance")
