@@ -99,11 +99,11 @@ def run(args: argparse.Namespace) -> int:
     store = ResultStore.open_for(out, Sweep(plan.name, plan.spec(), ()))
     try:
         code = _run_into(store, plan, robots.resolved, args)
+        if code:
+            return code
+        summary = write_report(store, plan)  # under the lock: a summarize waits for the report
     finally:
-        store.unlock()
-    if code:
-        return code
-    summary = write_report(store, plan)
+        store.unlock()  # and its lock file is removed
     print(f"wrote {out / 'report.md'} ({time.perf_counter() - t0:.0f} s)")
     for section in suite.sections:
         for name, against in summary[section.name]["pooled"].items():
