@@ -296,7 +296,7 @@ def parse_json_bytes(raw: bytes) -> object:
                          f"holds a number that cannot be read ({str(err).splitlines()[0]})") from None
 
 
-def parse_toml_bytes(raw: bytes) -> object:
+def parse_toml_bytes(raw: bytes) -> dict:
     """TOML from a file's bytes, as :func:`parse_json_bytes` does JSON (the same reasons), and
     its numbers checked as a user's file's (:func:`check_user_numbers`)."""
     import tomllib

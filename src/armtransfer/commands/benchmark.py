@@ -29,6 +29,7 @@ from armtransfer.experiments.stats import benchmark_stats
 from armtransfer.experiments.store import ResultStore, StoreError
 from armtransfer.experiments.sweep import Sweep, content_key
 from armtransfer.io import check_writable, write_bytes_atomic, write_json_atomic, write_text_atomic
+from armtransfer.checks import MAX_COUNT
 from armtransfer.parallel.executors import _check_reachable, _import_ray, run_local, run_ray
 
 HELP = "Compare every method with the baselines that share its learner on a fixed suite, over many source seeds."
@@ -229,7 +230,11 @@ def plan_of(store: ResultStore) -> benchmark.Plan:
         suite = suites.get(spec["suite"]["name"])
     except Exception:  # noqa: BLE001 - any malformed spec is the same one-line refusal
         raise StoreError(f"{str(store.root)!r} holds a benchmark of a suite this build does not have") from None
-    plan = benchmark.plan(suite, spec["seed"], ran=spec["methods"], missing=spec["not_in_registry"],
+    seed = spec.get("seed")
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= MAX_COUNT:
+        raise StoreError(f"{str(store.root)!r} holds the seed {str(seed)[:40]}, which no benchmark takes (--seed is an "
+                         f"integer 0..{MAX_COUNT}); it was not written by armtransfer")
+    plan = benchmark.plan(suite, seed, ran=spec["methods"], missing=spec["not_in_registry"],
                           preset=spec.get("preset", "default"), learners=spec.get("learners"))
     if content_key(plan.spec()) != store.meta.get("key"):
         raise StoreError(f"{str(store.root)!r} holds a benchmark of suite {suite.name!r} as another build defined "

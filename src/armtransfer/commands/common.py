@@ -7,7 +7,7 @@ import math
 import sys
 from dataclasses import fields
 
-from armtransfer.checks import MAX_COUNT
+from armtransfer.checks import MAX_COUNT, integer_text
 from armtransfer.errors import ArmModelError, ArmTransferError, InvalidParameterError, InvalidTaskError
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.tasks.catalog import parse_xy
@@ -15,10 +15,7 @@ from armtransfer.tasks.catalog import parse_xy
 
 def _integer_at_least(lo: int, what: str):
     def parse(text: str) -> int:
-        try:
-            value = int(text) if len(text) <= 40 else None  # no 10,000-digit number is parsed
-        except ValueError:
-            value = None
+        value = integer_text(text.strip())  # the one grammar of an integer: no '²', no 10,000 digits
         if value is None or not lo <= value <= MAX_COUNT:
             raise argparse.ArgumentTypeError(f"must be {what} (at most {MAX_COUNT:,}), got {text[:40]!r}")
         return value

@@ -8,7 +8,6 @@ all made from these fields, so a new parameter is one field here.
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import asdict, dataclass, field, fields
 
 import armtransfer.checks as checks
@@ -50,11 +49,7 @@ class LearnerConfig:
         for f in fields(self):
             value = getattr(self, f.name)
             lo, hi, lo_open = f.metadata["lo"], f.metadata["hi"], f.metadata["lo_open"]
-            if f.type in (int, "int"):
-                if isinstance(value, numbers.Real) and not isinstance(value, (bool, numbers.Integral)) \
-                        and math.isfinite(value) and float(value).is_integer():
-                    # typeshed's numbers.Real has no __int__, though every real number here (numpy's too) has one
-                    value = int(value)  # type: ignore[call-overload]  # 3.0 from a TOML or JSON file is 3
+            if f.type in (int, "int"):  # a count is an integer, as on the command line and in sweep files: 1e3 is not
                 value = checks.whole(value, f.name, int(lo), int(hi))
             else:
                 value = checks.real(value, f.name, lo, hi, lo_open=lo_open)

@@ -214,7 +214,8 @@ def probe(method: Method, where: str, robot: DiscreteRobot | None = None,
     limit of ``seconds`` (``plugin_calls.within``): a plugin that raises anything, returns the wrong
     shape, non-finite or complex numbers, or does not return in time, is refused now, in one line
     naming ``where`` it came from and the call, rather than in the middle of a run."""
-    if method.build is None:
+    build = method.build
+    if build is None:
         return
 
     def work() -> None:
@@ -222,7 +223,7 @@ def probe(method: Method, where: str, robot: DiscreteRobot | None = None,
         on = cell_robot(ROOMS) if robot is None else robot
         if method.bonus_per_k is not None:
             method.bonus_per_k(on, [traj])
-        method.build(on, [traj], 1.0, 1.0)
+        build(on, [traj], 1.0, 1.0)
 
     try:
         plugin_calls.within(seconds, f"method {method.name!r}: its probe", work)

@@ -54,6 +54,7 @@ def load_layout(path: str | os.PathLike) -> Layout:
         raise InvalidWorldError(f"{where}: cannot be read: {getattr(err, 'strerror', None) or err}") from None
     from armtransfer.io import check_user_numbers, parse_json_bytes, parse_toml_bytes
 
+    data: object
     try:
         if p.suffix.lower() == ".toml":
             data = parse_toml_bytes(raw)
