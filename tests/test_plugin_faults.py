@@ -213,3 +213,36 @@ def test_the_skip_variable_is_an_environment_variable_of_the_package():
     done = subprocess.run([sys.executable, "-c", "import armtransfer; print(len(armtransfer.METHODS))"],
                           env=dict(os.environ, ARMTRANSFER_NO_PLUGINS="1"), capture_output=True, text=True, timeout=60)
     assert done.returncode == 0 and int(done.stdout) == len(methods.BUILTIN), done.stderr
+
+
+def test_a_long_trial_of_an_outside_learner_says_how_far_it_has_got(monkeypatch, capsys):
+    """A slow learner is not mistaken for a hung one: a trial running past the heartbeat says
+    its steps on stderr (here every chunk: the heartbeat is 0 s)."""
+    from armtransfer.experiments import learner_trial
+    from armtransfer.learning import learners
+
+    class Slow:
+        def __init__(self, env):
+            self.env = env
+
+        def learn(self, total_timesteps):
+            self.env.reset()
+            for _ in range(total_timesteps):
+                self.env.step(0)
+            return self
+
+        def predict(self, obs, deterministic=True):
+            return 0, None
+
+    monkeypatch.setattr(learner_trial, "HEARTBEAT_SECONDS", 0.0)
+    learners.register_learner(learners.Learner("slow", "a slow learner", lambda env, seed: Slow(env)))
+    try:
+        ticks = []
+        armtransfer.transfer(methods=["none"], learner="slow", trials=1, max_total_steps=2000,
+                             progress=lambda: ticks.append(1))
+    finally:
+        del learners.LEARNERS["slow"]
+    lines = [line for line in capsys.readouterr().err.splitlines() if "steps learned in" in line]
+    assert ticks == [1] and len(lines) >= 2, lines
+    assert lines[0].startswith("armtransfer: learner 'slow' (registered at run time): method none, trial 1: ")
+    assert " of 2,000 steps learned in " in lines[-1]

@@ -118,7 +118,8 @@ def transfer(
     ``probe_timeout``: the time limit in seconds of the probe of each plugin (a method's potential
     or bonus built once on the target, an outside learner made, learning a few steps and
     predicting), run before anything is learned in a child process that is then ended; a plugin
-    that overruns it is named in one line with the call that overran.
+    that overruns it is named in one line with the call that overran. With ``progress`` given, an
+    outside learner's trial that runs longer than 30 s says how far it has got on stderr every 30 s.
     """
     if not isinstance(state, str) or state not in STATES:
         raise InvalidParameterError(f"unknown state {state!r}; valid states: {', '.join(STATES)}")
@@ -288,7 +289,8 @@ def _transfer_outside(learner, src: DiscreteRobot, tgt: DiscreteRobot, the_task:
         if made is not None:
             verified[m] = made.K
     runs = learner_transfer.run_all(learner, src, tgt, start, goal, method_names, trajs, trials, seed, config,
-                                    wind=wind, K=verified, beta=beta, tick=progress)
+                                    wind=wind, K=verified, beta=beta, tick=progress,
+                                    heartbeat=progress is not None)  # a long trial says how far it has got
     by_method = {r.method: r for r in runs if r.control is None}
     by_control: dict[str, dict] = {}
     for r in runs:

@@ -150,7 +150,7 @@ def _main(argv: list[str]) -> int:
 def _warn_left_out(argv: list[str]) -> None:
     """One warning line for every installed plugin left out (it cannot be imported or used),
     naming it and how to remove it; none for a plugin the command line names, whose use is then
-    its one-line error."""
+    its one-line error (unless it took a built-in's name, which names the built-in)."""
     import re
 
     from armtransfer.learning.learners import LEARNERS
@@ -160,7 +160,7 @@ def _warn_left_out(argv: list[str]) -> None:
     for registry in (METHODS, LEARNERS):
         registry.ensure_loaded()
         for name, (_, warning) in registry.broken.items():
-            if name not in named:
+            if name not in named or name in registry.builtin:  # a built-in's name runs the built-in
                 print(f"armtransfer: warning: {warning}", file=sys.stderr)
 
 

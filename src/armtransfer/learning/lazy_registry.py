@@ -88,7 +88,8 @@ class Registry(MutableMapping[str, V], Generic[V]):
     def leave_out(self, name: str, error: str, warning: str) -> None:
         """Record the installed plugin ``name`` as broken: looking it up raises ``error``; the
         command line prints ``warning`` (a Python user gets it as a :class:`PluginWarning`)."""
-        self._entries.pop(name, None)
+        if name not in self.builtin:
+            self._entries.pop(name, None)
         self.broken[name] = (error, warning)
         warnings.warn(warning, PluginWarning, stacklevel=2)
 
