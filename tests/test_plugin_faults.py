@@ -168,6 +168,7 @@ RAISES = armtransfer.potential_method("raises", "raises GeneratorExit",
 """
 
 
+@pytest.mark.slow  # the same cases, one command each, are dev/audit.py's (in the default suite)
 def test_an_installed_plugin_that_sleeps_or_raises_breaks_only_itself(tmp_path):
     site = tmp_path / "site"
     site.mkdir()
