@@ -1157,6 +1157,9 @@ CASES: list[Case] = [
     Case("rooms --help with a plugin whose import raises GeneratorExit", "completes, one warning",
          plugin_unused(["rooms", "--help"], warned="GeneratorExit", code="raise GeneratorExit\n",
                        eps={"gone": "hostile:GONE"})),
+    Case("--help with a plugin that sleeps 600 s as it is imported", "completes in ~60 s, one warning",
+         plugin_unused(["--help"], warned="did not import within 60 s", code="import time\ntime.sleep(600)\n",
+                       eps={"slow": "hostile:SLOW"}), slow=True),
     Case("ARMTRANSFER_NO_PLUGINS=yes", "refused",
          cli_refused(["rooms", "--trials", "1"], "ARMTRANSFER_NO_PLUGINS", env={"ARMTRANSFER_NO_PLUGINS": "yes"})),
     # Ray, determinism

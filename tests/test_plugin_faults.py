@@ -247,3 +247,28 @@ def test_a_long_trial_of_an_outside_learner_says_how_far_it_has_got(monkeypatch,
     assert ticks == [1] and len(lines) >= 2, lines
     assert lines[0].startswith("armtransfer: learner 'slow' (registered at run time): method none, trial 1: ")
     assert " of 2,000 steps learned in " in lines[-1]
+
+
+def test_a_plugin_that_hangs_as_it_is_imported_is_left_out(tmp_path, monkeypatch):
+    import threading
+
+    from armtransfer.learning import lazy_registry
+
+    if threading.current_thread() is not threading.main_thread():
+        pytest.skip("the import's timer runs in the main thread only")
+    site = tmp_path / "site"
+    site.mkdir()
+    fake_plugin(site, "hanging-plugin", "hanging", "import time\ntry:\n    time.sleep(600)\nexcept Exception:\n"
+                "    pass\nM = 3\n", {"hang": "hanging:M"})
+    monkeypatch.syspath_prepend(str(site))
+    monkeypatch.setattr(lazy_registry, "IMPORT_SECONDS", 1.0)
+    registry = lazy_registry.Registry({}, None)
+    t0 = time.monotonic()
+    with pytest.warns(lazy_registry.PluginWarning, match=r"plugin hanging-plugin 0.1 .* is left out \(did not import "
+                                                         r"within 1 s\); remove it with 'pip uninstall hanging-plugin'"):
+        found = lazy_registry.read_entry_points("armtransfer.methods", registry, "method", lambda obj, where: obj,
+                                                lambda m: "hang", lambda m, where: m)
+    assert found == {} and "hang" in registry.broken and time.monotonic() - t0 < 10
+    assert "hanging" not in sys.modules
+    with pytest.raises(PluginError, match="did not import within 1 s"):
+        registry["hang"]

@@ -267,6 +267,8 @@ def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, ba
     _check_arm_names(arms, spec["pairs"], w)
     for m in spec["methods"]:
         if m not in METHODS:
+            if isinstance(m, str) and m in _methods.METHODS.broken:  # an installed plugin left out: its own line
+                raise SweepFileError(f"{w}: method {m!r}: {_methods.METHODS.broken[m][0]}")
             raise SweepFileError(f"{w}: unknown method {m!r}; valid methods: {', '.join(METHODS)}")
     for s in spec["seeds"]:
         _check_number(f"{w}: seeds", s, 0, 2**63 - 1, integer=True)
@@ -306,6 +308,8 @@ def _learners(body: dict, spec: dict, where: str) -> None:
         raise SweepFileError(f"{where}: learner " + ("is empty; give at least one" if not names
                                                      else "lists a value twice"))
     for name in names:
+        if isinstance(name, str) and name not in learners.LEARNERS and name in learners.LEARNERS.broken:
+            raise SweepFileError(f"{where}: learner {name!r}: {learners.LEARNERS.broken[name][0]}")
         if not isinstance(name, str) or name not in learners.LEARNERS:
             raise SweepFileError(f"{where}: unknown learner {name!r}; valid learners: {', '.join(learners.LEARNERS)}")
     outside = [n for n in names if n != SARSA]

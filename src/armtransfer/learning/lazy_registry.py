@@ -22,6 +22,10 @@ from typing import Generic, TypeVar, overload
 
 V = TypeVar("V")
 
+IMPORT_SECONDS = 60.0
+"""An installed plugin that takes longer than this to import is left out (a warning line): a
+plugin that hangs as it is imported cannot hang ``--help``."""
+
 SKIP_ENV = "ARMTRANSFER_NO_PLUGINS"
 """Set to 1, no installed plugin is read (0 or unset: they are). Any other value is refused."""
 
@@ -206,9 +210,11 @@ def _read_one(ep: object, where: str, check: Callable[[object, str], V], registr
     if first != where:  # two plugins declare one name: neither is used
         raise PluginError(f"{where} is named {ep_name!r}, as a {kind} of {first} is; rename one of them")
     try:
-        obj = ep.load()  # type: ignore[attr-defined]
+        obj = _load_within(ep, IMPORT_SECONDS)
     except KeyboardInterrupt:
         raise
+    except _ImportOverrun:
+        raise PluginError(f"{where} did not import within {IMPORT_SECONDS:g} s") from None
     except BaseException as err:  # noqa: BLE001 - any failure to import is the plugin's, in one line
         raise PluginError(f"{where} fails to import: {fault(err)}") from None
     entry = check(obj, where)
@@ -220,6 +226,39 @@ def _read_one(ep: object, where: str, check: Callable[[object, str], V], registr
         other = getattr(taken[name], "origin")
         raise PluginError(f"{where} is named {name!r}, as a {kind} of {other} is; rename one of them")
     return entry
+
+
+class _ImportOverrun(BaseException):
+    """Raised into a plugin's import that overran (a BaseException: its ``except Exception`` cannot keep it)."""
+
+
+def _load_within(ep: object, seconds: float) -> object:
+    """``ep.load()``, interrupted after ``seconds`` by a timer signal in the main thread (a
+    Python-level wait or loop is interrupted; the import then fails and leaves nothing behind).
+    Elsewhere, or under a timer of the caller's due sooner, without a limit."""
+    import signal
+    import time
+
+    load = getattr(ep, "load")
+    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "setitimer"):
+        return load()
+    outer_delay, outer_interval = signal.getitimer(signal.ITIMER_REAL)
+    if outer_delay and outer_delay <= seconds:
+        return load()  # the caller's own timer is due first: it is left alone
+
+    def overran(signum: int, frame: object) -> None:
+        raise _ImportOverrun()
+
+    previous = signal.signal(signal.SIGALRM, overran)
+    t0 = time.monotonic()
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        return load()
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+        if outer_delay:  # the caller's timer, given back what is left of it
+            signal.setitimer(signal.ITIMER_REAL, max(outer_delay - (time.monotonic() - t0), 1e-3), outer_interval)
 
 
 def left_out(where: str, error: str, ep: object) -> str:
