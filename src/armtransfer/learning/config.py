@@ -14,6 +14,11 @@ import armtransfer.checks as checks
 from armtransfer.errors import InvalidParameterError
 
 
+MAX_REWARD = 1e6
+"""The largest magnitude of a reward: far past any useful one, and far from where Q values of
+sums over millions of steps overflow (a goal reward of 1e308 ran and converged nowhere)."""
+
+
 def _param(default, help: str, lo: float, hi: float = math.inf, *, lo_open: bool = False, cli: bool = True):
     return field(default=default, metadata={"help": help, "lo": lo, "hi": hi, "lo_open": lo_open, "cli": cli})
 
@@ -30,8 +35,8 @@ class LearnerConfig:
     gamma: float = _param(0.99, "discount", 0.0, 1.0)
     lam: float = _param(0.9, "trace decay lambda", 0.0, 1.0)
     epsilon: float = _param(0.1, "exploration rate of epsilon-greedy", 0.0, 1.0)
-    step_reward: float = _param(-1.0, "reward per step", -math.inf)
-    goal_reward: float = _param(0.0, "reward on reaching the goal", -math.inf)
+    step_reward: float = _param(-1.0, "reward per step", -MAX_REWARD, MAX_REWARD)
+    goal_reward: float = _param(0.0, "reward on reaching the goal", -MAX_REWARD, MAX_REWARD)
     trace_cutoff: float = _param(1e-3, "eligibility traces below this are dropped", 0.0, 1.0, cli=False)
     """With gamma*lambda = 0.891 a trace of 1 falls below 1e-3 after 60 steps. 0 keeps every
     trace until it underflows, which is exactly the dense Algorithm 1."""

@@ -3,9 +3,13 @@
 ``armtransfer.learning.methods.METHODS`` is one: its built-in entries are there from the start;
 the entries other packages declare (Python entry points, ``armtransfer.learning.plugins``) are
 read the first time anything looks in the mapping, never at import, so that importing the package
-stays cheap and a plugin's import cost is paid only by a run that reads the registry. A loader
-that raises leaves the mapping unloaded: the next look raises the same error again, so a broken
-plugin cannot be half-registered.
+stays cheap and a plugin's import cost is paid only by a run that reads the registry. Reading
+runs no code of a plugin's beyond its import (which is given :data:`IMPORT_SECONDS`). A plugin
+that cannot be used (it fails to import, is not an entry of the kind, is named otherwise than its
+entry point, or takes a name already taken) is left out: it breaks only itself, with one warning
+(:class:`PluginWarning`; the command line prints it as one line naming it and the
+``pip uninstall`` that removes it), and looking it up raises its one-line error. ``ARMTRANSFER_NO_PLUGINS=1``
+reads no installed plugin.
 
 :class:`Names` is a tuple-like view of the names whose entry passes a test, computed on every
 use, so a module can hold, say, "the reward-only methods" as a constant and still see a method

@@ -14,10 +14,11 @@ A package makes its learner known under the entry-point group ``armtransfer.lear
 entry point's name is the learner's name, its object the :class:`Learner`); it is read on the
 first use of :data:`LEARNERS`. A notebook calls :func:`register_learner` instead. A plugin that
 cannot be imported, is not a :class:`Learner`, is named otherwise than its entry point or takes
-a name already taken is refused in one line (:class:`~armtransfer.errors.PluginError`) naming
-it and the fault; one whose ``make``, ``learn`` or ``predict`` raises, or whose actions are not
-actions of the environment, is refused by the harness's probe before a benchmark writes
-anything.
+a name already taken is left out with a warning, and refused in one line
+(:class:`~armtransfer.errors.PluginError`) naming it and the fault when it is named; one whose
+``make``, ``learn`` or ``predict`` raises anything, does not return within the probe's time
+limit, or whose actions are not actions of the environment, is refused by the harness's probe
+(``experiments.learner_trial.probe``) before a run learns or writes anything.
 
 The built-in learner, ``sarsa``, is SARSA(lambda) (Algorithm 1) in the compiled kernel: the
 benchmark runs it directly, not through ``make``.

@@ -16,12 +16,14 @@ units of K (K='auto' is ``auto_k`` times -step_reward). With several trajectorie
 takes the largest value over them. Both kinds have ``none`` as their baseline.
 
 A package makes its method known under the entry-point group ``armtransfer.methods`` (the entry
-point's name is the method's name, its object the :class:`Method`); it is read on the first use
-of the registry (:func:`load_entry_points`). A notebook calls :func:`register_method` instead.
-Every method is tried once on the paper's rooms before it is accepted (:func:`probe`); a plugin
-that cannot be imported, raises, returns the wrong shape or a non-finite number, or takes a name
-already taken is refused in one line (:class:`~armtransfer.errors.PluginError`) naming it and
-the fault.
+point's name is the method's name, its object the :class:`Method`); it is imported on the first
+use of the registry (:func:`load_entry_points`), and none of its code runs then. A notebook calls
+:func:`register_method` instead. A method is tried once (:func:`probe`, in a child process under
+a time limit, ``plugin_calls.within``) before a run uses it, on each target robot (one registered
+at run time: on the paper's rooms, when it is registered); a plugin that cannot be imported,
+raises anything, returns the wrong shape, a non-finite or complex number, does not return in
+time, or takes a name already taken is refused in one line
+(:class:`~armtransfer.errors.PluginError`) naming it and the fault.
 """
 
 from __future__ import annotations
