@@ -82,7 +82,7 @@ class ResultStore:
                 for tmp in d.glob(".*.tmp"):
                     tmp.unlink(missing_ok=True)
         except BaseException:
-            store.unlock()
+            store.unlock(remove=not had_lock)  # a lock file that was there before stays, as everything else
             if created is not None:
                 shutil.rmtree(created, ignore_errors=True)
             elif not had_lock:
@@ -116,11 +116,13 @@ class ResultStore:
             os.close(fd)  # its holder removed it as this process opened it: take the new one
         self._lock_fd: int | None = fd
 
-    def unlock(self) -> None:
+    def unlock(self, remove: bool = True) -> None:
+        """Release the store, and (``remove``) delete its lock file first, while it is held."""
         fd = getattr(self, "_lock_fd", None)
         if fd is not None:
             try:
-                (self.root / LOCK).unlink(missing_ok=True)  # removed while held: nobody else holds it
+                if remove:
+                    (self.root / LOCK).unlink(missing_ok=True)  # removed while held: nobody else holds it
             except OSError:
                 pass  # a store on a disk gone read-only keeps its lock file; it is taken again
             os.close(fd)  # closing the descriptor releases the flock
