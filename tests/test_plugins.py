@@ -366,6 +366,8 @@ def test_a_bad_installed_plugin_breaks_only_itself(tmp_path, code, ep, fault, at
         assert len(lines) == 1 and lines[0].startswith("armtransfer: warning: plugin bad-plugin 0.1"), done.stderr
         assert at_import in lines[0], lines[0]
         assert "remove it with 'pip uninstall bad-plugin'" in lines[0] and "ARMTRANSFER_NO_PLUGINS=1" in lines[0]
+        top = run_cli(tmp_path, "--help", path=site)  # the top-level help too: printed, with the one warning
+        assert top.returncode == 0 and "commands:" in top.stdout and top.stderr.strip().splitlines() == lines
     else:
         assert lines == [], done.stderr
     assert (out / "r.json").exists()

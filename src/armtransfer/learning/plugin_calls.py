@@ -131,13 +131,14 @@ def _in_child(seconds: float, said: str, work: Callable[[], None]) -> None:
                 signal.signal(sig, signal.SIG_DFL)
             global _stage_fd
             _stage_fd = w
+            _one_thread()
             try:
                 work()
                 end = b"K\n"
             except PluginError as err:
                 end = ("E" + _line(err) + "\n").encode("utf-8", "replace")
             except BaseException as err:  # noqa: BLE001 - said by the parent in one line
-                end = ("E" + f"{said}: raised {fault(err)}" + "\n").encode("utf-8", "replace")
+                end = ("E" + f"{said} raised {fault(err)}" + "\n").encode("utf-8", "replace")
             for stream in (sys.stdout, sys.stderr):
                 try:
                     stream.flush()
@@ -176,6 +177,17 @@ def _in_child(seconds: float, said: str, work: Callable[[], None]) -> None:
         raise PluginError(ends[-1][1:])
 
 
+def _one_thread() -> None:
+    """In the probe's child: a thread pool the parent started (torch's OpenMP) does not survive
+    ``fork``, and entering it could hang the probe; the child computes on one thread."""
+    torch = sys.modules.get("torch")
+    if torch is not None:
+        try:
+            torch.set_num_threads(1)
+        except Exception:  # noqa: BLE001 - best effort
+            pass
+
+
 def _last_stage(data: bytes) -> str:
     stages = [line[1:] for line in data.decode("utf-8", "replace").splitlines() if line.startswith("S")]
     return stages[-1] if stages else ""
@@ -212,4 +224,4 @@ def _in_thread(seconds: float, said: str, work: Callable[[], None]) -> None:  # 
     if isinstance(err, PluginError):
         raise PluginError(_line(err)) from None
     if err is not None:
-        raise PluginError(f"{said}: raised {fault(err)}") from None
+        raise PluginError(f"{said} raised {fault(err)}") from None
