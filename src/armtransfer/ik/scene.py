@@ -333,12 +333,6 @@ def _chain(model: mujoco.MjModel, tip_body: int, where: str) -> list[int]:
                 f"arm MJCF {where}: joint {_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) or j} on the chain from the "
                 f"base to the tool is a {kinds.get(int(model.jnt_type[j]), 'free')} joint; only hinge joints "
                 "are supported")
-        lo, hi = (float(v) for v in model.jnt_range[j])
-        if lo > hi:  # MuJoCo's autolimits leave such a joint unlimited, without a word
-            raise ArmModelError(
-                f"arm MJCF {where}: joint {_name(model, mujoco.mjtObj.mjOBJ_JOINT, j) or j} has range=\"{lo:g} {hi:g}\", "
-                f"its lower end above its upper, which MuJoCo would take as no limit; give range=\"{hi:g} {lo:g}\", "
-                "or leave range out for an unlimited joint")
     return joints
 
 
