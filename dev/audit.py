@@ -769,6 +769,142 @@ RAY_RUN = ["sweep", "s.toml", "--out", "store", "--executor", "ray", "--workers"
 sweep_file = write("s.toml", SWEEP.format(seeds=list(range(6))))
 
 
+# ---- the third audit's classes: numbers, one integer grammar, addresses, plugins ------------
+
+def plugin_site(d: Path, code: str, entry_points: dict[str, str], group: str = "armtransfer.methods") -> Path:
+    """A distribution ``hostile-plugin`` installed into ``d/site`` (what ``pip install --target``
+    leaves): the module ``hostile`` and its entry points under ``group``."""
+    site = d / "site"
+    site.mkdir(exist_ok=True)
+    (site / "hostile.py").write_text(code)
+    info = site / "hostile_plugin-0.1.dist-info"
+    info.mkdir(exist_ok=True)
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: hostile-plugin\nVersion: 0.1\n")
+    lines = "".join(f"{k} = {v}\n" for k, v in entry_points.items())
+    (info / "entry_points.txt").write_text(f"[{group}]\n{lines}")
+    return site
+
+
+def plugin_cli(r: Runner, d: Path, site: Path, *argv: str, env: dict | None = None, timeout: float = 120) -> Ran:
+    """``armtransfer ARGV`` in a new process that sees the plugin in ``site`` (always a new
+    process: the entry points of this one are read once)."""
+    full = {**r.env(d, False, env), "PYTHONPATH": os.pathsep.join([str(site), str(ROOT / "src")])}
+    proc = subprocess.run([sys.executable, "-m", "armtransfer.cli", *argv], cwd=d, capture_output=True, text=True,
+                          env=full, timeout=timeout)
+    return Ran(proc.returncode, proc.stdout, proc.stderr)
+
+
+HOSTILE = """
+import time
+import numpy as np
+import armtransfer
+
+
+class Mute(Exception):
+    def __str__(self):
+        raise ValueError("no words")
+
+
+def mute(cells, trajectory):
+    raise Mute()
+
+
+def nap(cells, trajectory):
+    time.sleep(600)
+
+
+def twisted(cells, trajectory):
+    return np.zeros(len(cells)) * 1j
+
+
+MUTE = armtransfer.potential_method("mute", "raises an exception that cannot be printed", mute)
+NAP = armtransfer.potential_method("nap", "sleeps ten minutes", nap)
+TWISTED = armtransfer.potential_method("twisted", "returns complex numbers", twisted)
+
+
+class Dozy:
+    def __init__(self, env):
+        self.env = env
+
+    def learn(self, total_timesteps):
+        self.env.reset()
+        for _ in range(total_timesteps):
+            self.env.step(0)
+
+    def predict(self, observation, deterministic=True):
+        time.sleep(600)
+
+
+DOZY = armtransfer.Learner("dozy", "predicts after ten minutes", lambda env, seed: Dozy(env))
+"""
+
+HOSTILE_METHODS = {"mute": "hostile:MUTE", "nap": "hostile:NAP", "twisted": "hostile:TWISTED"}
+
+
+def plugin_refused(argv: list[str], *words: str, within: float = 60, group: str = "armtransfer.methods",
+                   eps: dict | None = None, code: str = HOSTILE):
+    """A case: with the hostile plugin installed, ``argv`` is refused in one line naming
+    ``words`` within ``within`` seconds, nothing written and no process of it left."""
+    def case(r: Runner, d: Path) -> str:
+        site = plugin_site(d, code, eps or HOSTILE_METHODS, group)
+        before = listing(d)
+        t0 = time.monotonic()
+        line = refused(plugin_cli(r, d, site, *argv), before, d, *words)
+        secs = time.monotonic() - t0
+        if secs > within:
+            raise Failed(f"refused, but after {secs:.0f} s")
+        return f"{line}, {secs:.0f} s"
+    return case
+
+
+def plugin_unused(argv: list[str], warned: str = "", code: str = HOSTILE, eps: dict | None = None):
+    """A case: with the hostile plugin installed, ``argv`` (which does not use it) completes;
+    its stderr is one warning line naming ``warned``, or empty."""
+    def case(r: Runner, d: Path) -> str:
+        site = plugin_site(d, code, eps or HOSTILE_METHODS)
+        ran = plugin_cli(r, d, site, *argv)
+        completed(ran, d)
+        lines = ran.err.strip().splitlines()
+        if warned:
+            if len(lines) != 1 or warned not in lines[0] or "pip uninstall hostile-plugin" not in lines[0]:
+                raise Failed(f"{len(lines)} stderr lines: {(lines or [''])[0][:120]}")
+            return "exit 0, one warning line"
+        if lines:
+            raise Failed(f"stderr: {lines[0][:120]}")
+        return "exit 0, silent"
+    return case
+
+
+def store_being_written(r: Runner, d: Path) -> str:
+    """summarize on a store a sweep holds (its lock taken here, as a running sweep holds it)."""
+    from armtransfer.experiments import sweep as sweeps
+    from armtransfer.experiments.store import LOCK, ResultStore
+
+    store = one_run_store(d, r)
+    if (store / LOCK).exists():
+        raise Failed("the finished store keeps its lock file")
+    holder = ResultStore.open_for(store, sweeps.load(d / "s.toml"))
+    try:
+        before = listing(d)
+        return refused(r.cli(d, "summarize", "store"), before, d, "being written by a running sweep")
+    finally:
+        holder.unlock()
+
+
+def results_file(seed: object) -> Callable[[Path], None]:
+    def setup(d: Path) -> None:
+        (d / "results.json").write_text(json.dumps({"suite": {"name": "fast"}, "seed": seed, "methods": [],
+                                                    "not_in_registry": [], "records": [], "summary": {}}))
+    return setup
+
+
+def reversed_joint(d: Path) -> None:
+    (d / "scara.xml").write_text(SCARA_XML.replace('range="-3 3"', 'range="2 -2"', 1))
+
+
+LAYOUT_11 = (ROOT / "src" / "armtransfer" / "worlds" / "data" / "rooms11.toml").read_text()
+
+
 # ---- the cases -------------------------------------------------------------------------
 
 @dataclass
@@ -963,6 +1099,69 @@ CASES: list[Case] = [
     Case("arms generate into a non-empty --out", "refused",
          cli_refused(["arms", "generate", "--family", "planar", "--dof", "2", "--out", "g"], "not empty",
                      setup=nonempty_generate_out)),
+    # the third audit: numbers bounded in every reader, one integer grammar, addresses, world names,
+    # plugins that raise, return or sleep anything, concurrent users of one store
+    Case("sweep file seeds of 5,000 digits", "refused",
+         cli_refused(["sweep", "s.toml", "--out", "o"], "digits",
+                     setup=write("s.toml", "[sweep]\nseeds = [" + "7" * 5000 + "]\n"))),
+    Case("layout JSON name of 4,400 digits", "refused",
+         cli_refused(["rooms", "--world", "w.json"], "digits", setup=write("w.json", '{"name": ' + "9" * 4400 + "}"))),
+    Case("layout TOML cell size inf", "refused",
+         cli_refused(["rooms", "--world", "w.toml"], "finite", setup=write("w.toml", LAYOUT_11 + "\ncell = inf\n"))),
+    Case("rooms --method progress --K 1e308", "refused",
+         cli_refused(["rooms", "--method", "progress", "--K", "1e308", "--trials", "1"], "--K", "1e+06")),
+    Case("transfer(K=np.float64(1e300))", "refused",
+         api_refused(transfer(methods=["pseudo"], K=np.float64(1e300)), "InvalidParameterError", "K")),
+    Case("transfer(max_episodes=30.0): a float count", "refused",
+         api_refused(transfer(methods=["none"], max_episodes=30.0), "InvalidParameterError", "max_episodes",
+                     "integer")),
+    Case("rooms --world generated:¹²", "refused",
+         cli_refused(["rooms", "--world", "generated:¹²", "--trials", "1"], "generated:SEED")),
+    Case("rooms --goal '٣,4' (Arabic-Indic digit)", "refused",
+         cli_refused(["rooms", "--start", "0,0", "--goal", "٣,4", "--trials", "1"], "--goal", "two integers")),
+    Case("sweep --address with a 64-character host label", "refused",
+         cli_refused(["sweep", "s.toml", "--out", "o", "--executor", "ray", "--address", "b" * 64 + ".lan:6379"],
+                     "63", setup=write("s.toml", SWEEP.format(seeds=[0])), within=10)),
+    Case('layout file name = "rooms15"', "refused",
+         cli_refused(["rooms", "--world", "w.toml"], "built-in world",
+                     setup=write("w.toml", LAYOUT_11.replace('name = "rooms11"', 'name = "rooms15"')))),
+    Case('layout file name = "generated:4"', "refused",
+         cli_refused(["rooms", "--world", "w.toml"], "built-in world",
+                     setup=write("w.toml", LAYOUT_11.replace('name = "rooms11"', 'name = "generated:4"')))),
+    Case('arm joint range="2 -2"', "refused",
+         cli_refused(["arms", "list", "--arm-xml", "scara.xml", "--tip-site", "pen_tip"], "shoulder",
+                     "lower end above", setup=reversed_joint)),
+    Case("summarize results.json with seed 2**70", "refused",
+         cli_refused(["summarize", "results.json", "--out", "r"], "seed", setup=results_file(2**70))),
+    Case("benchmark --learner 'sarsa,'", "refused",
+         cli_refused(["benchmark", "--suite", "fast", "--learner", "sarsa,", "--out", "b"], "empty learner name")),
+    Case("benchmark --learner sarsa,sarsa", "refused",
+         cli_refused(["benchmark", "--suite", "fast", "--learner", "sarsa,sarsa", "--out", "b"], "named twice")),
+    Case("summarize a store a sweep is writing", "refused", store_being_written),
+    Case("plugin potential raising an exception whose __str__ raises", "refused",
+         plugin_refused(["rooms", "--method", "mute", "--trials", "1"], "plugin hostile-plugin", "Mute",
+                        "cannot be printed")),
+    Case("plugin potential returning complex numbers", "refused",
+         plugin_refused(["rooms", "--method", "twisted", "--trials", "1"], "plugin hostile-plugin", "complex")),
+    Case("plugin potential sleeping 600 s, --probe-timeout 2", "refused in the limit",
+         plugin_refused(["rooms", "--method", "nap", "--probe-timeout", "2", "--trials", "1"], "hostile:NAP",
+                        "its potential did not return within 2 s", within=30)),
+    Case("plugin learner whose predict sleeps 600 s, --probe-timeout 2", "refused in the limit",
+         plugin_refused(["rooms", "--method", "none", "--learner", "dozy", "--probe-timeout", "2", "--trials", "1"],
+                        "learner 'dozy'", "its predict did not return within 2 s", within=30,
+                        group="armtransfer.learners", eps={"dozy": "hostile:DOZY"})),
+    Case("--help with a sleeping and a raising plugin installed", "completes, silent",
+         plugin_unused(["--help"])),
+    Case("rooms --method none with a sleeping plugin installed", "completes, silent",
+         plugin_unused(["rooms", "--method", "none", "--trials", "1", "--max-episodes", "5", "--no-controls"])),
+    Case("rooms --help with a plugin whose import raises GeneratorExit", "completes, one warning",
+         plugin_unused(["rooms", "--help"], warned="GeneratorExit", code="raise GeneratorExit\n",
+                       eps={"gone": "hostile:GONE"})),
+    Case("--help with a plugin that sleeps 600 s as it is imported", "completes in ~60 s, one warning",
+         plugin_unused(["--help"], warned="did not import within 60 s", code="import time\ntime.sleep(600)\n",
+                       eps={"slow": "hostile:SLOW"}), slow=True),
+    Case("ARMTRANSFER_NO_PLUGINS=yes", "refused",
+         cli_refused(["rooms", "--trials", "1"], "ARMTRANSFER_NO_PLUGINS", env={"ARMTRANSFER_NO_PLUGINS": "yes"})),
     # Ray, determinism
     Case("Ray address served by a plain TCP listener", "refused fast, no store", ray_address_not_ray, slow=True),
     Case("two stores of one sweep", "byte-identical", same_sweep_same_bytes, slow=True),

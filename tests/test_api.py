@@ -63,7 +63,7 @@ def test_same_seed_same_json_bit_for_bit():
     (dict(start=(0, 0)), "start and goal go together"),
     (dict(start=(0, 0), goal=(-3, 0)), "inside a wall"),
     (dict(epsilon=float("nan")), "epsilon must be in [0, 1]"),
-    (dict(step_reward=float("inf")), "step_reward must be a finite number"),
+    (dict(step_reward=float("inf")), "step_reward must be in [-1e+06, 1e+06]"),
     (dict(source="nobody"), "unknown robot 'nobody'; valid: coarse, fine"),
     (dict(K=5.0), "can be farmed"),
     (dict(mapping="m.json"), "a mapping goes with method 'mapping'"),

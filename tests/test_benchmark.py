@@ -35,7 +35,7 @@ def test_fast_suite_writes_one_whole_report(fast_runs):
     assert codes == [0, 0]
     out = root / "one"
     names = {p.name for p in out.iterdir()}
-    assert names == {*REPORT, "timings.json", "sweep.json", "runs", "failed", "timings", ".lock"}
+    assert names == {*REPORT, "timings.json", "sweep.json", "runs", "failed", "timings"}  # no .lock: a finished store keeps none
     suite = suites.get("fast")
     ran, _ = benchmark.methods_to_run()
     section = suite.sections[0]  # a source run per (case, source seed) and a run per trial of every method

@@ -47,6 +47,12 @@ def test_the_audit_covers_every_class_of_the_contract():
                  "ARMTRANSFER_CPUS", "ARMTRANSFER_CACHE", "FIFO", "60 MB", "300-character", "sweep.json",
                  "failed record", "/dev/full", ">&-", "ASCII locale", "runs/ takes no files", "full disk",
                  "--arm-name planar2", 'model="a:b"', "newline", "method was edited", 'seeds ["x"]', "reset(",
-                 "arms generate into a non-empty"):
+                 "arms generate into a non-empty",
+                 # the third audit's classes
+                 "5,000 digits", "4,400 digits", "cell size inf", "--K 1e308", "a float count", "generated:¹²",
+                 "Arabic-Indic", "64-character host", 'name = "rooms15"', "joint range", "seed 2**70",
+                 "--learner 'sarsa,'", "sarsa,sarsa", "a store a sweep is writing", "__str__ raises", "complex",
+                 "sleeping 600 s", "predict sleeps", "--help with a sleeping", "import raises GeneratorExit",
+                 "ARMTRANSFER_NO_PLUGINS"):
         assert word in names, f"no audit case for {word!r}"
     assert len({c.name for c in audit.CASES}) == len(audit.CASES)

@@ -106,7 +106,9 @@ def test_the_contract_is_exported_and_sarsa_is_the_built_in_learner():
 def test_a_registered_learner_is_listed_and_its_name_is_guarded(registered):
     lr = registered(armtransfer.Learner("oracle", "knows the shortest path", Oracle))
     assert lr.origin == "registered at run time" and list(armtransfer.LEARNERS)[-1] == "oracle"
-    assert learners.parse("sarsa, oracle,sarsa") == ("sarsa", "oracle")
+    assert learners.parse("sarsa, oracle") == ("sarsa", "oracle")
+    with pytest.raises(InvalidParameterError, match="learner 'sarsa' is named twice"):
+        learners.parse("sarsa, oracle,sarsa")  # a repeated name is a typo, said rather than dropped
     with pytest.raises(PluginError, match="learner 'oracle' .* the name is taken .*pass replace=True"):
         armtransfer.register_learner(armtransfer.Learner("oracle", "again", Oracle))
     assert registered(armtransfer.Learner("oracle", "again", Oracle), replace=True).description == "again"
@@ -322,8 +324,6 @@ def _learner(act="0", pred="0", make="M(env, seed)", extra="") -> str:
      r"armtransfer.learners\) fails to import: ModuleNotFoundError: No module named 'numpyy'"),
     ("L = 3\n", "walker = badlearn:L", r"plugin bad-learner 0.1 .* is int, not a learner"),
     (_learner(), "other = badlearn:L", r"plugin bad-learner 0.1 .* is a learner named 'walker'; name the entry point"),
-    (_learner().replace("'walker'", "'sarsa'"), "sarsa = badlearn:L",
-     r"plugin bad-learner 0.1 .* is named 'sarsa', as a learner of armtransfer is"),
     (_learner(make="1 / 0"), "walker = badlearn:L",
      r"learner 'walker' \(plugin bad-learner 0.1 .*\), on robot fine: its make raised ZeroDivisionError"),
     (_learner(act="np.array([0, 1])"), "walker = badlearn:L",
@@ -352,15 +352,35 @@ def test_a_bad_installed_learner_is_one_line_and_nothing_is_written(tmp_path, co
     assert done.stderr.startswith("armtransfer benchmark: error: ") and not out.exists()
 
 
-def test_two_installed_learners_with_one_name_are_refused(tmp_path):
+def test_a_learner_named_as_the_built_in_one_is_left_out_with_a_warning(tmp_path):
+    site = tmp_path / "site"
+    site.mkdir()
+    fake_plugin(site, "bad-learner", "badlearn", _learner().replace("'walker'", "'sarsa'"), {"sarsa": "badlearn:L"})
+    done = run_cli(tmp_path, "benchmark", "--learner", "sarsa", "--help", path=site)
+    assert done.returncode == 0 and "usage:" in done.stdout
+    assert len(done.stderr.strip().splitlines()) == 1, done.stderr
+    assert re.search(r"^armtransfer: warning: plugin bad-learner 0.1 .* is left out \(is named 'sarsa', as a learner "
+                     r"of armtransfer is; rename one of them\); remove it with 'pip uninstall bad-learner'",
+                     done.stderr), done.stderr
+
+
+def test_two_installed_learners_with_one_name_are_left_out(tmp_path):
+    """Neither is used (which one is meant?); the help works, with one warning line; naming the
+    learner is its one-line error."""
     site = tmp_path / "site"
     site.mkdir()
     fake_plugin(site, "learner-a", "learn_a", _learner(), {"walker": "learn_a:L"})
     fake_plugin(site, "learner-b", "learn_b", _learner(), {"walker": "learn_b:L"})
+    said = ("plugin learner-b 0.1 (entry point walker = learn_b:L in group armtransfer.learners) is named "
+            "'walker', as a learner of plugin learner-a 0.1")
     done = run_cli(tmp_path, "benchmark", "--help", path=site)
-    assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1 and not done.stdout
-    assert "plugin learner-b 0.1 (entry point walker = learn_b:L in group armtransfer.learners) is named " \
-           "'walker', as a learner of plugin learner-a 0.1" in done.stderr
+    assert done.returncode == 0 and "usage:" in done.stdout
+    assert len(done.stderr.strip().splitlines()) == 1 and "pip uninstall learner-b" in done.stderr
+    assert "is left out (is named 'walker', as a learner of plugin learner-a 0.1" in done.stderr
+    used = run_cli(tmp_path, "benchmark", "--suite", "fast", "--learner", "walker", "--out", str(tmp_path / "o"),
+                   path=site)
+    assert used.returncode == 2 and len(used.stderr.strip().splitlines()) == 1 and said in used.stderr
+    assert not (tmp_path / "o").exists()
 
 
 def test_an_installed_learner_is_read_on_first_use_and_listed(tmp_path):

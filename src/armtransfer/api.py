@@ -75,6 +75,7 @@ def transfer(
     preset: str = "default",
     noise: float = 0.0,
     learner: str = "sarsa",
+    probe_timeout: float = 60.0,
     **learner_options,
 ) -> TransferResult | ContinuousResult:
     """Transfer a trajectory from ``source`` to ``target`` and learn with each method.
@@ -113,6 +114,12 @@ def transfer(
     and no controls (a control trajectory ends elsewhere than the task's goal, which the harness's
     reward term refuses), and is made, learns a few steps and predicts once before anything else is learned, so a
     learner that raises is refused in one line naming it.
+
+    ``probe_timeout``: the time limit in seconds of the probe of each plugin (a method's potential
+    or bonus built once on the target, an outside learner made, learning a few steps and
+    predicting), run before anything is learned in a child process that is then ended; a plugin
+    that overruns it is named in one line with the call that overran. With ``progress`` given, an
+    outside learner's trial that runs longer than 30 s says how far it has got on stderr every 30 s.
     """
     if not isinstance(state, str) or state not in STATES:
         raise InvalidParameterError(f"unknown state {state!r}; valid states: {', '.join(STATES)}")
@@ -144,8 +151,11 @@ def transfer(
     save_mapping = checks.flag(save_mapping, "save_mapping")
     if progress is not None and not callable(progress):
         raise InvalidParameterError(f"progress must be a function called after every trial, got {progress!r}")
-    if not (isinstance(K, str) and K == "auto"):
-        K = checks.real(K, "K", 0.0) if not isinstance(K, str) else _bad_k(K)
+    from armtransfer.learning.method import check_k
+    from armtransfer.learning.plugin_calls import probe_seconds
+
+    K = check_k(K)
+    probe_timeout = probe_seconds(probe_timeout)
     if beta is not None:
         beta = checks.real(beta, "beta", 0.0)
     if arm_xml is not None:
@@ -191,9 +201,10 @@ def transfer(
                 f"robot {robot.name} cannot reach the goal {the_task.goal} from {the_task.start}", robot))
         paths[robot.name] = found
     path = paths[tgt.name]
+    registry.probe_on(method_names, [tgt], probe_timeout)  # a plugin's fault or overrun: one line, now
     if outside is not None:
         return _transfer_outside(outside, src, tgt, the_task, method_names, specs, trials, seed, wind, K, beta,
-                                 config, controls, progress, len(path) - 1)
+                                 config, controls, progress, len(path) - 1, probe_timeout)
 
     mapping_obj, mapping_path = None, None
     if uses_mapping:
@@ -261,13 +272,13 @@ def _outside_learner(learner: object):
 
 def _transfer_outside(learner, src: DiscreteRobot, tgt: DiscreteRobot, the_task: Task, method_names: list[str],
                       specs, trials: int, seed: int, wind: float, K, beta, config: LearnerConfig, controls: bool,
-                      progress, distance: int) -> TransferResult:
+                      progress, distance: int, probe_timeout: float = 60.0) -> TransferResult:
     """``transfer`` by an outside learner (see its docstring): probed first, then every method
     through the harness; no controls (``controls`` is not read)."""
     from armtransfer.experiments import learner_trial, learner_transfer
 
     start, goal = list(the_task.start), list(the_task.goal)
-    learner_trial.probe(learner, tgt, start, goal)  # a learner that raises: one line, before anything is learned
+    learner_trial.probe(learner, tgt, start, goal, probe_timeout)  # a learner that raises: one line, before anything is learned
     shaped = any(registry.get(m).shaped and registry.get(m).uses_trajectory for m in method_names)
     trajs = resolve_trajectories(specs, src, the_task, config, seed) if shaped else []
     start_cell, goal_cell = the_task.cells()
@@ -278,7 +289,8 @@ def _transfer_outside(learner, src: DiscreteRobot, tgt: DiscreteRobot, the_task:
         if made is not None:
             verified[m] = made.K
     runs = learner_transfer.run_all(learner, src, tgt, start, goal, method_names, trajs, trials, seed, config,
-                                    wind=wind, K=verified, beta=beta, tick=progress)
+                                    wind=wind, K=verified, beta=beta, tick=progress,
+                                    heartbeat=progress is not None)  # a long trial says how far it has got
     by_method = {r.method: r for r in runs if r.control is None}
     by_control: dict[str, dict] = {}
     for r in runs:
@@ -398,10 +410,6 @@ def _as_sequence(value, what: str) -> Sequence:
         return list(value)
     except TypeError:
         raise InvalidParameterError(f"{what} must be a name or a list of them, got {value!r}") from None
-
-
-def _bad_k(K: str):
-    raise InvalidParameterError(f"K must be a non-negative number or 'auto', got {K!r}")
 
 
 def _with_walls_cause(message: str, robot: DiscreteRobot) -> str:

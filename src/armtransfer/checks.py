@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 import numbers
 import os
+import re
 
 from armtransfer.errors import ArmTransferError, InvalidParameterError
 
@@ -27,6 +28,22 @@ position): far past any arm on a table, small enough that the scene's numbers st
 inside MuJoCo's and mink's range (a tool offset of 1e300 overflowed in the IK)."""
 
 ErrorType = type[ArmTransferError]
+
+MAX_DIGITS = 40
+"""The most digits an integer written in a spec or on a command line may have."""
+
+_INTEGER = re.compile(r"[+-]?[0-9]{1,%d}" % MAX_DIGITS)
+
+
+def integer_text(text: object, signed: bool = True) -> int | None:
+    """The integer ``text`` writes, by the one grammar every spec of the project uses for an
+    integer (a seed, a side, a task number, a cell's x and y): an optional sign (when
+    ``signed``), then 1 to :data:`MAX_DIGITS` ASCII digits, nothing around them. None for
+    anything else: what ``int()`` would refuse (a superscript '²') or read otherwise than it
+    looks (Arabic-Indic digits, '1_000', spaces) is never accepted."""
+    if not isinstance(text, str) or not _INTEGER.fullmatch(text) or (not signed and text[0] in "+-"):
+        return None
+    return int(text)
 
 
 def whole(value: object, what: str, lo: int = 0, hi: int = MAX_COUNT,

@@ -131,12 +131,42 @@ class _InterruptAgain:
 def _main(argv: list[str]) -> int:
     from armtransfer.errors import ArmTransferError
 
-    try:
-        parser = build_parser()  # reads the methods of installed plugins: a broken one is one line
-    except ArmTransferError as err:
-        command = next((a for a in argv if a in COMMANDS), "")
-        print(f"armtransfer{' ' + command if command else ''}: error: {err}", file=sys.stderr)
-        return 2
+    import warnings
+
+    from armtransfer.learning.lazy_registry import PluginWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PluginWarning)  # said here, in one line each
+        try:
+            parser = build_parser()
+            _warn_left_out(argv)  # a broken plugin breaks only itself: the rest runs, with a warning
+        except ArmTransferError as err:
+            command = next((a for a in argv if a in COMMANDS), "")
+            print(f"armtransfer{' ' + command if command else ''}: error: {err}", file=sys.stderr)
+            return 2
+        return _run(parser, argv)
+
+
+def _warn_left_out(argv: list[str]) -> None:
+    """One warning line for every installed plugin left out (it cannot be imported or used),
+    naming it and how to remove it; none for a plugin the command line names, whose use is then
+    its one-line error (unless it took a built-in's name, which names the built-in)."""
+    import re
+
+    from armtransfer.learning.learners import LEARNERS
+    from armtransfer.learning.methods import METHODS
+
+    named = {word for arg in argv for word in re.split(r"[,=\s]+", arg)}
+    for registry in (METHODS, LEARNERS):
+        registry.ensure_loaded()
+        for name, (_, warning) in registry.broken.items():
+            if name not in named or name in registry.builtin:  # a built-in's name runs the built-in
+                print(f"armtransfer: warning: {warning}", file=sys.stderr)
+
+
+def _run(parser: argparse.ArgumentParser, argv: list[str]) -> int:
+    from armtransfer.errors import ArmTransferError
+
     args = parser.parse_args(_join_xy_values(argv))
     try:
         from armtransfer.commands.common import refuse_empty

@@ -2,7 +2,8 @@
 value is one line naming the variable, exit 2, and nothing written (a bad value found later,
 in a sweep's workers, failed every run and left their records behind).
 
-The variables: ``ARMTRANSFER_CPUS`` (threads per process, :mod:`armtransfer.cpus`),
+The variables: ``ARMTRANSFER_NO_PLUGINS`` (1: read no installed plugin, a way round a broken
+one, :mod:`armtransfer.learning.lazy_registry`), ``ARMTRANSFER_CPUS`` (threads per process, :mod:`armtransfer.cpus`),
 ``ARMTRANSFER_CACHE`` and, without it, ``XDG_CACHE_HOME`` (the arm cache's folder,
 :func:`armtransfer.ik.cache.cache_dir`). ``MUJOCO_GL`` is checked where it is used
 (:mod:`armtransfer.ik.offscreen` falls back from a backend that cannot be loaded).
@@ -16,16 +17,18 @@ from pathlib import Path
 from armtransfer.cpus import ENV as CPUS_ENV
 from armtransfer.cpus import cpus
 from armtransfer.errors import InvalidParameterError
+from armtransfer.learning.lazy_registry import SKIP_ENV, plugins_skipped
 
 CACHE_ENV = "ARMTRANSFER_CACHE"
 XDG_ENV = "XDG_CACHE_HOME"
-VARIABLES = (CPUS_ENV, CACHE_ENV, XDG_ENV)
+VARIABLES = (SKIP_ENV, CPUS_ENV, CACHE_ENV, XDG_ENV)
 """Every environment variable of the package's own (``MUJOCO_GL`` is MuJoCo's)."""
 
 
 def check_environment() -> None:
     """Raise ``InvalidParameterError`` (one line naming the variable) for a bad value of any
     variable in :data:`VARIABLES`; reads, never writes."""
+    plugins_skipped()
     try:
         cpus()
     except InvalidParameterError as err:

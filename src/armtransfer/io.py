@@ -262,19 +262,82 @@ def check_writable(path: str | os.PathLike) -> None:
                           f"({err.strerror or err})") from None
 
 
+MAX_DIGITS = 40
+"""The most digits an integer in a file may have (Python refuses 4,300 with a bare ValueError)."""
+
+MAX_FILE_INT = 2**64
+"""The largest integer magnitude a user's file may hold: every count and seed of the project is
+far below it; a larger one is refused as the file is read, before any check sees it."""
+
+
+def _int_of(text: str) -> int:
+    digits = len(text.lstrip("+-"))
+    if digits > MAX_DIGITS:
+        raise ValueError(f"holds an integer of {digits} digits; no value of this project has more than {MAX_DIGITS}")
+    return int(text)
+
+
 def parse_json_bytes(raw: bytes) -> object:
     """JSON from a file's bytes; ValueError with the reason (not UTF-8, not JSON, nested too
-    deeply) for anything else. Every JSON file this project reads goes through here."""
+    deeply, an integer of more than :data:`MAX_DIGITS` digits) for anything else. Every JSON file
+    this project reads goes through here."""
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError:
         raise ValueError("is not UTF-8 text") from None
     try:
-        return json.loads(text)
+        return json.loads(text, parse_int=_int_of)
     except json.JSONDecodeError as err:
         raise ValueError(f"is not valid JSON (line {err.lineno}: {err.msg})") from None
     except RecursionError:
         raise ValueError("nests too deeply to be a file of this project") from None
+    except ValueError as err:  # an integer too long, from _int_of or Python's own limit
+        raise ValueError(str(err).splitlines()[0] if str(err).startswith("holds") else
+                         f"holds a number that cannot be read ({str(err).splitlines()[0]})") from None
+
+
+def parse_toml_bytes(raw: bytes) -> dict:
+    """TOML from a file's bytes, as :func:`parse_json_bytes` does JSON (the same reasons), and
+    its numbers checked as a user's file's (:func:`check_user_numbers`)."""
+    import tomllib
+
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        raise ValueError("is not UTF-8 text") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise ValueError(f"is not valid TOML: {str(err).splitlines()[0]}") from None
+    except RecursionError:
+        raise ValueError("nests too deeply to be a file of this project") from None
+    except ValueError as err:  # Python's limit on the digits of an integer
+        raise ValueError(f"holds a number that cannot be read ({str(err).splitlines()[0]})") from None
+    check_user_numbers(data)
+    return data
+
+
+def check_user_numbers(data: object) -> None:
+    """ValueError naming the first number of a user's parsed file that no value of the project
+    can be: an integer of magnitude above :data:`MAX_FILE_INT` or more than :data:`MAX_DIGITS`
+    digits, a float that is not finite (inf, nan, 1e999)."""
+    import math
+
+    stack = [data]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, dict):
+            stack.extend(item.values())
+        elif isinstance(item, list):
+            stack.extend(item)
+        elif isinstance(item, bool):
+            continue
+        elif isinstance(item, int) and abs(item) > MAX_FILE_INT:
+            digits = len(str(abs(item))) if abs(item) < 10**MAX_DIGITS else f"more than {MAX_DIGITS}"
+            raise ValueError(f"holds an integer of {digits} digits, beyond any value of this project "
+                             f"(at most {MAX_FILE_INT})")
+        elif isinstance(item, float) and not math.isfinite(item):
+            raise ValueError(f"holds the number {item!r}; every number in it must be finite")
 
 
 def read_json(path: str | os.PathLike, what: str, error: type[ArmTransferError]) -> object:

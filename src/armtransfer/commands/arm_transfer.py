@@ -57,6 +57,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "breadth-first search")
     common.add_method_arguments(p, default=DEFAULT_METHODS)
     common.add_learning_arguments(p)
+    common.add_probe_timeout_argument(p)
     p.add_argument("--json", default=None, metavar="PATH", help="also write the results JSON here")
     p.add_argument("--render", default=None, metavar="PATH",
                    help="also write the rollout video here (.mp4, or .gif)")

@@ -29,6 +29,7 @@ from armtransfer.experiments.stats import benchmark_stats
 from armtransfer.experiments.store import ResultStore, StoreError
 from armtransfer.experiments.sweep import Sweep, content_key
 from armtransfer.io import check_writable, write_bytes_atomic, write_json_atomic, write_text_atomic
+from armtransfer.checks import MAX_COUNT
 from armtransfer.parallel.executors import _check_reachable, _import_ray, run_local, run_ray
 
 HELP = "Compare every method with the baselines that share its learner on a fixed suite, over many source seeds."
@@ -92,18 +93,18 @@ def run(args: argparse.Namespace) -> int:
     from armtransfer.learning.methods import probe_on, refuse_run_time
 
     # a plugin's fault stops the run here, in one line, before its store is opened
-    probe_on(plan.methods, [robots(p.case.target, p.case.world) for p in plan.pairs])
+    probe_on(plan.methods, [robots(p.case.target, p.case.world) for p in plan.pairs], args.probe_timeout)
     refuse_run_time(plan.methods, "a benchmark's runs")  # every case's task checked before anything is written
-    probe_learners(plan, robots)
+    probe_learners(plan, robots, args.probe_timeout)
     t0 = time.perf_counter()
     store = ResultStore.open_for(out, Sweep(plan.name, plan.spec(), ()))
     try:
         code = _run_into(store, plan, robots.resolved, args)
+        if code:
+            return code
+        summary = write_report(store, plan)  # under the lock: a summarize waits for the report
     finally:
-        store.unlock()
-    if code:
-        return code
-    summary = write_report(store, plan)
+        store.unlock()  # and its lock file is removed
     print(f"wrote {out / 'report.md'} ({time.perf_counter() - t0:.0f} s)")
     for section in suite.sections:
         for name, against in summary[section.name]["pooled"].items():
@@ -112,7 +113,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def probe_learners(plan: benchmark.Plan, robots: benchmark.Robots) -> None:
+def probe_learners(plan: benchmark.Plan, robots: benchmark.Robots, seconds: float = 60.0) -> None:
     """Every outside learner of ``plan`` made, learning a few steps and predicting on the first
     case of each of its target robots (``learner_trial.probe``): a learner's fault is one line
     now, before the store is opened; a learner registered in this process only is refused (the
@@ -134,7 +135,7 @@ def probe_learners(plan: benchmark.Plan, robots: benchmark.Robots) -> None:
                                   "package declaring it under the entry-point group armtransfer.learners "
                                   "(docs/extending.md)")
             target = robots(pair.case.target, pair.case.world)
-            learner_trial.probe(learner, target, list(pair.start), list(pair.goal))
+            learner_trial.probe(learner, target, list(pair.start), list(pair.goal), seconds)
 
 
 def _run_into(store: ResultStore, plan: benchmark.Plan, robots: dict, args: argparse.Namespace) -> int:
@@ -229,7 +230,11 @@ def plan_of(store: ResultStore) -> benchmark.Plan:
         suite = suites.get(spec["suite"]["name"])
     except Exception:  # noqa: BLE001 - any malformed spec is the same one-line refusal
         raise StoreError(f"{str(store.root)!r} holds a benchmark of a suite this build does not have") from None
-    plan = benchmark.plan(suite, spec["seed"], ran=spec["methods"], missing=spec["not_in_registry"],
+    seed = spec.get("seed")
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= MAX_COUNT:
+        raise StoreError(f"{str(store.root)!r} holds the seed {str(seed)[:40]}, which no benchmark takes (--seed is an "
+                         f"integer 0..{MAX_COUNT}); it was not written by armtransfer")
+    plan = benchmark.plan(suite, seed, ran=spec["methods"], missing=spec["not_in_registry"],
                           preset=spec.get("preset", "default"), learners=spec.get("learners"))
     if content_key(plan.spec()) != store.meta.get("key"):
         raise StoreError(f"{str(store.root)!r} holds a benchmark of suite {suite.name!r} as another build defined "

@@ -14,6 +14,7 @@ import zlib
 from pathlib import Path
 
 from armtransfer.errors import InvalidParameterError
+from armtransfer.checks import MAX_COUNT
 from armtransfer.io import parse_json_bytes, read_input, staged_directory
 from armtransfer.experiments import suites
 from armtransfer.experiments.stats import benchmark_stats
@@ -49,6 +50,10 @@ def read_results(path: Path) -> tuple[dict, bytes]:
     for name, kind in FIELDS:
         if not isinstance(data.get(name), kind) or isinstance(data.get(name), bool):
             raise InvalidParameterError(f"results file {str(path)!r}: field {name!r} must be a {kind.__name__}")
+    seed = data.get("seed")
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= MAX_COUNT:
+        raise InvalidParameterError(f"results file {str(path)!r}: field 'seed' is {str(seed)[:40]}, which no benchmark "
+                                    f"takes (--seed is an integer 0..{MAX_COUNT})")
     return data, raw
 
 

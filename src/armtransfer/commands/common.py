@@ -7,18 +7,15 @@ import math
 import sys
 from dataclasses import fields
 
-from armtransfer.checks import MAX_COUNT
-from armtransfer.errors import ArmModelError, InvalidParameterError, InvalidTaskError
+from armtransfer.checks import MAX_COUNT, integer_text
+from armtransfer.errors import ArmModelError, ArmTransferError, InvalidParameterError, InvalidTaskError
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.tasks.catalog import parse_xy
 
 
 def _integer_at_least(lo: int, what: str):
     def parse(text: str) -> int:
-        try:
-            value = int(text) if len(text) <= 40 else None  # no 10,000-digit number is parsed
-        except ValueError:
-            value = None
+        value = integer_text(text.strip())  # the one grammar of an integer: no '²', no 10,000 digits
         if value is None or not lo <= value <= MAX_COUNT:
             raise argparse.ArgumentTypeError(f"must be {what} (at most {MAX_COUNT:,}), got {text[:40]!r}")
         return value
@@ -41,15 +38,33 @@ def probability(text: str) -> float:
 
 
 def k_value(text: str) -> float | str:
+    from armtransfer.learning.method import MAX_K, check_k
+
     if text == "auto":
         return text
     try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a number >= 0 or 'auto', got {text!r}") from None
-    if not value >= 0:
-        raise argparse.ArgumentTypeError(f"must be a number >= 0 or 'auto', got {text!r}")
-    return value
+        return check_k(float(text))
+    except (ValueError, ArmTransferError):
+        raise argparse.ArgumentTypeError(f"must be 'auto' or a number in [0, {MAX_K:g}], got {text!r}") from None
+
+
+def probe_timeout(text: str) -> float:
+    from armtransfer.learning.plugin_calls import MAX_PROBE_SECONDS, probe_seconds
+
+    try:
+        return probe_seconds(float(text))
+    except (ValueError, ArmTransferError):
+        raise argparse.ArgumentTypeError(f"must be a number of seconds in (0, {MAX_PROBE_SECONDS:g}], "
+                                         f"got {text!r}") from None
+
+
+def add_probe_timeout_argument(p: argparse.ArgumentParser) -> None:
+    from armtransfer.learning.plugin_calls import PROBE_SECONDS
+
+    p.add_argument("--probe-timeout", type=probe_timeout, default=PROBE_SECONDS, metavar="SECONDS",
+                   help="the time limit of each plugin's probe (a method's potential built once, an outside learner "
+                        "learning a few steps) before anything is run; a plugin that overruns it is named in one line "
+                        f"(default {PROBE_SECONDS:g})")
 
 
 def add_method_arguments(p: argparse.ArgumentParser, default: list[str] | None = None) -> None:
@@ -228,6 +243,7 @@ def transfer_kwargs(args: argparse.Namespace) -> dict:
         world=world, task=args.task, start=start, goal=goal, methods=args.method, trials=args.trials, seed=args.seed,
         wind=args.wind, K=args.K, beta=args.beta, trajectory=args.trajectory, controls=not args.no_controls,
         mapping=args.mapping, save_mapping=args.mapping is not None, max_span=args.max_span,
+        probe_timeout=getattr(args, "probe_timeout", 60.0),
         **({} if args.learner == "sarsa" else {"learner": args.learner}), **config_options(args),
     )
 

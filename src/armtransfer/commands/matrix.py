@@ -12,6 +12,7 @@ from pathlib import Path
 
 from armtransfer.commands import common
 from armtransfer.commands.sweep import add_executor_arguments, check_executor_options, run_sweep
+from armtransfer.checks import integer_text
 from armtransfer.errors import InvalidParameterError
 from armtransfer.io import write_bytes_atomic, write_json_atomic, write_text_atomic
 from armtransfer.experiments import matrix
@@ -53,10 +54,10 @@ def world_tasks(parts: list[str] | None, layout) -> list:
     out: list[str] = []
     for part in parts:
         lo, dash, hi = part.partition("-")
-        if dash and lo.isdigit() and hi.isdigit():
+        if dash and integer_text(lo, signed=False) is not None and integer_text(hi, signed=False) is not None:
             first, last = known(str(int(lo))), known(str(int(hi)))  # both ends first: '1-9999999999' lists nothing
             out.extend(known(str(t)) for t in range(int(first), int(last) + 1))
-        elif part.isdigit():
+        elif integer_text(part, signed=False) is not None:
             out.append(known(str(int(part))))
         elif rooms:
             raise InvalidTaskError(f"tasks are numbers or ranges like 1-4 or 1,3, got {text[:80]!r}")

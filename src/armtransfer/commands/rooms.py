@@ -21,6 +21,7 @@ def add_arguments(p: argparse.ArgumentParser, source: str = "coarse", target: st
     p.add_argument("--target", default=target, help=f"robot that learns (default {target})")
     common.add_method_arguments(p)
     common.add_learning_arguments(p)
+    common.add_probe_timeout_argument(p)
     p.add_argument("--json", default=None, metavar="PATH", help="write the results as JSON here")
 
 

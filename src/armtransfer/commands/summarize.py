@@ -35,6 +35,11 @@ def run(args: argparse.Namespace) -> int:
     if args.out is not None:
         raise InvalidParameterError("--out is for a results file; a store's summary is written into the store")
     store = ResultStore.open_existing(args.dir)
+    with store.reading():  # a store a sweep or benchmark is writing is refused in one line
+        return _summarize(store, args)
+
+
+def _summarize(store: ResultStore, args: argparse.Namespace) -> int:
     if is_benchmark(store.meta["spec"]):
         from armtransfer.commands.benchmark import summarize as benchmark_report
 

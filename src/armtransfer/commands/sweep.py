@@ -8,7 +8,7 @@ import os
 from armtransfer.commands import common
 from armtransfer.experiments.execute import learner_config, robot_specs
 from armtransfer.tasks.catalog import custom_task
-from armtransfer.parallel.executors import ExecutorError, _check_reachable, _import_ray, run_local, run_ray
+from armtransfer.parallel.executors import ExecutorError, _check_reachable, check_address, _import_ray, run_local, run_ray
 from armtransfer.tasks.specs import resolve
 from armtransfer.experiments import sweep as sweeps
 from armtransfer.experiments.store import ResultStore
@@ -38,12 +38,15 @@ def add_executor_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--address", default=None, help="Ray cluster address (default: start a local instance)")
     p.add_argument("--retries", type=common.non_negative_int, default=2,
                    help="retries of a run whose worker died (default 2)")
+    common.add_probe_timeout_argument(p)
 
 
 def check_executor_options(args: argparse.Namespace) -> None:
     """The executor options that do not apply to the chosen executor are an error."""
     if args.address is not None and args.executor != "ray":
         raise ExecutorError("--address goes with --executor ray (the local executor has no address)")
+    if args.address is not None:
+        check_address(args.address)  # before anything uses it
     if args.address and args.workers is not None:
         raise ExecutorError("--workers does not apply to a Ray cluster (--address): its CPUs are the cluster's; "
                             "--workers sizes the local pool or a local Ray instance")
@@ -58,7 +61,7 @@ def run_sweep(sweep: sweeps.Sweep, args: argparse.Namespace) -> int:
         _import_ray()  # say how to install Ray before anything is written
         if args.address:
             _check_reachable(args.address)
-    robots = check_runs(list(sweep.runs))
+    robots = check_runs(list(sweep.runs), getattr(args, "probe_timeout", 60.0))
     store = ResultStore.open_for(args.out, sweep)
     try:
         return _run_into(store, sweep, robots, args)
@@ -66,7 +69,7 @@ def run_sweep(sweep: sweeps.Sweep, args: argparse.Namespace) -> int:
         store.unlock()
 
 
-def check_runs(runs: list[dict]) -> dict:
+def check_runs(runs: list[dict], probe_timeout: float = 60.0) -> dict:
     """Every robot the runs name, built once (arms come from the on-disk cache) to be shared
     with the workers; a robot that cannot be built, or a task cell it cannot start or end
     at, is a one-line error naming the run's robot and task."""
@@ -92,8 +95,9 @@ def check_runs(runs: list[dict]) -> dict:
             robots[spec].start_state(start)
             robots[spec].start_state(goal, what="goal")
     _check_farming_bounds(runs, robots)
-    probe_on((run["method"] for run in runs), [robots[s] for s in dict.fromkeys(run["target"] for run in runs)])
-    probe_learners(outside, runs, robots)
+    probe_on((run["method"] for run in runs), [robots[s] for s in dict.fromkeys(run["target"] for run in runs)],
+             probe_timeout)
+    probe_learners(outside, runs, robots, probe_timeout)
     return robots
 
 
@@ -112,7 +116,7 @@ def refuse_run_time_learners(names: list[str]) -> None:
                               "armtransfer.transfer(..., learner=...)")
 
 
-def probe_learners(names: list[str], runs: list[dict], robots: dict) -> None:
+def probe_learners(names: list[str], runs: list[dict], robots: dict, seconds: float = 60.0) -> None:
     """Every outside learner made, learning a few steps and predicting on each target robot's
     first task (``learner_trial.probe``): a learner's fault is one line now, before the store
     is opened."""
@@ -124,7 +128,7 @@ def probe_learners(names: list[str], runs: list[dict], robots: dict) -> None:
         for run in runs:
             if run.get("learner") == name and run["target"] not in seen:
                 seen.add(run["target"])
-                learner_trial.probe(get(name), robots[run["target"]], list(run["start"]), list(run["goal"]))
+                learner_trial.probe(get(name), robots[run["target"]], list(run["start"]), list(run["goal"]), seconds)
 
 
 def _check_farming_bounds(runs: list[dict], robots: dict) -> None:

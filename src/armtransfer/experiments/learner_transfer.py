@@ -49,7 +49,7 @@ def trial_result(result: dict, stream: list[int]) -> TrialResult:
 def run_method(learner: Learner, method: str, target: DiscreteRobot, start: list[int], goal: list[int],
                trajs: Sequence[Trajectory] | None, trials: int, seed: int, config: LearnerConfig,
                wind: float = 0.0, K: float | str | None = "auto", beta: float | None = None,
-               on_trial: Callable[[], None] | None = None) -> MethodResult:
+               on_trial: Callable[[], None] | None = None, heartbeat: bool = False) -> MethodResult:
     """``trials`` trials of ``method`` by ``learner`` on ``target`` from ``start`` to ``goal``
     (x, y), one after the other (a Python learner holds the GIL), a shaped method paid for
     ``trajs``. A learner's fault is a one-line ``PluginError`` naming it."""
@@ -61,7 +61,8 @@ def run_method(learner: Learner, method: str, target: DiscreteRobot, start: list
         given = trajs if shaped else None
         run = {"method": method, "trial": trial, "seed": int(seed), "start": list(start), "goal": list(goal),
                "wind": float(wind), "config": config.to_dict(), "K": "auto" if K is None else K, "beta": beta}
-        result, stream = learner_trial.trial(learner, run, target, None if given is None else list(given))
+        result, stream = learner_trial.trial(learner, run, target, None if given is None else list(given),
+                                             heartbeat=heartbeat)
         out.trials.append(trial_result(result, stream))
         ks.append(result["K"])
         if on_trial is not None:
@@ -74,7 +75,7 @@ def run_method(learner: Learner, method: str, target: DiscreteRobot, start: list
 def run_all(learner: Learner, source: DiscreteRobot, target: DiscreteRobot, start: list[int], goal: list[int],
             method_names: Sequence[str], trajs: Sequence[Trajectory], trials: int, seed: int, config: LearnerConfig,
             wind: float = 0.0, K: float | str | dict = "auto", beta: float | None = None,
-            tick: Callable[[], None] | None = None) -> list[MethodResult]:
+            tick: Callable[[], None] | None = None, heartbeat: bool = False) -> list[MethodResult]:
     """Every method of ``method_names`` by ``learner``, in that order. No controls: a control
     trajectory (``experiment.control_trajectories``) ends elsewhere than the task's goal, and
     the harness's reward term (``TransferReward``) pays only a trajectory of the task."""
@@ -83,5 +84,5 @@ def run_all(learner: Learner, source: DiscreteRobot, target: DiscreteRobot, star
     def k_of(name: str) -> float | str:
         return K.get(name, "auto") if isinstance(K, dict) else K
 
-    return [run_method(learner, m, target, start, goal, trajs, trials, seed, config, wind, k_of(m), beta, tick)
-            for m in method_names]
+    return [run_method(learner, m, target, start, goal, trajs, trials, seed, config, wind, k_of(m), beta, tick,
+                       heartbeat) for m in method_names]

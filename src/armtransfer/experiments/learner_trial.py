@@ -28,6 +28,8 @@ from __future__ import annotations
 
 import math
 import numbers
+import sys
+import time
 from typing import Any
 
 import gymnasium as gym
@@ -36,7 +38,7 @@ import numpy as np
 from armtransfer.errors import ArmTransferError, PluginError
 from armtransfer.experiments.stats import learning_metrics
 from armtransfer.learning import learners as registry
-from armtransfer.learning import methods
+from armtransfer.learning import methods, plugin_calls
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.learners import Learner
 from armtransfer.learning.trajectory import Trajectory
@@ -59,6 +61,10 @@ target's shortest path."""
 EVAL_CAP = 4
 """A greedy episode stops after EVAL_CAP x the target's shortest path steps (failed)."""
 
+HEARTBEAT_SECONDS = 30.0
+"""A trial running longer says how far it has got on stderr every this many seconds (when asked
+to, ``heartbeat=True``), so that a slow learner is not mistaken for a hung one."""
+
 PROBE_STEPS = 64
 """Steps a learner learns in its probe before a benchmark opens its store."""
 
@@ -75,7 +81,17 @@ def where(learner: Learner) -> str:
 
 def action_of(raw: object, space: gym.spaces.Discrete, said: str) -> int:
     """The action index ``raw`` stands for (a Python or numpy integer, a 0-d or one-element integer
-    array, an integral float); anything else is a one-line :class:`PluginError` starting ``said``."""
+    array, an integral float); anything else (an object that raises as it is read included) is a
+    one-line :class:`PluginError` starting ``said``."""
+    try:
+        return _action_of(raw, space, said)
+    except (PluginError, KeyboardInterrupt):
+        raise
+    except BaseException as err:  # noqa: BLE001 - the plugin's object, said in one line
+        raise PluginError(f"{said} an object that cannot be read as an action ({plugin_calls.fault(err)})") from None
+
+
+def _action_of(raw: object, space: gym.spaces.Discrete, said: str) -> int:
     value = raw
     if isinstance(value, np.ndarray):
         if value.size != 1 or value.ndim > 1:
@@ -83,7 +99,7 @@ def action_of(raw: object, space: gym.spaces.Discrete, said: str) -> int:
                               f"integer in 0..{int(space.n) - 1}")
         value = value.reshape(()).item()
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise PluginError(f"{said} {type(raw).__name__} {raw!r} as an action; an action of this environment is one "
+        raise PluginError(f"{said} {type(raw).__name__} {_shown(raw)} as an action; an action of this environment is one "
                           f"integer in 0..{int(space.n) - 1}")
     number = float(value)
     if not math.isfinite(number) or not number.is_integer() or not 0 <= number < int(space.n):
@@ -133,13 +149,22 @@ class Monitor(gym.Wrapper):
 
 
 def _call(said: str, what: str, fn: Any, *args: Any, **kwargs: Any) -> Any:
-    """``fn(*args)``; whatever it raises is the learner's fault, in one line naming it."""
+    """``fn(*args)``; whatever it raises is the learner's fault, in one line naming it
+    (``plugin_calls.call``)."""
+    return plugin_calls.call(said, what, fn, *args, **kwargs)
+
+
+def _call_method(said: str, model: Any, what: str, *args: Any, **kwargs: Any) -> Any:
+    """``model.what(*args)``, the attribute looked up inside the guard too."""
+    return plugin_calls.call(said, what, lambda *a, **k: getattr(model, what)(*a, **k), *args, **kwargs)
+
+
+def _shown(obj: object) -> str:
     try:
-        return fn(*args, **kwargs)
-    except PluginError:
-        raise
-    except (Exception, SystemExit) as err:  # noqa: BLE001 - a plugin's bug, said in one line
-        raise PluginError(f"{said}: its {what} raised {type(err).__name__}: {err}".splitlines()[0]) from None
+        text = repr(obj)
+    except BaseException:  # noqa: BLE001
+        return "(that cannot be shown)"
+    return text if len(text) <= 80 else text[:77] + "..."
 
 
 def case_env(target: DiscreteRobot, start: list[int], goal: list[int], wind: float,
@@ -179,7 +204,7 @@ def greedy_episode(model: Any, env: RobotRoomsEnv, cap: int, said: str) -> int |
     space = env.action_space
     assert isinstance(space, gym.spaces.Discrete)
     for k in range(1, cap + 1):
-        out = _call(said, "predict", model.predict, obs, deterministic=True)
+        out = _call_method(said, model, "predict", obs, deterministic=True)
         if not isinstance(out, tuple) or len(out) != 2:
             raise PluginError(f"{said}: its predict returned {type(out).__name__}, not (action, state)")
         a = action_of(out[0], space, f"{said}: its predict returned")
@@ -196,7 +221,7 @@ def run_trial(learner: Learner, run: dict, target: DiscreteRobot, trajectory: Tr
 
 
 def trial(learner: Learner, run: dict, target: DiscreteRobot,
-          trajectory: Trajectory | list[Trajectory] | None) -> tuple[dict, list[int]]:
+          trajectory: Trajectory | list[Trajectory] | None, heartbeat: bool = False) -> tuple[dict, list[int]]:
     """:func:`run_trial`'s result and the monitored stream of every training episode's steps
     (an unfinished one negative, as the kernel's ``episode_steps``)."""
     said = where(learner)
@@ -218,9 +243,14 @@ def trial(learner: Learner, run: dict, target: DiscreteRobot,
     evals: list[list[int | None]] = []
     converged_at: int | None = None
     greedy: int | None = None
+    t0 = last_said = time.monotonic()
     while env.total < budget:
+        if heartbeat and time.monotonic() - last_said >= HEARTBEAT_SECONDS:
+            last_said = time.monotonic()
+            _say(f"armtransfer: {said}: method {run['method']}, trial {int(run['trial']) + 1}: {env.total:,} of "
+                 f"{budget:,} steps learned in {last_said - t0:.0f} s")
         before = env.total
-        _call(said, "learn", model.learn, min(chunk, budget - env.total))
+        _call_method(said, model, "learn", min(chunk, budget - env.total))
         if env.total == before:
             raise PluginError(f"{said}: its learn({min(chunk, budget - before)}) took no step of the environment")
         steps = greedy_episode(model, ev, cap, said)
@@ -239,20 +269,34 @@ def trial(learner: Learner, run: dict, target: DiscreteRobot,
             "K": None if term is None else float(term.K), "evaluations": evals}, stream
 
 
-def probe(learner: Learner, target: DiscreteRobot, start: list[int], goal: list[int]) -> None:
+def _say(line: str) -> None:
+    """A progress line on stderr, above a progress bar when one is drawn."""
+    from tqdm import tqdm
+
+    tqdm.write(line, file=sys.stderr)
+
+
+def probe(learner: Learner, target: DiscreteRobot, start: list[int], goal: list[int],
+          seconds: float = plugin_calls.PROBE_SECONDS) -> None:
     """``learner`` made on the case's environment (no reward term), learning :data:`PROBE_STEPS`
-    steps, then predicting greedily a few steps: a learner that raises or acts outside the action
-    space is refused now, in one line, before a benchmark writes anything."""
+    steps, then predicting greedily a few steps, in a child process under a time limit of
+    ``seconds`` (``plugin_calls.within``): a learner that raises anything, acts outside the action
+    space or does not return in time is refused now, in one line naming it and the call, before
+    anything is learned or written."""
     said = f"{where(learner)}, on robot {target.name}"
-    config = LearnerConfig()
-    env = Monitor(gym.wrappers.TimeLimit(case_env(target, start, goal, 0.0, config),
-                                         max_episode_steps=MAX_EPISODE_STEPS), said)
-    env.reset(seed=0)
-    model = _call(said, "make", learner.make, env, 0)
-    if model is None or not all(callable(getattr(model, m, None)) for m in ("learn", "predict")):
-        raise PluginError(f"{said}: its make returned {type(model).__name__}, not a model with learn and predict")
-    _call(said, "learn", model.learn, PROBE_STEPS)
-    greedy_episode(model, case_env(target, start, goal, 0.0, config), 4, said)
+
+    def work() -> None:
+        config = LearnerConfig()
+        env = Monitor(gym.wrappers.TimeLimit(case_env(target, start, goal, 0.0, config),
+                                             max_episode_steps=MAX_EPISODE_STEPS), said)
+        env.reset(seed=0)
+        model = _call(said, "make", learner.make, env, 0)
+        if model is None or not all(callable(getattr(model, m, None)) for m in ("learn", "predict")):
+            raise PluginError(f"{said}: its make returned {type(model).__name__}, not a model with learn and predict")
+        _call_method(said, model, "learn", PROBE_STEPS)
+        greedy_episode(model, case_env(target, start, goal, 0.0, config), 4, said)
+
+    plugin_calls.within(seconds, f"{said}: its probe", work)
 
 
 def refuse_methods(learner: Learner, names: list[str] | tuple[str, ...]) -> None:

@@ -20,6 +20,8 @@ import fcntl
 import os
 import shutil
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, cast
 
@@ -80,7 +82,7 @@ class ResultStore:
                 for tmp in d.glob(".*.tmp"):
                     tmp.unlink(missing_ok=True)
         except BaseException:
-            store.unlock()
+            store.unlock(remove=not had_lock)  # a lock file that was there before stays, as everything else
             if created is not None:
                 shutil.rmtree(created, ignore_errors=True)
             elif not had_lock:
@@ -92,25 +94,67 @@ class ResultStore:
         """Take the store for this process (an exclusive ``flock`` on DIR/.lock, held until the
         process ends or :meth:`unlock`), so two sweeps never write one store; the second is
         refused in one line. Temporary files are cleared only once the lock is held, so a live
-        writer's files are never deleted."""
+        writer's files are never deleted. :meth:`unlock` removes the lock file, so a finished
+        store has none; a lock taken on a file another process has just removed is taken again."""
         try:
             self.root.mkdir(parents=True, exist_ok=True)
-            fd = os.open(self.root / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
         except OSError as err:
             raise OutputError(f"cannot write {str(self.root)!r}: {err.strerror}") from None
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            os.close(fd)
-            raise StoreError(f"store {str(self.root)!r} is in use by another sweep; wait for it or choose "
-                             "another --out") from None
+        while True:
+            try:
+                fd = os.open(self.root / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+            except OSError as err:
+                raise OutputError(f"cannot write {str(self.root)!r}: {err.strerror}") from None
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                os.close(fd)
+                raise StoreError(f"store {str(self.root)!r} is in use by another sweep or summarize; wait for it or "
+                                 "choose another --out") from None
+            if _same_file(fd, self.root / LOCK):
+                break
+            os.close(fd)  # its holder removed it as this process opened it: take the new one
         self._lock_fd: int | None = fd
 
-    def unlock(self) -> None:
+    def unlock(self, remove: bool = True) -> None:
+        """Release the store, and (``remove``) delete its lock file first, while it is held."""
         fd = getattr(self, "_lock_fd", None)
         if fd is not None:
+            try:
+                if remove:
+                    (self.root / LOCK).unlink(missing_ok=True)  # removed while held: nobody else holds it
+            except OSError:
+                pass  # a store on a disk gone read-only keeps its lock file; it is taken again
             os.close(fd)  # closing the descriptor releases the flock
             self._lock_fd = None
+
+    @contextmanager
+    def reading(self) -> Iterator[None]:
+        """Hold the store against writers while the block reads it (and writes its summary): a
+        store a running sweep or benchmark holds is refused in one line (its report would race the
+        writer's); a writer starting meanwhile is refused until the block ends."""
+        path = self.root / LOCK
+        while True:
+            try:
+                fd = os.open(path, os.O_RDONLY)
+            except FileNotFoundError:
+                yield  # no writer has it; a writer creating it now is not waited for
+                return
+            except OSError as err:
+                raise StoreError(f"cannot read the lock of store {str(self.root)!r}: {err.strerror}") from None
+            try:
+                fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+            except BlockingIOError:
+                os.close(fd)
+                raise StoreError(f"store {str(self.root)!r} is being written by a running sweep or benchmark; "
+                                 "summarize it when that has finished") from None
+            if _same_file(fd, path):
+                break
+            os.close(fd)
+        try:
+            yield
+        finally:
+            os.close(fd)
 
     @classmethod
     def open_existing(cls, root: str | os.PathLike) -> "ResultStore":
@@ -313,3 +357,13 @@ def _run_problem(record: object, key: str) -> str | None:
     if len(lengths) != 1:
         return "has result lists of different lengths"
     return None
+
+
+def _same_file(fd: int, path: Path) -> bool:
+    """Whether ``fd`` is still the file at ``path`` (not one removed since it was opened)."""
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        return False
+    here = os.fstat(fd)
+    return (st.st_dev, st.st_ino) == (here.st_dev, here.st_ino)

@@ -53,7 +53,6 @@ import hashlib
 import itertools
 import json
 import os
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -65,6 +64,7 @@ from armtransfer.errors import ArmTransferError
 from armtransfer.io import read_input
 from armtransfer.tasks.arms import ARM_NAME, ARM_NAME_FORM
 from armtransfer.learning import methods as _methods
+from armtransfer.learning.method import MAX_K
 from armtransfer.learning import presets as _presets
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.lazy_registry import Names
@@ -267,12 +267,14 @@ def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, ba
     _check_arm_names(arms, spec["pairs"], w)
     for m in spec["methods"]:
         if m not in METHODS:
+            if isinstance(m, str) and m in _methods.METHODS.broken:  # an installed plugin left out: its own line
+                raise SweepFileError(f"{w}: method {m!r}: {_methods.METHODS.broken[m][0]}")
             raise SweepFileError(f"{w}: unknown method {m!r}; valid methods: {', '.join(METHODS)}")
     for s in spec["seeds"]:
         _check_number(f"{w}: seeds", s, 0, 2**63 - 1, integer=True)
     for k in spec["K"]:
         if k != "auto":
-            _check_number(f"{w}: K", k, 0, 1e9)
+            _check_number(f"{w}: K", k, 0, MAX_K)
     for key, lo, hi in (("epsilon", 0, 1), ("lam", 0, 1), ("gamma", 0, 1), ("wind", 0, 1), ("alpha", 1e-12, 1)):
         for v in spec[key]:
             _check_number(f"{w}: {key}", v, lo, hi)
@@ -306,6 +308,8 @@ def _learners(body: dict, spec: dict, where: str) -> None:
         raise SweepFileError(f"{where}: learner " + ("is empty; give at least one" if not names
                                                      else "lists a value twice"))
     for name in names:
+        if isinstance(name, str) and name not in learners.LEARNERS and name in learners.LEARNERS.broken:
+            raise SweepFileError(f"{where}: learner {name!r}: {learners.LEARNERS.broken[name][0]}")
         if not isinstance(name, str) or name not in learners.LEARNERS:
             raise SweepFileError(f"{where}: unknown learner {name!r}; valid learners: {', '.join(learners.LEARNERS)}")
     outside = [n for n in names if n != SARSA]
@@ -436,12 +440,12 @@ def load(path: str | os.PathLike, max_runs: int = MAX_RUNS) -> Sweep:
     p = Path(path)
     where = f"sweep file {str(p)!r}"
     data = read_input(p, "sweep file", SweepFileError)
+    from armtransfer.io import parse_toml_bytes
+
     try:
-        raw = tomllib.loads(data.decode("utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
-        raise SweepFileError(f"{where} is not valid TOML: {str(err).splitlines()[0]}") from None
-    except RecursionError:
-        raise SweepFileError(f"{where} nests too deeply to be a sweep file") from None
+        raw = parse_toml_bytes(data)
+    except ValueError as err:
+        raise SweepFileError(f"{where} {err}") from None
     spec = normalise(raw, where, max_runs, base=p.parent)
     return Sweep(spec["name"], spec, tuple(expand(spec)))
 

@@ -8,11 +8,15 @@ all made from these fields, so a new parameter is one field here.
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import asdict, dataclass, field, fields
 
 import armtransfer.checks as checks
 from armtransfer.errors import InvalidParameterError
+
+
+MAX_REWARD = 1e6
+"""The largest magnitude of a reward: far past any useful one, and far from where Q values of
+sums over millions of steps overflow (a goal reward of 1e308 ran and converged nowhere)."""
 
 
 def _param(default, help: str, lo: float, hi: float = math.inf, *, lo_open: bool = False, cli: bool = True):
@@ -31,8 +35,8 @@ class LearnerConfig:
     gamma: float = _param(0.99, "discount", 0.0, 1.0)
     lam: float = _param(0.9, "trace decay lambda", 0.0, 1.0)
     epsilon: float = _param(0.1, "exploration rate of epsilon-greedy", 0.0, 1.0)
-    step_reward: float = _param(-1.0, "reward per step", -math.inf)
-    goal_reward: float = _param(0.0, "reward on reaching the goal", -math.inf)
+    step_reward: float = _param(-1.0, "reward per step", -MAX_REWARD, MAX_REWARD)
+    goal_reward: float = _param(0.0, "reward on reaching the goal", -MAX_REWARD, MAX_REWARD)
     trace_cutoff: float = _param(1e-3, "eligibility traces below this are dropped", 0.0, 1.0, cli=False)
     """With gamma*lambda = 0.891 a trace of 1 falls below 1e-3 after 60 steps. 0 keeps every
     trace until it underflows, which is exactly the dense Algorithm 1."""
@@ -50,11 +54,7 @@ class LearnerConfig:
         for f in fields(self):
             value = getattr(self, f.name)
             lo, hi, lo_open = f.metadata["lo"], f.metadata["hi"], f.metadata["lo_open"]
-            if f.type in (int, "int"):
-                if isinstance(value, numbers.Real) and not isinstance(value, (bool, numbers.Integral)) \
-                        and math.isfinite(value) and float(value).is_integer():
-                    # typeshed's numbers.Real has no __int__, though every real number here (numpy's too) has one
-                    value = int(value)  # type: ignore[call-overload]  # 3.0 from a TOML or JSON file is 3
+            if f.type in (int, "int"):  # a count is an integer, as on the command line and in sweep files: 1e3 is not
                 value = checks.whole(value, f.name, int(lo), int(hi))
             else:
                 value = checks.real(value, f.name, lo, hi, lo_open=lo_open)

@@ -3,9 +3,13 @@
 ``armtransfer.learning.methods.METHODS`` is one: its built-in entries are there from the start;
 the entries other packages declare (Python entry points, ``armtransfer.learning.plugins``) are
 read the first time anything looks in the mapping, never at import, so that importing the package
-stays cheap and a plugin's import cost is paid only by a run that reads the registry. A loader
-that raises leaves the mapping unloaded: the next look raises the same error again, so a broken
-plugin cannot be half-registered.
+stays cheap and a plugin's import cost is paid only by a run that reads the registry. Reading
+runs no code of a plugin's beyond its import (which is given :data:`IMPORT_SECONDS`). A plugin
+that cannot be used (it fails to import, is not an entry of the kind, is named otherwise than its
+entry point, or takes a name already taken) is left out: it breaks only itself, with one warning
+(:class:`PluginWarning`; the command line prints it as one line naming it and the
+``pip uninstall`` that removes it), and looking it up raises its one-line error. ``ARMTRANSFER_NO_PLUGINS=1``
+reads no installed plugin.
 
 :class:`Names` is a tuple-like view of the names whose entry passes a test, computed on every
 use, so a module can hold, say, "the reward-only methods" as a constant and still see a method
@@ -14,11 +18,35 @@ registered later.
 
 from __future__ import annotations
 
+import os
 import threading
+import warnings
 from collections.abc import Callable, Iterator, MutableMapping, Sequence
 from typing import Generic, TypeVar, overload
 
 V = TypeVar("V")
+
+IMPORT_SECONDS = 60.0
+"""An installed plugin that takes longer than this to import is left out (a warning line): a
+plugin that hangs as it is imported cannot hang ``--help``."""
+
+SKIP_ENV = "ARMTRANSFER_NO_PLUGINS"
+"""Set to 1, no installed plugin is read (0 or unset: they are). Any other value is refused."""
+
+
+class PluginWarning(UserWarning):
+    """An installed plugin that cannot be used is left out (one line naming it and how to remove it)."""
+
+
+def plugins_skipped() -> bool:
+    """Whether :data:`SKIP_ENV` says to read no installed plugin (a bad value: one line)."""
+    from armtransfer.errors import InvalidParameterError
+
+    value = os.environ.get(SKIP_ENV, "").strip()
+    if value not in ("", "0", "1"):
+        raise InvalidParameterError(f"environment variable {SKIP_ENV} must be 1 (read no installed plugin) or 0, "
+                                    f"got {value[:40]!r}")
+    return value == "1"
 
 
 class Registry(MutableMapping[str, V], Generic[V]):
@@ -26,6 +54,8 @@ class Registry(MutableMapping[str, V], Generic[V]):
 
     def __init__(self, builtin: dict[str, V], load: Callable[["Registry[V]"], None] | None = None) -> None:
         self._entries: dict[str, V] = dict(builtin)
+        self.broken: dict[str, tuple[str, str]] = {}
+        """Installed plugins left out: their name -> (the one-line error naming them, the warning)."""
         self.builtin: frozenset[str] = frozenset(builtin)
         self._load = load
         self._state = "unloaded"  # -> "loading" -> "loaded"
@@ -57,7 +87,19 @@ class Registry(MutableMapping[str, V], Generic[V]):
 
     def __getitem__(self, name: str) -> V:
         self.ensure_loaded()
+        if name not in self._entries and isinstance(name, str) and name in self.broken:
+            from armtransfer.errors import PluginError
+
+            raise PluginError(self.broken[name][0])
         return self._entries[name]
+
+    def leave_out(self, name: str, error: str, warning: str) -> None:
+        """Record the installed plugin ``name`` as broken: looking it up raises ``error``; the
+        command line prints ``warning`` (a Python user gets it as a :class:`PluginWarning`)."""
+        if name not in self.builtin:
+            self._entries.pop(name, None)
+        self.broken[name] = (error, warning)
+        warnings.warn(warning, PluginWarning, stacklevel=2)
 
     def __setitem__(self, name: str, value: V) -> None:
         self.ensure_loaded()
@@ -146,19 +188,90 @@ def read_entry_points(group: str, registry: Registry[V], kind: str, check: Calla
     from armtransfer.errors import PluginError
 
     found: dict[str, V] = {}
+    if plugins_skipped():
+        return found
+    claimed: dict[str, str] = {}  # a name -> the plugin that declared it first
     for ep in sorted(entry_points(group=group), key=lambda e: (e.name, e.value)):
         where = describe_entry_point(ep, group)
         try:
-            obj = ep.load()
-        except (Exception, SystemExit) as err:  # noqa: BLE001 - any failure to import is the plugin's, in one line
-            raise PluginError(f"{where} fails to import: {type(err).__name__}: {err}".splitlines()[0]) from None
-        entry = check(obj, where)
-        name = named(entry)
-        if name != ep.name:
-            raise PluginError(f"{where} is a {kind} named {name!r}; name the entry point as the {kind}")
-        taken = registry.peek()
-        if name in taken or name in found:
-            other = getattr(taken[name] if name in taken else found[name], "origin")
-            raise PluginError(f"{where} is named {name!r}, as a {kind} of {other} is; rename one of them")
-        found[name] = with_origin(entry, where)
+            entry = _read_one(ep, where, check, registry, kind, named, found, claimed)
+        except PluginError as err:
+            ep_name = str(getattr(ep, "name", "?"))
+            found.pop(ep_name, None)
+            registry.leave_out(ep_name, str(err), left_out(where, str(err), ep))
+            continue
+        found[ep.name] = with_origin(entry, where)
     return found
+
+
+def _read_one(ep: object, where: str, check: Callable[[object, str], V], registry: Registry[V], kind: str,
+              named: Callable[[V], str], found: dict[str, V], claimed: dict[str, str]) -> V:
+    from armtransfer.errors import PluginError
+    from armtransfer.learning.plugin_calls import fault
+
+    ep_name = str(getattr(ep, "name", "?"))
+    first = claimed.setdefault(ep_name, where)
+    if first != where:  # two plugins declare one name: neither is used
+        raise PluginError(f"{where} is named {ep_name!r}, as a {kind} of {first} is; rename one of them")
+    try:
+        obj = _load_within(ep, IMPORT_SECONDS)
+    except KeyboardInterrupt:
+        raise
+    except _ImportOverrun:
+        raise PluginError(f"{where} did not import within {IMPORT_SECONDS:g} s") from None
+    except BaseException as err:  # noqa: BLE001 - any failure to import is the plugin's, in one line
+        raise PluginError(f"{where} fails to import: {fault(err)}") from None
+    entry = check(obj, where)
+    name = named(entry)
+    if name != ep_name:
+        raise PluginError(f"{where} is a {kind} named {name!r}; name the entry point as the {kind}")
+    taken = registry.peek()
+    if name in taken:
+        other = getattr(taken[name], "origin")
+        raise PluginError(f"{where} is named {name!r}, as a {kind} of {other} is; rename one of them")
+    return entry
+
+
+class _ImportOverrun(BaseException):
+    """Raised into a plugin's import that overran (a BaseException: its ``except Exception`` cannot keep it)."""
+
+
+def _load_within(ep: object, seconds: float) -> object:
+    """``ep.load()``, interrupted after ``seconds`` by a timer signal in the main thread (a
+    Python-level wait or loop is interrupted; the import then fails and leaves nothing behind).
+    Elsewhere, or under a timer of the caller's due sooner, without a limit."""
+    import signal
+    import time
+
+    load = getattr(ep, "load")
+    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "setitimer"):
+        return load()
+    outer_delay, outer_interval = signal.getitimer(signal.ITIMER_REAL)
+    if outer_delay and outer_delay <= seconds:
+        return load()  # the caller's own timer is due first: it is left alone
+
+    def overran(signum: int, frame: object) -> None:
+        raise _ImportOverrun()
+
+    previous = signal.signal(signal.SIGALRM, overran)
+    t0 = time.monotonic()
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        return load()
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+        if outer_delay:  # the caller's timer, given back what is left of it
+            signal.setitimer(signal.ITIMER_REAL, max(outer_delay - (time.monotonic() - t0), 1e-3), outer_interval)
+
+
+def left_out(where: str, error: str, ep: object) -> str:
+    """The one warning line of a plugin left out: what is wrong and how to remove it."""
+    dist = getattr(ep, "dist", None)
+    try:
+        remove = f"pip uninstall {dist.metadata['Name']}" if dist is not None else "uninstall its distribution"
+    except Exception:  # noqa: BLE001 - a distribution without a name
+        remove = "uninstall its distribution"
+    said = error[len(where):].lstrip(": ") if error.startswith(where) else error
+    return (f"{where} is left out ({said}); remove it with '{remove}', or set {SKIP_ENV}=1 to read no "
+            "installed plugin")

@@ -14,10 +14,11 @@ A package makes its learner known under the entry-point group ``armtransfer.lear
 entry point's name is the learner's name, its object the :class:`Learner`); it is read on the
 first use of :data:`LEARNERS`. A notebook calls :func:`register_learner` instead. A plugin that
 cannot be imported, is not a :class:`Learner`, is named otherwise than its entry point or takes
-a name already taken is refused in one line (:class:`~armtransfer.errors.PluginError`) naming
-it and the fault; one whose ``make``, ``learn`` or ``predict`` raises, or whose actions are not
-actions of the environment, is refused by the harness's probe before a benchmark writes
-anything.
+a name already taken is left out with a warning, and refused in one line
+(:class:`~armtransfer.errors.PluginError`) naming it and the fault when it is named; one whose
+``make``, ``learn`` or ``predict`` raises anything, does not return within the probe's time
+limit, or whose actions are not actions of the environment, is refused by the harness's probe
+(``experiments.learner_trial.probe``) before a run learns or writes anything.
 
 The built-in learner, ``sarsa``, is SARSA(lambda) (Algorithm 1) in the compiled kernel: the
 benchmark runs it directly, not through ``make``.
@@ -145,9 +146,17 @@ def get(name: str) -> Learner:
 
 
 def parse(names: str | list[str] | tuple[str, ...]) -> tuple[str, ...]:
-    """Learner names from ``NAME[,NAME...]`` (or a list of them), each checked, in order, once."""
+    """Learner names from ``NAME[,NAME...]`` (or a list of them), each checked, in order; an
+    empty name (``sarsa,``) or a name given twice is a one-line error."""
     items = names.split(",") if isinstance(names, str) else [n for part in names for n in str(part).split(",")]
-    items = [n.strip() for n in items if n.strip()]
-    if not items:
+    items = [n.strip() for n in items]
+    if not any(items):
         raise InvalidParameterError(f"no learner named; valid learners: {', '.join(LEARNERS)}")
-    return tuple(dict.fromkeys(get(n).name for n in items))
+    if not all(items):
+        raise InvalidParameterError(f"an empty learner name in {names!r}; give NAME[,NAME...], valid learners: "
+                                    f"{', '.join(LEARNERS)}")
+    found = [get(n).name for n in items]
+    twice = next((n for i, n in enumerate(found) if n in found[:i]), None)
+    if twice is not None:
+        raise InvalidParameterError(f"learner {twice!r} is named twice in {names!r}; name each learner once")
+    return tuple(found)

@@ -25,6 +25,24 @@ bound -step_reward/n (a farmable method's is then verified by value iteration, s
 DEFAULT_GAMMA = LearnerConfig().gamma
 """The discount :func:`build_shaping` bounds potentials for unless told the learner's."""
 
+MAX_K = 1e6
+"""The largest K a run takes, in units of reward (the step reward is -1 by default): far past
+any useful shaping, and small enough that K times any bounded potential stays finite."""
+
+
+def check_k(K: object) -> float | str:
+    """``K`` as a run takes it: 'auto', or a real number (numpy's too) in [0, :data:`MAX_K`];
+    anything else is one line."""
+    import numbers
+
+    if isinstance(K, str) and K == "auto":
+        return K
+    if isinstance(K, (bool, np.bool_)) or not isinstance(K, numbers.Real) or not np.isfinite(float(K)) \
+            or not 0 <= float(K) <= MAX_K:
+        raise InvalidParameterError(f"K must be 'auto' or a number in [0, {MAX_K:g}], got {K!r}")
+    return float(K)
+
+
 Builder = Callable[[DiscreteRobot, list[Trajectory], float, float], Shaping]
 """(robot, trajectories, K, beta) -> the shaping arrays."""
 
@@ -83,10 +101,6 @@ class Method:
             if self.auto_k is not None:
                 return self.auto_k * -step_reward
             return HALF_BOUND * farming_bound(step_reward, trajs)
-        try:
-            k = float(K)
-        except (TypeError, ValueError):
-            raise InvalidParameterError(f"K must be a non-negative number or 'auto', got {K!r}") from None
-        if not np.isfinite(k) or k < 0:
-            raise InvalidParameterError(f"K must be a non-negative number or 'auto', got {K!r}")
+        k = check_k(K)
+        assert isinstance(k, float)
         return k

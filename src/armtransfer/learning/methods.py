@@ -29,6 +29,7 @@ from armtransfer.errors import InvalidParameterError, PluginError
 from armtransfer.learning import guide, plugins, potentials
 from armtransfer.learning import shaping as modes
 from armtransfer.learning.lazy_registry import Names, Registry
+from armtransfer.learning.plugin_calls import PROBE_SECONDS, probe_seconds
 from armtransfer.learning.method import DEFAULT_GAMMA, HALF_BOUND, Builder, Method
 from armtransfer.learning.rewards import as_list, farming_bound, longest_n, union_index
 from armtransfer.learning.shaping import Shaping
@@ -191,12 +192,12 @@ REWARD_ONLY = Names(METHODS, lambda name, m: m.shaped and not m.chooses,
                     "The methods whose transfer is a reward term alone (what ``armtransfer.wrappers`` can add).")
 
 
-def register_method(method: Method, replace: bool = False) -> Method:
+def register_method(method: Method, replace: bool = False, probe_timeout: float = PROBE_SECONDS) -> Method:
     """Make ``method`` (``armtransfer.potential_method(...)`` or ``armtransfer.bonus_method(...)``)
     a method of this process, everywhere a built-in one is (``plugins.register``): a notebook's
     way. Worker processes (a sweep's pool, Ray) do not see it: an installed package's entry point
     is seen by every process (:func:`refuse_run_time`)."""
-    return plugins.register(METHODS, method, replace=replace)
+    return plugins.register(METHODS, method, replace=replace, seconds=probe_seconds(probe_timeout))
 
 
 def refuse_run_time(names: Iterable[str], where: str) -> None:
@@ -211,15 +212,16 @@ def refuse_run_time(names: Iterable[str], where: str) -> None:
                 f"group {plugins.GROUP} (docs/extending.md), or run it with armtransfer.transfer(...)")
 
 
-def probe_on(names: Iterable[str], robots: Iterable[DiscreteRobot]) -> None:
-    """Build every plugin method among ``names`` once on each of ``robots`` (``plugins.probe``): a
-    fault that shows only on one robot is a one-line error before a run that writes starts."""
+def probe_on(names: Iterable[str], robots: Iterable[DiscreteRobot], seconds: float = PROBE_SECONDS) -> None:
+    """Build every plugin method among ``names`` once on each of ``robots`` (``plugins.probe``),
+    each under a time limit of ``seconds``: a fault that shows only on one robot, or a potential
+    that does not return, is a one-line error before a run that writes starts."""
     robots = list(robots)
     for name in dict.fromkeys(names):
         m = get(name)
         if m.origin != "armtransfer":
             for robot in robots:
-                plugins.probe(m, f"{m.origin}, on robot {robot.name}", robot)
+                plugins.probe(m, f"{m.origin}, on robot {robot.name}", robot, seconds)
 
 
 def get(name: str) -> Method:
@@ -283,9 +285,23 @@ def build_shaping(
                 f"(-step_reward/n) or the method 'first-visit'"
             )
     sh = build(robot, trajs, k, potentials.DENSE_BETA if beta is None else float(beta))
+    _check_scaled(m.name, k, sh)
     if sh.mode == modes.MODE_POTENTIAL:
         sh = replace(sh, phi=potentials.bounded(sh.phi, gamma, step_reward))
     return sh
+
+
+def _check_scaled(name: str, k: float, sh: Shaping) -> None:
+    """Every value of the shaping, after the multiplication by K, finite and at most
+    ``plugins.MAX_VALUE`` in magnitude: a K too large for the method is one line, not a run
+    filled with inf that reports nothing converged."""
+    for values in (sh.bonus, sh.phi):
+        with np.errstate(invalid="ignore"):
+            bad = ~np.isfinite(values) | (np.abs(values) > plugins.MAX_VALUE)
+        if bad.any():
+            raise InvalidParameterError(f"method {name!r} with K={k:g} gives the shaping value {values[bad][0]:g} at "
+                                        f"{int(bad.sum())} states; every value must be finite and at most "
+                                        f"{plugins.MAX_VALUE:g} in magnitude: use a smaller K")
 
 
 def bonus_bound(m: Method, robot: DiscreteRobot, trajs: Sequence[Trajectory], step_reward: float) -> float:

@@ -16,25 +16,29 @@ units of K (K='auto' is ``auto_k`` times -step_reward). With several trajectorie
 takes the largest value over them. Both kinds have ``none`` as their baseline.
 
 A package makes its method known under the entry-point group ``armtransfer.methods`` (the entry
-point's name is the method's name, its object the :class:`Method`); it is read on the first use
-of the registry (:func:`load_entry_points`). A notebook calls :func:`register_method` instead.
-Every method is tried once on the paper's rooms before it is accepted (:func:`probe`); a plugin
-that cannot be imported, raises, returns the wrong shape or a non-finite number, or takes a name
-already taken is refused in one line (:class:`~armtransfer.errors.PluginError`) naming it and
-the fault.
+point's name is the method's name, its object the :class:`Method`); it is imported on the first
+use of the registry (:func:`load_entry_points`), and none of its code runs then. A notebook calls
+:func:`register_method` instead. A method is tried once (:func:`probe`, in a child process under
+a time limit, ``plugin_calls.within``) before a run uses it, on each target robot (one registered
+at run time: on the paper's rooms, when it is registered); a plugin that cannot be imported,
+raises anything, returns the wrong shape, a non-finite or complex number, does not return in
+time, or takes a name already taken is refused in one line
+(:class:`~armtransfer.errors.PluginError`) naming it and the fault.
 """
 
 from __future__ import annotations
 
+import numbers
 import re
 from collections.abc import Callable
 
 import numpy as np
 
-from armtransfer.errors import ArmTransferError, PluginError
+from armtransfer.errors import InvalidParameterError, PluginError
+from armtransfer.learning import plugin_calls
 from armtransfer.learning import shaping as modes
 from armtransfer.learning.lazy_registry import read_entry_points
-from armtransfer.learning.method import Method
+from armtransfer.learning.method import MAX_K, Method
 from armtransfer.learning.shaping import Shaping
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.robot import DiscreteRobot, cell_robot
@@ -49,6 +53,10 @@ RUN_TIME = "registered at run time"
 NAME = re.compile(r"[a-z0-9][a-z0-9_.-]{0,63}")
 """A method's name: lower case letters, digits, '_', '.', '-', starting with a letter or digit
 (it is typed on command lines and written in file names and sweep files)."""
+
+MAX_VALUE = 1e12
+"""The largest magnitude of a plugin's value, and of a shaping value after the multiplication by
+K: far beyond any useful shaping, and far from where float64 sums lose every step reward."""
 
 CellFunction = Callable[[np.ndarray, np.ndarray], object]
 """``f(cells, trajectory)``: (n, 2) and (m, 2) int64 arrays of (x, y) -> n numbers."""
@@ -72,7 +80,7 @@ def bonus_method(name: str, description: str, bonus: CellFunction) -> Method:
     that can be farmed, or that pays a move leaving the state unchanged, is refused."""
     _check_definition(name, description, bonus, "bonus", None)
     per_k = _bonus_per_k(name, bonus)
-    return Method(name, description.strip(), paper=False, build=_bonus_builder(per_k), farmable=True,
+    return Method(name, description.strip(), paper=False, build=_bonus_builder(name, per_k), farmable=True,
                   baselines=("none",), bonus_per_k=per_k, origin=RUN_TIME)
 
 
@@ -83,9 +91,9 @@ def _check_definition(name: object, description: object, fn: object, what: str, 
         raise PluginError(f"method {name!r}: its description must be one line of text, got {description!r}")
     if not callable(fn):
         raise PluginError(f"method {name!r}: its {what} must be a function (cells, trajectory) -> values, got {fn!r}")
-    if auto_k is not None and (isinstance(auto_k, bool) or not isinstance(auto_k, (int, float))
-                               or not np.isfinite(auto_k) or auto_k < 0):
-        raise PluginError(f"method {name!r}: auto_k must be a finite number >= 0, got {auto_k!r}")
+    if auto_k is not None and (isinstance(auto_k, (bool, np.bool_)) or not isinstance(auto_k, numbers.Real)
+                               or not np.isfinite(float(auto_k)) or not 0 <= float(auto_k) <= MAX_K):
+        raise PluginError(f"method {name!r}: auto_k must be a number in [0, {MAX_K:g}], got {auto_k!r}")
 
 
 def trajectory_xy(traj: Trajectory, robot: DiscreteRobot) -> np.ndarray:
@@ -100,32 +108,67 @@ def _values(name: str, fn: CellFunction, robot: DiscreteRobot, trajs: list[Traje
     out = None
     for traj in trajs:
         given_cells = cells.copy()  # the plugin may write into what it is handed; the robot stays as it is
-        try:
-            raw = fn(given_cells, trajectory_xy(traj, robot))
-        except ArmTransferError as err:
-            raise PluginError(f"method {name!r}: its {what} raised: {err}") from None
-        except (Exception, SystemExit) as err:  # noqa: BLE001 - a plugin's bug, said in one line
-            raise PluginError(f"method {name!r}: its {what} raised {type(err).__name__}: {err}".splitlines()[0]) from None
-        try:
-            values = np.asarray(raw, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise PluginError(f"method {name!r}: its {what} returned {type(raw).__name__}, not {n} numbers") from None
-        if values.shape != (n,):
-            raise PluginError(f"method {name!r}: its {what} returned shape {values.shape} for {n} states; it must "
-                              f"return one number per state, shape ({n},)")
-        bad = ~np.isfinite(values)
-        if bad.any():
-            raise PluginError(f"method {name!r}: its {what} returned {values[bad][0]} for {int(bad.sum())} of {n} "
-                              "states; every value must be a finite number")
+        raw = plugin_calls.call(f"method {name!r}", what, fn, given_cells, trajectory_xy(traj, robot))
+        values = _numbers(name, what, raw, n)
         out = values if out is None else np.maximum(out, values)
     assert out is not None  # the registry hands at least one trajectory to a method that uses them
+    return out
+
+
+def _numbers(name: str, what: str, raw: object, n: int) -> np.ndarray:
+    """What a plugin returned as n finite real numbers; anything else (an object whose
+    ``__array__`` raises, complex or non-finite numbers, the wrong shape) is one line."""
+    said = f"method {name!r}: its {what} returned"
+    try:
+        values = np.asarray(raw)
+        kind = values.dtype.kind
+        if kind == "O":
+            values = np.asarray(raw, dtype=np.float64)
+            kind = values.dtype.kind
+    except KeyboardInterrupt:
+        raise
+    except BaseException as err:  # noqa: BLE001 - the plugin's object cannot be read as numbers
+        raise PluginError(f"{said} {_type_name(raw)}, which cannot be read as numbers ({plugin_calls.fault(err)})"
+                          ) from None
+    if kind == "c":
+        raise PluginError(f"{said} complex numbers; it must return {n} real numbers")
+    if kind not in "biuf":
+        raise PluginError(f"{said} {_type_name(raw)}, not {n} numbers")
+    if values.shape != (n,):
+        raise PluginError(f"{said} shape {values.shape} for {n} states; it must "
+                          f"return one number per state, shape ({n},)")
+    values = values.astype(np.float64)
+    bad = ~np.isfinite(values) | (np.abs(values) > MAX_VALUE)
+    if bad.any():
+        raise PluginError(f"{said} {values[bad][0]} for {int(bad.sum())} of {n} states; every value must be a "
+                          f"finite number of magnitude at most {MAX_VALUE:g}")
+    return values
+
+
+def _type_name(obj: object) -> str:
+    try:
+        return str(type(obj).__name__)
+    except BaseException:  # noqa: BLE001
+        return "an object"
+
+
+def _scaled(name: str, what: str, k: float, values: np.ndarray) -> np.ndarray:
+    """``k * values``, checked after the multiplication: every product finite and within
+    :data:`MAX_VALUE` (a K too large for the plugin's values is one line)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = k * values
+    bad = ~np.isfinite(out) | (np.abs(out) > MAX_VALUE)
+    if bad.any():
+        raise InvalidParameterError(f"method {name!r}: K={k:g} times its {what} gives {out[bad][0]:g} at "
+                                    f"{int(bad.sum())} states; the shaping's values must be finite and at most "
+                                    f"{MAX_VALUE:g} in magnitude: use a smaller K")
     return out
 
 
 def _potential_builder(name: str, potential: CellFunction):
     def build(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
         phi = _values(name, potential, robot, trajs, "potential")
-        return Shaping.potential(k * phi, k)
+        return Shaping.potential(_scaled(name, "potential", k, phi), k)
 
     return build
 
@@ -141,10 +184,11 @@ def _bonus_per_k(name: str, bonus: CellFunction):
     return per_k
 
 
-def _bonus_builder(per_k: Callable[[DiscreteRobot, list[Trajectory]], np.ndarray]):
+def _bonus_builder(name: str, per_k: Callable[[DiscreteRobot, list[Trajectory]], np.ndarray]):
     def build(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
         n = robot.n_states
-        return Shaping(modes.MODE_PSEUDO, k * per_k(robot, trajs), np.full(n, -1, np.int64), np.zeros(n), k)
+        return Shaping(modes.MODE_PSEUDO, _scaled(name, "bonus", k, per_k(robot, trajs)), np.full(n, -1, np.int64),
+                       np.zeros(n), k)
 
     return build
 
@@ -165,19 +209,26 @@ def _trajectory_on(robot: DiscreteRobot) -> Trajectory:
     return Trajectory(cells, (0,) * len(cells), labels[-1], source="probe")
 
 
-def probe(method: Method, where: str, robot: DiscreteRobot | None = None) -> None:
+def probe(method: Method, where: str, robot: DiscreteRobot | None = None,
+          seconds: float = plugin_calls.PROBE_SECONDS) -> None:
     """Build ``method``'s shaping once, on ``robot`` with a trajectory over its own cells, or (None)
-    on the paper's rooms (every cell a state) with a short path: a plugin that raises, or returns
-    the wrong shape or non-finite numbers, is refused now, in one line naming ``where`` it came
-    from, rather than in the middle of a run."""
-    if method.build is None:
+    on the paper's rooms (every cell a state) with a short path, in a child process under a time
+    limit of ``seconds`` (``plugin_calls.within``): a plugin that raises anything, returns the wrong
+    shape, non-finite or complex numbers, or does not return in time, is refused now, in one line
+    naming ``where`` it came from and the call, rather than in the middle of a run."""
+    build = method.build
+    if build is None:
         return
-    traj = _probe_trajectory() if robot is None else _trajectory_on(robot)
-    robot = cell_robot(ROOMS) if robot is None else robot
-    try:
+
+    def work() -> None:
+        traj = _probe_trajectory() if robot is None else _trajectory_on(robot)
+        on = cell_robot(ROOMS) if robot is None else robot
         if method.bonus_per_k is not None:
-            method.bonus_per_k(robot, [traj])
-        method.build(robot, [traj], 1.0, 1.0)
+            method.bonus_per_k(on, [traj])
+        build(on, [traj], 1.0, 1.0)
+
+    try:
+        plugin_calls.within(seconds, f"method {method.name!r}: its probe", work)
     except PluginError as err:
         said, named = str(err), f"method {method.name!r}: "
         if where.startswith(named[:-2]) and said.startswith(named):  # name the method once
@@ -187,11 +238,10 @@ def probe(method: Method, where: str, robot: DiscreteRobot | None = None) -> Non
 
 def load_entry_points(registry) -> None:
     """Add every method installed packages declare under :data:`GROUP` to ``registry`` (a
-    ``lazy_registry.Registry``); a bad one is a :class:`PluginError` naming it, and then none is
-    added."""
+    ``lazy_registry.Registry``): importing them runs no code of theirs beyond the import (the
+    probe runs before a run that uses one, ``methods.probe_on``). A plugin that cannot be used is
+    left out with one warning line, and naming it is its one-line error (``lazy_registry``)."""
     found = read_entry_points(GROUP, registry, "method", _a_method, lambda m: m.name, _with_origin)
-    for method in found.values():
-        probe(method, method.origin)
     for name, method in found.items():
         registry.add(name, method)
 
@@ -209,7 +259,8 @@ def _with_origin(method: Method, origin: str) -> Method:
     return replace(method, origin=origin)
 
 
-def register(registry, method: object, replace: bool = False) -> Method:
+def register(registry, method: object, replace: bool = False,
+             seconds: float = plugin_calls.PROBE_SECONDS) -> Method:
     """Add ``method`` (from :func:`potential_method` or :func:`bonus_method`) to ``registry`` in
     this process (a notebook's way; an installed package declares an entry point instead).
     ``replace``: an earlier run-time registration of the same name is replaced (a notebook cell
@@ -224,6 +275,6 @@ def register(registry, method: object, replace: bool = False) -> Method:
             raise PluginError(f"{where}: the name is taken by a method of {old.origin}; rename it"
                               + ("" if old.origin != RUN_TIME else ", or pass replace=True"))
     method = _with_origin(method, RUN_TIME)
-    probe(method, where)
+    probe(method, where, seconds=seconds)
     registry[method.name] = method
     return method

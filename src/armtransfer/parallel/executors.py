@@ -9,12 +9,14 @@ wait for robot 1's path): they are run too, by the same workers.
 
 from __future__ import annotations
 
+import re
 import os
 from collections import deque
 from collections.abc import Callable
 from typing import cast
 
 from armtransfer.experiments.execute import execute
+from armtransfer.checks import integer_text
 from armtransfer.errors import ArmTransferError
 from armtransfer.cpus import ENV as CPUS_ENV
 from armtransfer.parallel.pool import DONE, Pool
@@ -98,24 +100,59 @@ RAY_CONNECT_TIMEOUT = 10.0
 """Seconds to wait for a Ray address to answer before saying it cannot be reached."""
 
 
+_LABEL = re.compile(r"(?!-)[A-Za-z0-9-]{1,63}(?<!-)")
+
+
+def check_address(address: object) -> tuple[str, int] | None:
+    """``address`` (``HOST:PORT`` or ``ray://HOST:PORT``, or ``auto``) as (host, port), checked
+    before anything uses it: a host name of dot-separated labels of 1 to 63 letters, digits and
+    '-' (at most 253 characters), an IPv4 address or a bracketed IPv6 one; a port 1..65535. None
+    for ``auto``. Anything else is one line."""
+    usage = "a Ray address is HOST:PORT, ray://HOST:PORT or auto"
+    if not isinstance(address, str):
+        raise ExecutorError(f"{usage}, got {address!r}")
+    shown = address if len(address) <= 100 else f"{address[:60]}... ({len(address)} characters)"
+    if address == "auto":
+        return None
+    target = address[len("ray://"):] if address.startswith("ray://") else address
+    host, colon, port = target.rpartition(":")
+    number = integer_text(port, signed=False)
+    if not colon or number is None or not 1 <= number <= 65535:
+        raise ExecutorError(f"{usage}, with a port 1..65535, got {shown!r}")
+    if host.startswith("[") and host.endswith("]"):
+        import ipaddress
+
+        try:
+            ipaddress.IPv6Address(host[1:-1])
+        except ValueError:
+            raise ExecutorError(f"{usage}; {host[:60]!r} is not an IPv6 address") from None
+        return host[1:-1], number
+    if host == "":
+        return "127.0.0.1", number
+    labels = host.rstrip(".").split(".")
+    if len(host) > 253 or not all(_LABEL.fullmatch(label) for label in labels):
+        long = next((label for label in labels if len(label) > 63), None)
+        why = (f"its part {long[:20]}... has {len(long)} characters (at most 63)" if long is not None else
+               "a host name is dot-separated parts of 1 to 63 letters, digits and '-' (at most 253 characters)")
+        raise ExecutorError(f"{usage}; the host of {shown!r} is not a host name: {why}")
+    return host, number
+
+
 def _check_reachable(address: str) -> None:
     """Fail in one line within ``RAY_CONNECT_TIMEOUT`` when nothing answers at ``address``
-    (``host:port`` or ``ray://host:port``); ``ray.init`` alone would retry for minutes."""
-    if address == "auto":
+    (``host:port`` or ``ray://host:port``, checked first by :func:`check_address`); ``ray.init``
+    alone would retry for minutes."""
+    found = check_address(address)
+    if found is None:
         return
-    target = address.split("://", 1)[-1]
-    host, _, port = target.rpartition(":")
-    try:
-        port_number = int(port)
-    except ValueError:
-        raise ExecutorError(f"a Ray address is HOST:PORT or ray://HOST:PORT, got {address!r}") from None
+    host, port_number = found
     import socket
 
     try:
-        with socket.create_connection((host or "127.0.0.1", port_number), timeout=RAY_CONNECT_TIMEOUT) as conn:
+        with socket.create_connection((host, port_number), timeout=RAY_CONNECT_TIMEOUT) as conn:
             answer = _http2_answer(conn)
-    except OSError as err:
-        raise ExecutorError(f"cannot reach Ray at {address!r}: {err.strerror or err}") from None
+    except (OSError, UnicodeError, ValueError) as err:
+        raise ExecutorError(f"cannot reach Ray at {address[:100]!r}: {getattr(err, 'strerror', None) or err}") from None
     if answer is not None:
         raise ExecutorError(f"what answers at {address!r} is not Ray ({answer}); give the address of a Ray "
                             "head node (HOST:6379, or ray://HOST:10001 for Ray Client)")

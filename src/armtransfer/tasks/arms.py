@@ -29,6 +29,7 @@ from armtransfer.ik.actions import ACTION_MODELS, action_model
 from armtransfer.ik.description import ArmDescription
 from armtransfer.ik.tool import Tool, parse_held
 from armtransfer.errors import ArmModelError, UnknownArmError
+from armtransfer.ik.joint_ranges import check_joint_ranges
 from armtransfer.io import check_input, read_input
 from armtransfer.models import ARMS
 from armtransfer.worlds.layout import ROOMS, Layout
@@ -212,6 +213,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
             if value is not None:
                 checks.name(value, what, error=ArmModelError)
         xml_bytes = read_input(path, "arm MJCF", ArmModelError)
+        check_joint_ranges(path, repr(str(path)))  # before a mount is searched or anything compiled
         tool = make_tool(tip_site, tip_body, tip_offset, stylus)
         name = arm_name or arm or file_arm_name(path)
         check_arm_name(name, "--arm-name (arm_name)" if arm_name or arm else

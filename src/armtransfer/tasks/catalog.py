@@ -5,6 +5,7 @@ from __future__ import annotations
 import numbers
 from dataclasses import dataclass, field
 
+from armtransfer.checks import integer_text
 from armtransfer.errors import InvalidTaskError
 from armtransfer.worlds.layout import ROOMS, Layout
 
@@ -51,13 +52,12 @@ def table_task(number: int | str) -> Task:
 
 def parse_xy(text: str, what: str) -> tuple[int, int]:
     """Parse 'X,Y' into integers, with a one-line error naming ``what``."""
-    parts = text.split(",")
-    try:
-        if len(parts) != 2:
-            raise ValueError
-        return int(parts[0]), int(parts[1])
-    except ValueError:
-        raise InvalidTaskError(f"{what} must be two integers 'X,Y', got {text!r}") from None
+    parts = text.split(",") if isinstance(text, str) else []
+    xy = [integer_text(p.strip()) for p in parts]
+    if len(xy) != 2 or xy[0] is None or xy[1] is None:
+        shown = text if not isinstance(text, str) or len(text) <= 80 else f"{text[:60]}... ({len(text)} characters)"
+        raise InvalidTaskError(f"{what} must be two integers 'X,Y', got {shown!r}")
+    return xy[0], xy[1]
 
 
 def as_xy(value: object, what: str) -> tuple[int, int]:
@@ -82,8 +82,9 @@ def world_task(layout: Layout, task: object = None) -> Task:
     else:
         name = str(task)
     if layout is ROOMS or layout == ROOMS:
-        if name.isdigit() and name.isascii() and len(name) < 40:
-            return table_task(int(name))  # the one-line error listing Table I's tasks when unknown
+        number = integer_text(name, signed=False)
+        if number is not None:
+            return table_task(number)  # the one-line error listing Table I's tasks when unknown
         raise InvalidTaskError(f"unknown task {name[:40]!r}; valid tasks: {', '.join(str(k) for k in TABLE_I)}")
     found = layout.task(name)
     if found is None:

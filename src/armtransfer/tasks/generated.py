@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from armtransfer.checks import integer_text
 from armtransfer.errors import ArmModelError, ArmTransferError
 from armtransfer.io import check_output_dir, staged_directory, write_json_atomic, write_text_atomic
 from armtransfer.ik.workspace import DEFAULT_CELL
@@ -174,28 +175,28 @@ def resolve_generated(spec: str, progress: bool = False, layout: Layout = ROOMS)
 def generated_file(spec: str, progress: bool = False) -> tuple[Path, dict, str]:
     """(the arm file, its sidecar, the action model named) of ``gen:FAMILY:DOF:SEED[:ACTIONS]``,
     generated into the cache directory at its first use."""
-    from armtransfer.ik.cache import cache_dir
+    from armtransfer.ik.cache import building, cache_dir
 
     parts = spec.split(":")
-    try:
-        family, dof, seed = parts[1], int(parts[2]), int(parts[3])
-        actions = parts[4] if len(parts) > 4 else "cartesian"
-        if len(parts) > 5:
-            raise ValueError
-    except (IndexError, ValueError):
-        raise ArmModelError(f"a generated arm is gen:FAMILY:DOF:SEED[:ACTIONS], got {spec!r}") from None
+    numbers = [integer_text(p, signed=False) for p in parts[2:4]]
+    if len(parts) not in (4, 5) or None in numbers:
+        shown = spec if len(spec) <= 80 else f"{spec[:60]}... ({len(spec)} characters)"
+        raise ArmModelError(f"a generated arm is gen:FAMILY:DOF:SEED[:ACTIONS], DOF and SEED integers, got {shown!r}")
+    family, dof, seed = parts[1], int(parts[2]), int(parts[3])
+    actions = parts[4] if len(parts) > 4 else "cartesian"
     name = arm_name(family, dof, seed)
     root = cache_dir() / "generated"
     xml = root / name / f"{name}.xml"
-    try:
-        generated = read_sidecar(xml) if xml.is_file() else None
-    except ArmModelError:
-        generated = None
-    if generated is None:  # never made, or its files were changed or lost: drawn again (the same arm)
-        if os.path.lexists(root / name):
-            shutil.rmtree(root / name) if (root / name).is_dir() and not (root / name).is_symlink() \
-                else (root / name).unlink()
-        generate_arm(family, dof, seed, root, progress=progress)
-        generated = read_sidecar(xml)
-        assert generated is not None  # generate_arm has just written it
+    with building(root / name):  # another process drawing the same arm is waited for, then its arm read
+        try:
+            generated = read_sidecar(xml) if xml.is_file() else None
+        except ArmModelError:
+            generated = None
+        if generated is None:  # never made, or its files were changed or lost: drawn again (the same arm)
+            if os.path.lexists(root / name):
+                shutil.rmtree(root / name) if (root / name).is_dir() and not (root / name).is_symlink() \
+                    else (root / name).unlink()
+            generate_arm(family, dof, seed, root, progress=progress)
+            generated = read_sidecar(xml)
+            assert generated is not None  # generate_arm has just written it
     return xml, generated, actions

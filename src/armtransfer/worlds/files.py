@@ -22,10 +22,8 @@ is one string or a list of row strings. Every task must be solvable (``worlds.ch
 
 from __future__ import annotations
 
-import json
 import numbers
 import os
-import tomllib
 from pathlib import Path
 
 from armtransfer.errors import InvalidWorldError
@@ -54,13 +52,17 @@ def load_layout(path: str | os.PathLike) -> Layout:
         raw = p.read_bytes()
     except (OSError, ValueError) as err:  # ValueError: a path with a NUL byte
         raise InvalidWorldError(f"{where}: cannot be read: {getattr(err, 'strerror', None) or err}") from None
+    from armtransfer.io import check_user_numbers, parse_json_bytes, parse_toml_bytes
+
+    data: object
     try:
-        text = raw.decode("utf-8")
-        data = tomllib.loads(text) if p.suffix.lower() == ".toml" else json.loads(text)
-    except UnicodeDecodeError:
-        raise InvalidWorldError(f"{where}: not UTF-8 text") from None
-    except (tomllib.TOMLDecodeError, json.JSONDecodeError, RecursionError) as err:
-        raise InvalidWorldError(f"{where}: not valid {p.suffix[1:].upper()}: {str(err).splitlines()[0]}") from None
+        if p.suffix.lower() == ".toml":
+            data = parse_toml_bytes(raw)
+        else:
+            data = parse_json_bytes(raw)
+            check_user_numbers(data)
+    except ValueError as err:
+        raise InvalidWorldError(f"{where} {err}") from None
     return parse_layout(data, p.stem, where)
 
 

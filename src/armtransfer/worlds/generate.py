@@ -13,11 +13,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from armtransfer.checks import integer_text
 from armtransfer.errors import InvalidWorldError
 from armtransfer.worlds.check import check_world
 from armtransfer.worlds.layout import Layout, NamedTask, WallSegment
 
 PREFIX = "generated"
+MAX_SEED = 10**18 - 1
+"""The largest seed of a generated world (18 digits)."""
 DEFAULT_SIDE = 11
 SIDES = tuple(range(11, 52, 4))
 """Sides a generated world may have: 11, 15, ..., 51 (side = 4k + 3, so its edges are odd
@@ -28,12 +31,16 @@ def parse_generated(spec: str) -> tuple[int, int]:
     """``generated:SEED[:SIDE]`` -> (seed, side), with a one-line error."""
     parts = spec.split(":")
     usage = f"a generated world is {PREFIX}:SEED or {PREFIX}:SEED:SIDE (SIDE one of {', '.join(map(str, SIDES))})"
-    if parts[0] != PREFIX or len(parts) not in (2, 3) or not all(p.isdigit() and len(p) <= 18 for p in parts[1:]):
-        raise InvalidWorldError(f"{usage}, got {spec!r}")
-    side = int(parts[2]) if len(parts) == 3 else DEFAULT_SIDE
+    numbers = [integer_text(p, signed=False) for p in parts[1:]]
+    if parts[0] != PREFIX or len(parts) not in (2, 3) or any(n is None or n > MAX_SEED for n in numbers):
+        shown = spec if len(spec) <= 80 else f"{spec[:60]}... ({len(spec)} characters)"
+        raise InvalidWorldError(f"{usage}, SEED an integer 0..{MAX_SEED}, got {shown!r}")
+    seed = numbers[0]
+    side = numbers[1] if len(numbers) == 2 else DEFAULT_SIDE
+    assert seed is not None and side is not None
     if side not in SIDES:
         raise InvalidWorldError(f"{usage}, got side {side}")
-    return int(parts[1]), side
+    return seed, side
 
 
 def generated_world(seed: int, side: int = DEFAULT_SIDE) -> Layout:

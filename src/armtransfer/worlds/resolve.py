@@ -36,7 +36,7 @@ def world(spec: str | os.PathLike | Layout | None = None) -> Layout:
     if isinstance(spec, Layout):
         return spec
     if isinstance(spec, os.PathLike):
-        return load_layout(spec)
+        return _user_file(spec)
     if not isinstance(spec, str):
         raise InvalidWorldError(f"a world is a name or a layout file; valid worlds: {VALID}; got {spec!r}")
     if spec == DEFAULT_WORLD:
@@ -46,7 +46,7 @@ def world(spec: str | os.PathLike | Layout | None = None) -> Layout:
     if spec.split(":")[0] == PREFIX:
         return _generated(*parse_generated(spec))
     if spec.lower().endswith((".toml", ".json")) or os.sep in spec or "/" in spec:
-        return load_layout(spec)
+        return _user_file(spec)
     raise InvalidWorldError(f"unknown world {spec[:100]!r}; valid worlds: {VALID}")
 
 
@@ -73,12 +73,28 @@ def layout_of_data(data: dict, where: str) -> Layout:
             named = None
         if named is not None and layout_data(named) == data:
             return named
+    refuse_reserved(name, where)
     return parse_layout(data, str(name), where)
 
 
 @lru_cache(maxsize=None)
 def _shipped(name: str) -> Layout:
     return load_layout(DATA / f"{name}.toml")
+
+
+def _user_file(spec: str | os.PathLike) -> Layout:
+    """A user's layout file; one that names itself as a built-in or generated world (its results
+    would be indistinguishable from that world's) is one line."""
+    layout = load_layout(spec)
+    refuse_reserved(layout.name, f"world file {str(spec)[:120]!r}")
+    return layout
+
+
+def refuse_reserved(name: object, where: str) -> None:
+    """A world named as a built-in world, or as a generated one, that is not it: one line."""
+    if isinstance(name, str) and (name.strip().lower() in WORLDS or name.split(":")[0].strip().lower() == PREFIX):
+        raise InvalidWorldError(f"{where}: name {name!r} is a built-in world's ({', '.join(WORLDS)}, "
+                                f"{PREFIX}:SEED[:SIDE]); results would claim that world: give it a name of its own")
 
 
 @lru_cache(maxsize=64)
