@@ -23,8 +23,7 @@ from __future__ import annotations
 
 import zlib
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
-from typing import cast
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -149,6 +148,8 @@ class Robots:
     """Robots by spec, each resolved (and, for an arm, compiled or loaded) once per run."""
 
     resolved: dict
+    worlds: dict = field(default_factory=dict)
+    """The worlds a suite carries (``Suite.layouts``), by id: a suite file's layout files."""
 
     def __call__(self, spec: str, world: str = suites.DEFAULT_WORLD) -> DiscreteRobot:
         key = benchmark_runs.robot_key(spec, world)
@@ -157,6 +158,8 @@ class Robots:
 
             if world == suites.DEFAULT_WORLD:
                 self.resolved[key] = resolve(spec)
+            elif world in self.worlds:
+                self.resolved[key] = resolve(spec, layout=self.worlds[world])
             else:
                 from armtransfer.worlds.resolve import world as layout_of
 
@@ -164,8 +167,21 @@ class Robots:
         return self.resolved[key]
 
 
+def unreachable_hint(case: suites.Case) -> str:
+    """What to try when a robot cannot reach a goal of a case's world: an arm's reach on it
+    (``arms list --world``) or a larger cell (``--cell-size``); nothing to add on the rooms."""
+    if case.world == suites.DEFAULT_WORLD:
+        return ""
+    return ("; `armtransfer arms list --world WORLD` shows which cells each arm reaches on a world, and an arm "
+            "with a larger --cell-size reaches farther (docs/worlds.md)")
+
+
 def case_cells(case: suites.Case, source: DiscreteRobot, target: DiscreteRobot, seed: int, section: str,
                index: int, source_seed: int) -> tuple[int, int]:
+    if case.start is not None and case.goal is not None:
+        from armtransfer.tasks.catalog import custom_task
+
+        return custom_task(case.start, case.goal, target.layout).cells(target.layout)
     if case.task is not None:
         if case.world == suites.DEFAULT_WORLD:
             if isinstance(case.task, bool) or not isinstance(case.task, int):
@@ -344,24 +360,48 @@ class Plan:
         return sum(benchmark_runs.needs_trajectory(m) for _, ms in self.entries(pair) for m in ms) \
             * pair.section.trials
 
-    def records(self, result: Lookup) -> list[dict]:
+    def records(self, result: Lookup, failed: dict[str, str] | None = None) -> list[dict]:
         """One record per (section, case, source seed, method), in the plan's order, from the
-        runs' results; :class:`IncompleteError` when a run's result is not there."""
-        out, missing = [], 0
+        runs' results; :class:`IncompleteError` when a run's result is not there and it did not
+        fail. ``failed``: the runs that failed, by key (their first error line): a record one of
+        whose runs failed is left out (the statistics pair records by source seed, so the others
+        stay paired) and named in :meth:`failures`."""
+        return self._records(result, failed or {})[0]
+
+    def failures(self, result: Lookup, failed: dict[str, str]) -> list[dict]:
+        """The records :meth:`records` leaves out because a run of theirs failed: per (section,
+        case, source seed, method; ``source`` for robot 1's run) the runs that failed and the
+        first error, in the plan's order."""
+        return self._records(result, failed)[1]
+
+    def _records(self, result: Lookup, failed: dict[str, str]) -> tuple[list[dict], list[dict]]:
+        out, lost, missing = [], [], 0
+
+        def lose(pair: Pair, name: str, keys: list[str]) -> None:
+            lost.append({"section": pair.section.name, "case": pair.index, "label": pair.case.label,
+                         "source_seed": pair.source_seed, "method": name, "failed_runs": len(keys),
+                         "error": failed[keys[0]]})
+
         for pair in self.pairs:
-            source = result(pair.source_run())
+            src = pair.source_run()
+            source = result(src)
             if source is None:
-                missing += 1 + self.trials_of(pair)
+                if src["key"] in failed:
+                    lose(pair, "source", [src["key"]])
+                else:
+                    missing += 1 + self.trials_of(pair)
                 continue
             trials = [(run, result(run)) for run in self.all_trial_runs(pair, source)]
-            missing += sum(r is None for _, r in trials)
+            missing += sum(r is None and run["key"] not in failed for run, r in trials)
             for name in self.labels(pair):
-                mine = [r for run, r in trials if label(run["method"], run["learner"]) == name]
-                if all(r is not None for r in mine):
-                    out.append(record(pair, name, source, cast(list, mine)))
+                mine = [(run, r) for run, r in trials if label(run["method"], run["learner"]) == name]
+                if all(r is not None for _, r in mine):
+                    out.append(record(pair, name, source, [r for _, r in mine if r is not None]))
+                elif keys := [run["key"] for run, r in mine if r is None and run["key"] in failed]:
+                    lose(pair, name, keys)
         if missing:
             raise IncompleteError(f"{missing} of {self.size()} runs are not in yet", missing)
-        return out
+        return out, lost
 
     def timings(self, result: Lookup, seconds: Callable[[dict], float | None]) -> dict:
         """Each pair's seconds: its source run's and, per method, its trial runs' summed;
@@ -393,6 +433,7 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
     if ran is None:
         ran, missing = methods_to_run()
     robots = robots if robots is not None else Robots({})
+    robots.worlds.update(suite.layouts())
     pairs = []
     for section in suite.sections:
         outside = [lr for lr in (section.learners if learners is None else learners) if lr != benchmark_runs.LEARNER]
@@ -410,8 +451,11 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
                 except ArmTransferError as err:
                     raise InvalidParameterError(f"{case.label}: {err}") from None
             for j in range(section.source_seeds):
-                start, goal = case_cells(case, source, target, seed, section.name, ci, j)
-                source.start_state(start)
+                try:
+                    start, goal = case_cells(case, source, target, seed, section.name, ci, j)
+                    source.start_state(start)
+                except ArmTransferError as err:  # the case named, before anything runs
+                    raise InvalidTaskError(f"{case.label}: {err}") from None
                 if arm is not None and start not in placed:
                     try:
                         arm.place(start)
@@ -420,7 +464,7 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
                     placed.add(start)
                 path = target.shortest_path(target.start_state(start), goal)
                 if path is None:
-                    raise InvalidTaskError(f"{case.label}: {target.name} cannot reach the goal")
+                    raise InvalidTaskError(f"{case.label}: {target.name} cannot reach the goal{unreachable_hint(case)}")
                 pairs.append(Pair(section, ci, case, j, run_seed(seed, section.name, ci, j), target.layout.xy(start),
                                   target.layout.xy(goal), len(path) - 1, learner))
     return Plan(suite, int(seed), tuple(ran), tuple(missing), tuple(pairs), preset,
@@ -440,9 +484,9 @@ def run_suite(suite: suites.Suite, seed: int = 0, tick: Callable[[], None] | Non
     seconds: dict[str, float] = {}
     for pair in p.pairs:
         src = pair.source_run()
-        results[src["key"]], seconds[src["key"]] = benchmark_runs.execute(src, robots.resolved)
+        results[src["key"]], seconds[src["key"]] = benchmark_runs.execute_here(src, robots.resolved)
         runs = p.all_trial_runs(pair, results[src["key"]])
-        done = experiment.map_trials(lambda i: benchmark_runs.execute(runs[i], robots.resolved), len(runs), threads,
+        done = experiment.map_trials(lambda i: benchmark_runs.execute_here(runs[i], robots.resolved), len(runs), threads,
                                      on_trial=tick)
         for run, (result, secs) in zip(runs, done):
             results[run["key"]], seconds[run["key"]] = result, secs

@@ -28,6 +28,7 @@ the bytes of running them together.
 from __future__ import annotations
 
 import time
+import traceback
 from collections.abc import Callable
 
 from armtransfer.errors import ArmTransferError, PluginError
@@ -205,8 +206,32 @@ refuses the case: recorded as the run's ``error``). A learner not here, of
 ``armtransfer.learning.learners.LEARNERS`` (a plugin's), runs through ``learner_trial``."""
 
 
+class RunFailed(ArmTransferError):
+    """A run that raised: the first line of the message says what, the rest is the traceback
+    (the store keeps it beside the failure, ``ResultStore.write_failure``)."""
+
+
+def with_traceback(err: BaseException) -> str:
+    """``err`` in one line, then its traceback: that of the exception it was raised from or
+    while handling first (a plugin's own fault, which the one-line error names), then its own."""
+    first = (str(err) if isinstance(err, ArmTransferError) else f"{type(err).__name__}: {err}").splitlines()
+    inner = err.__cause__ or err.__context__
+    parts = [] if inner is None else traceback.format_exception(inner)
+    parts += traceback.format_exception(err, chain=False)
+    return (first[0] if first else type(err).__name__) + "\n" + "".join(parts)
+
+
 def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
-    """(result, seconds) of one benchmark run; what a worker runs (``robots``: by spec)."""
+    """(result, seconds) of one benchmark run; what a worker runs (``robots``: by spec). A run
+    that raises is :class:`RunFailed`, its message carrying the traceback."""
+    try:
+        return execute_here(run, robots)
+    except Exception as err:  # noqa: BLE001 - a failed run, its traceback kept for the store
+        raise RunFailed(with_traceback(err)) from None
+
+
+def execute_here(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
+    """:func:`execute` in this process: what a run raises propagates as it is."""
     t0 = time.perf_counter()
     if run["format"] == SOURCE_FORMAT:
         source = robots[robot_key(run["source"], run.get("world"))]

@@ -12,7 +12,7 @@ a report's numbers always name the suite they came from.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 from armtransfer.errors import InvalidParameterError
 
@@ -63,6 +63,9 @@ class Case:
     (``tasks.continuous.continuous_arm(target)``); robot 1 stays table-based either way."""
     noise: float = 0.0
     """A continuous target's actuation noise sigma (``ik.continuous``); 0 for a discrete one."""
+    start: tuple[int, int] | None = None
+    """The task's start cell (x, y), given with :attr:`goal` instead of a ``task``."""
+    goal: tuple[int, int] | None = None
 
     def __post_init__(self) -> None:
         if self.state not in STATES:
@@ -71,17 +74,22 @@ class Case:
             raise InvalidParameterError("noise (actuation noise) applies to a continuous target; valid noise: 0")
         if self.state == "continuous" and self.wind:
             raise InvalidParameterError("a continuous target has no wind; valid wind: 0")
+        if (self.start is None) != (self.goal is None) or (self.start is not None and self.task is not None):
+            raise InvalidParameterError("a case gives a task, or a start and a goal, or neither")
 
     @property
     def label(self) -> str:
-        task = "random task" if self.task is None else f"task {self.task}"
+        if self.start is not None and self.goal is not None:
+            task = f"({self.start[0]},{self.start[1]}) -> ({self.goal[0]},{self.goal[1]})"
+        else:
+            task = "random task" if self.task is None else f"task {self.task}"
         if self.task is None and self.distance is not None:
             lo, hi = self.distance
             task += f" of {lo}+ steps" if hi is None else f" of {lo}-{hi - 1} steps"
         if self.task is None and self.cells != "any":
             task += f" on {self.cells} cells"
         wind = f", wind {self.wind:g}" if self.wind else ""
-        world = f", in {self.world}" if self.world != DEFAULT_WORLD else ""
+        world = f", in {self.world.partition('#')[0]}" if self.world != DEFAULT_WORLD else ""
         target = self.target
         if self.state == "continuous":
             target += " continuous" + (f" (noise {self.noise:g})" if self.noise else "")
@@ -118,6 +126,8 @@ class Section:
                 del case["world"]
             if case["state"] == "discrete":  # a discrete case keeps the bytes it had before states
                 del case["state"], case["noise"]
+            if case["start"] is None:  # a case of a task or drawn one keeps the bytes it had before cells
+                del case["start"], case["goal"]
         if self.learners == DEFAULT_LEARNERS:
             del out["learners"]
         else:
@@ -136,111 +146,46 @@ class Suite:
     held_out: bool
     description: str
     sections: tuple[Section, ...]
+    methods: tuple[str, ...] | None = None
+    """The methods a suite file names (each section runs them); None: :data:`METHODS`."""
+    worlds: dict[str, dict] = field(default_factory=dict)
+    """The layout files' worlds the cases name, by id (``suite_files.world_id``): their content
+    (``worlds.files.layout_data``), so a stored suite needs no file to be made again."""
 
     def to_dict(self) -> dict:
-        return {"name": self.name, "version": self.version, "held_out": self.held_out,
-                "description": self.description, "methods": list(METHODS), "budget_factor": BUDGET_FACTOR,
-                "sections": [s.to_dict() for s in self.sections]}
+        out = {"name": self.name, "version": self.version, "held_out": self.held_out,
+               "description": self.description, "methods": list(METHODS if self.methods is None else self.methods),
+               "budget_factor": BUDGET_FACTOR, "sections": [s.to_dict() for s in self.sections]}
+        if self.worlds:  # a suite on built-in worlds keeps the bytes it had before suite files
+            out["worlds"] = {k: self.worlds[k] for k in sorted(self.worlds)}
+        return out
+
+    def layouts(self) -> dict:
+        """The worlds of :attr:`worlds`, by id (``worlds.layout.Layout``)."""
+        from armtransfer.worlds.resolve import layout_of_data
+
+        return {k: layout_of_data(v, f"suite {self.name!r}: world {k!r}") for k, v in self.worlds.items()}
+
+    @property
+    def builtin(self) -> bool:
+        """One of the suites shipped with the package, as it ships."""
+        return self.name in SUITES and SUITES[self.name].to_dict() == self.to_dict()
 
 
-def _both_ways(pairs: list[tuple[str, str]], tasks: tuple[int | None, ...], wind: float = 0.0) -> tuple[Case, ...]:
-    return tuple(Case(a, b, t, wind) for s, d in pairs for a, b in ((s, d), (d, s)) for t in tasks)
+def _load() -> dict[str, "Suite"]:
+    from armtransfer.experiments.suite_files import builtin
+
+    return builtin()
 
 
-TRIALS = 3
-"""Trials of every method per source seed in the held-out sections: enough to estimate how
-much of the spread lies between source seeds (reported) beside the spread within them."""
+SUITES: dict[str, Suite] = _load()
+"""Every built-in suite by name: the suite files of ``armtransfer/experiments/suite_data/``."""
 
-ARM_TRIALS = 2
-"""Trials per source seed on the arms (``embodiment``): a method's trials run two at a time on two
-cores, so a third trial doubles the wall time of the section that takes 80% of ``standard``'s
-(measured, docs/benchmark.md); two per seed still give the one-way ANOVA its within-seed spread."""
-
-BANDS = ((10, 20), (20, 30), (30, 45), (45, 65), (65, None))
-"""The drawn tasks' distance bands of ``random``; the shortest, below 20 steps, is a length no
-choice of a parameter saw (``research/select_defaults.py`` drew 20 steps and more)."""
-
-PAPER = Section(
-    "paper", "the paper's Table I tasks 1-4, coarse -> fine and fine -> coarse",
-    _both_ways([("coarse", "fine")], (1, 2, 3, 4)), source_seeds=10, trials=TRIALS, max_total_steps=2_000_000)
-RANDOM = Section(
-    "random", "start and goal drawn per source seed on cells no parameter was chosen on (at least one odd "
-    "coordinate), in five distance bands from 10-19 to 65+ steps, coarse <-> fine",
-    tuple(Case(a, b, None, distance=band, cells="odd") for a, b in (("coarse", "fine"), ("fine", "coarse"))
-          for band in BANDS),
-    source_seeds=10, trials=TRIALS, max_total_steps=2_000_000)
-EMBODIMENT = Section(
-    "embodiment", "arms that move their joints (2-4 joints) and a generated planar arm, both directions, "
-    "Table I tasks 1-4",
-    _both_ways([("planar2:joint", "planar3:joint"), ("planar3:joint", "planar4:joint"),
-                ("gen:planar:3:1:joint", "planar2:joint")], (1, 2, 3, 4)),
-    source_seeds=10, trials=ARM_TRIALS, max_total_steps=1_000_000)
-WIND_LEVELS = (0.01, 0.05, 0.1)
-WIND = Section(
-    "wind", "Table I tasks 1-4, coarse -> fine, with wind 0.01, 0.05 and 0.1 (a move is blown one cell aside)",
-    tuple(Case("coarse", "fine", t, w) for w in WIND_LEVELS for t in (1, 2, 3, 4)), source_seeds=10,
-    trials=TRIALS, max_total_steps=2_000_000)
-DEV = Section(
-    "dev", "the development cases parameters may be chosen on: tasks drawn on even cells (coarse -> fine), "
-    "as every earlier choice was, and the robot pairs earlier parameters were chosen on (ur5e_like:cartesian -> "
-    "planar2:joint task 3, planar3:joint -> planar4:cartesian task 4)",
-    (Case("coarse", "fine", None, cells="even"), Case("ur5e_like:cartesian", "planar2:joint", 3),
-     Case("planar3:joint", "planar4:cartesian", 4)),
-    source_seeds=10, trials=2, max_total_steps=2_000_000)
-FAST = Section(
-    "fast", "coarse -> fine task 1, two source seeds: checks the whole protocol in seconds",
-    (Case("coarse", "fine", 1),), source_seeds=2, trials=2, max_total_steps=300_000)
-SMALL_LEARNERS = ("sarsa", "dqn", "ppo")
-"""The learners of ``small``: the built-in SARSA(lambda) and stable-baselines3's DQN and PPO (the
-``sb3`` extra; ``armtransfer.learning.sb3``), which run ``none`` and the reward-term methods."""
-
-SMALL = Section(
-    "small", "the small rooms worlds rooms11 and rooms15, task 2 (north-east room to south-west), coarse -> fine, "
-    "learned by SARSA(lambda) and by stable-baselines3's DQN and PPO; rooms11 task 3 was the dev case the SB3 "
-    "settings and this step cap were chosen on (source seeds 100 and 101 of research/sb3_small.py)",
-    (Case("coarse", "fine", 2, world="rooms11"), Case("coarse", "fine", 2, world="rooms15")),
-    source_seeds=10, trials=2, max_total_steps=25_000, learners=SMALL_LEARNERS)
-
-VOXELS = Section(
-    "voxels", "arms moving their joints with the tool off the table, over the 3D workspace of rooms11 (3 levels, "
-    "walls 1 level high), task 2: planar2:joint -> ur5e_like:joint (a 2D path, paid at level 0) and "
-    "ur5e_like:joint -> panda_like:joint (a path of voxels); none and pseudo",
-    (Case("planar2:joint", "ur5e_like:joint", 2, world="rooms11"),
-     Case("ur5e_like:joint", "panda_like:joint", 2, world="rooms11")),
-    source_seeds=10, trials=ARM_TRIALS, max_total_steps=1_000_000, methods=("none", "pseudo"))
-
-CONTINUOUS_CAP = 300_000
-"""The step cap of a continuous target's trial (``voxels-continuous``): every move runs MuJoCo
-(and, with actuation noise, the Python loop), so a trial costs far more per step than a
-table-based one."""
-
-VOXELS_CONTINUOUS = Section(
-    "voxels-continuous", "the voxels cases with a continuous target: the joint robot's arm in its joint "
-    "configuration with MuJoCo at every move, actuation noise 0.1, learned by linear SARSA(lambda) over hashed "
-    "tiles; robot 1 is table-based: planar2:joint -> ur5e_like (6 joints), ur5e_like:joint -> panda_like "
-    "(7 joints), rooms11 task 2; none and pseudo",
-    (Case("planar2:joint", "ur5e_like:joint", 2, world="rooms11", state="continuous", noise=0.1),
-     Case("ur5e_like:joint", "panda_like:joint", 2, world="rooms11", state="continuous", noise=0.1)),
-    source_seeds=10, trials=ARM_TRIALS, max_total_steps=CONTINUOUS_CAP, methods=("none", "pseudo"))
-
-SUITES: dict[str, Suite] = {
-    s.name: s
-    for s in (
-        Suite("paper", 3, True, PAPER.description, (PAPER,)),
-        Suite("random", 3, True, RANDOM.description, (RANDOM,)),
-        Suite("embodiment", 3, True, EMBODIMENT.description, (EMBODIMENT,)),
-        Suite("wind", 3, True, WIND.description, (WIND,)),
-        Suite("standard", 3, True, "the held-out union: paper, random, embodiment and wind",
-              (PAPER, RANDOM, EMBODIMENT, WIND)),
-        Suite("dev", 3, False, DEV.description, (DEV,)),
-        Suite("fast", 2, False, FAST.description, (FAST,)),
-        Suite("small", 1, True, SMALL.description, (SMALL,)),
-        Suite("voxels", 2, True, "arms moving their joints over the 3D workspace of rooms11, table-based and "
-              "continuous targets: " + VOXELS.description + "; " + VOXELS_CONTINUOUS.description,
-              (VOXELS, VOXELS_CONTINUOUS)),
-    )
-}
-"""Every suite by name."""
+DEV = SUITES["dev"].sections[0]
+FAST = SUITES["fast"].sections[0]
+SMALL = SUITES["small"].sections[0]
+VOXELS, VOXELS_CONTINUOUS = SUITES["voxels"].sections
+SMALL_LEARNERS = SMALL.learners
 
 
 def get(name: str) -> Suite:
@@ -248,4 +193,12 @@ def get(name: str) -> Suite:
     try:
         return SUITES[name]
     except (KeyError, TypeError):
-        raise InvalidParameterError(f"unknown suite {name!r}; valid suites: {', '.join(SUITES)}") from None
+        raise InvalidParameterError(f"unknown suite {name!r}; valid suites: {', '.join(SUITES)}, or a suite file "
+                                    "PATH.toml or PATH.json (docs/benchmark.md)") from None
+
+
+def named(text: str) -> Suite:
+    """The suite ``--suite TEXT`` names: a built-in one, or a suite file (``.toml``, ``.json``)."""
+    from armtransfer.experiments import suite_files
+
+    return suite_files.load(text) if suite_files.is_file_name(text) else get(text)

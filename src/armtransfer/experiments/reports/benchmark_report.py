@@ -184,15 +184,21 @@ def write_figures(summary: dict, suite: suites.Suite, out: Path) -> None:
                            f"{section.name}: learning curves", out / curves_name(section.name))
 
 
-def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str], missing: list[str]) -> str:
+def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str], missing: list[str],
+                    failures: list[dict] | None = None) -> str:
     from armtransfer.experiments.benchmark import baselines_of, registered_baseline
 
     from armtransfer.experiments.benchmark import parse_label
 
     kind = ("held out: no parameter of any method was chosen on it" if suite.held_out
             else "not held out: parameters may be chosen on it")
+    made = (f"Made by `armtransfer benchmark --suite {suite.name} --seed {seed}`." if suite.builtin else
+            f"Made by `armtransfer benchmark --suite FILE --seed {seed}` from the suite file of `{suite.name}` (its "
+            "whole definition is in results.json), on the worlds "
+            + ", ".join(f"`{w}`" for w in dict.fromkeys(c.world.partition("#")[0] for sec in suite.sections
+                                                         for c in sec.cases)) + ".")
     out = [f"# Benchmark `{suite.name}` (version {suite.version})", "",
-           f"Made by `armtransfer benchmark --suite {suite.name} --seed {seed}`. {suite.description}; {kind}.", "",
+           f"{made} {suite.description}; {kind}.", "",
            "## Methods and their baselines", "",
            "Every method's gain is measured against the baseline that shares its learner and differs only "
            "in what is transferred; each baseline is run beside it on the same random streams.", ""]
@@ -212,6 +218,14 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
                 "shortest path, its steps those at the first of them; otherwise censored at the cap."]
     if missing:
         out += ["", f"Not in this build's method registry, so not run: {', '.join(missing)}."]
+    if failures:
+        out += ["", "## Runs that failed", "",
+                f"{sum(f['failed_runs'] for f in failures)} runs failed, so {len(failures)} records are left out of "
+                "everything below (each method is paired with its baseline over the source seeds both have); the "
+                "store's `failed/` keeps each run's traceback, and running the same command again retries them.", ""]
+        out.append(markdown_table(["section", "case", "source seed", "method", "runs failed", "first error"],
+                                  [[f["section"], f["label"], str(f["source_seed"]), f["method"],
+                                    str(f["failed_runs"]), f["error"].replace("|", "\\|")] for f in failures]))
     out += ["", "## Claims", ""]
     for section in suite.sections:
         for name, against in summary[section.name]["pooled"].items():
