@@ -240,10 +240,15 @@ class Pair:
                    learner: str = benchmark_runs.LEARNER) -> list[dict]:
         """Every trial run of the methods ``names`` by ``learner``, in (method, trial) order;
         without the source run's result, only those of the methods that read no trajectory."""
+        options = None
+        if learner != benchmark_runs.LEARNER:
+            from armtransfer.learning.learners import options_of
+
+            options = options_of(learner)
         return [benchmark_runs.trial_run(name, k, self.case.source, self.case.target, list(self.start),
                                          list(self.goal), self.case.wind, self.seed, self.config, source_result,
                                          learner=learner, world=self.case.world, state=self.case.state,
-                                         noise=self.case.noise)
+                                         noise=self.case.noise, learner_options=options)
                 for name in names if source_result is not None or not benchmark_runs.needs_trajectory(name)
                 for k in range(self.section.trials)]
 

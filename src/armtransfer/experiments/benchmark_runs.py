@@ -91,16 +91,21 @@ target's compiled table (every run written before continuous targets, with its k
 
 def trial_run(method: str, trial: int, source: str, target: str, start: list[int], goal: list[int], wind: float,
               seed: int, config: LearnerConfig, source_result: dict | None, learner: str = LEARNER,
-              world: str = DEFAULT_WORLD, state: str = "discrete", noise: float = 0.0) -> dict:
+              world: str = DEFAULT_WORLD, state: str = "discrete", noise: float = 0.0,
+              learner_options: dict | None = None) -> dict:
     """Trial ``trial`` of ``method`` on robot 2 (``target``). A method that reads the trajectory
     is handed ``source_result``'s (the result of the case's source run: its path, or why there
     is none); the others carry neither. Where robot 1 handed nothing over, the run also names
     ``told_nothing``: the method's baseline, which the trial then runs (:func:`trial_result`).
     ``state`` ``continuous``: robot 2 is ``target``'s continuous arm with actuation noise
-    ``noise`` (the run names both; a discrete run names neither, keeping its key)."""
+    ``noise`` (the run names both; a discrete run names neither, keeping its key).
+    ``learner_options``: an outside learner's own settings (``Learner.options``), in the run's
+    configuration and so its key (none: the key it had before learners had options)."""
     run = {"format": TRIAL_FORMAT, "learner": learner, "method": method, "trial": int(trial), "source": source,
            "target": target, "start": list(start), "goal": list(goal), "wind": wind, "seed": int(seed),
            "config": config.to_dict()}
+    if learner_options:
+        run["learner_options"] = dict(learner_options)
     _in_world(run, world)
     if state == CONTINUOUS:
         run["state"], run["noise"] = CONTINUOUS, float(noise)

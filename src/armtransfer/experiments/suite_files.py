@@ -197,7 +197,7 @@ def _case(table: object, where: str, world: str, worlds: _Worlds, check: bool) -
     if "distance" in t:
         d = t["distance"]
         if not isinstance(d, list) or len(d) not in (1, 2) or not all(
-                v is None or (isinstance(v, numbers.Integral) and not isinstance(v, bool) and v >= 1) for v in d) \
+                v is None or (isinstance(v, numbers.Integral) and not isinstance(v, bool) and int(v) >= 1) for v in d) \
                 or d[0] is None or (len(d) == 2 and d[1] is not None and int(d[1]) <= int(d[0])):
             raise _fail(where, f"distance must be [low] or [low, high] with 1 <= low < high, got {d!r}")
         distance = (int(d[0]), None if len(d) == 1 or d[1] is None else int(d[1]))
