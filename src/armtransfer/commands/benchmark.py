@@ -233,12 +233,16 @@ def write_report(store: ResultStore, plan: benchmark.Plan) -> dict:
     write_report_files(store.root, plan.suite, plan.seed, plan.labels(), list(plan.missing), summary,
                        results_bytes(plan.suite, plan.seed, plan.labels(), list(plan.missing), records, summary,
                                      failures),
-                       timings=plan.timings(result, seconds), failures=failures)
+                       timings=plan.timings(result, seconds), failures=failures,
+                       warnings=benchmark_report.record_warnings(records))
+    for line in benchmark_report.record_warnings(records):
+        print(f"warning: {line}")
     return summary
 
 
 def write_report_files(out: Path, suite: suites.Suite, seed: int, ran: list[str], missing: list[str], summary: dict,
-                       results: bytes, timings: dict | None = None, failures: list[dict] | None = None) -> None:
+                       results: bytes, timings: dict | None = None, failures: list[dict] | None = None,
+                       warnings: list[str] | None = None) -> None:
     """A benchmark's report files in ``out``: results.json (``results``, its bytes), timings.json
     when given, the figures, and report.md last, so that it is there only when the rest is."""
     write_bytes_atomic(out / "results.json", results)
@@ -246,7 +250,7 @@ def write_report_files(out: Path, suite: suites.Suite, seed: int, ran: list[str]
         write_json_atomic(out / "timings.json", timings)
     benchmark_report.write_figures(summary, suite, out)
     write_text_atomic(out / "report.md", benchmark_report.report_markdown(suite, seed, summary, ran, missing,
-                                                                         failures or []))
+                                                                         failures or [], warnings or []))
 
 
 def plan_of(store: ResultStore) -> benchmark.Plan:

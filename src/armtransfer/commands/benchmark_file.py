@@ -16,6 +16,7 @@ from pathlib import Path
 from armtransfer.errors import InvalidParameterError
 from armtransfer.io import parse_json_bytes, read_input, staged_directory
 from armtransfer.experiments import suite_files, suites
+from armtransfer.experiments.reports import benchmark_report
 from armtransfer.experiments.stats import benchmark_stats
 
 MAX_UNPACKED_BYTES = 1 << 30
@@ -83,7 +84,7 @@ def report_from_file(path: Path, out: str | None) -> int:
                                     f"{len(data['records'])} records differ from the file's (another build wrote it)")
     with staged_directory(out) as tmp:
         write_report_files(tmp, suite, data["seed"], data["methods"], data["not_in_registry"], summary, again,
-                           failures=failures)
+                           failures=failures, warnings=benchmark_report.record_warnings(data["records"]))
     print(f"recomputed the statistics of {len(data['records'])} records: the same bytes as {str(path)!r}; "
           f"wrote {str(Path(out) / 'report.md')!r}")
     return 0

@@ -289,6 +289,9 @@ def record(pair: Pair, name: str, source_result: dict, trials: list[dict]) -> di
         rec.update(first_exposure=[None] * n, converged=[False] * n, convergence_steps=[None] * n,
                    greedy_steps=[None] * n, episodes=[0] * n, area=[None] * n, curves=[])
         return rec
+    said = list(dict.fromkeys(w for t in trials for w in t.get("warnings") or ()))
+    if said:  # a potential of one's own that was squashed, constant or not 0 at the goal
+        rec["warnings"] = said
     rec.update({key: [t[field] for t in trials] for key, field in (
         ("first_exposure", "first_exposure"), ("converged", "converged"), ("convergence_steps", "convergence_steps"),
         ("greedy_steps", "greedy_steps"), ("episodes", "episodes"), ("area", "area"), ("curves", "curve"))})

@@ -173,7 +173,7 @@ def _fields(res: experiment.MethodResult) -> dict:
     return {"error": None, "first_exposure": t.exploration_steps, "converged": bool(t.converged),
             "convergence_steps": t.total_steps if t.converged else None, "greedy_steps": t.greedy_steps,
             "episodes": int(t.episodes), "area": float(curve.sum()), "curve": [float(v) for v in curve],
-            "K": res.extra.get("K")}
+            "K": res.extra.get("K"), **({"warnings": res.extra["warnings"]} if res.extra.get("warnings") else {})}
 
 
 def _continuous_trial(run: dict, target: DiscreteRobot) -> dict:

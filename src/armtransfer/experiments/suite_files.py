@@ -147,6 +147,7 @@ class _Worlds:
         self.check = check
         self.seen: dict[str, str] = {}
         self.content: dict[str, dict] = dict(known or {})
+        self.layouts: dict[str, Any] = {}
 
     def __call__(self, value: object, where: str) -> str:
         if isinstance(value, str) and (value in self.seen or value in self.content or (
@@ -172,7 +173,24 @@ class _Worlds:
             out = world_id(layout.name or Path(value).stem, data)
             self.content[out] = data
         self.seen[value] = out
+        self.layouts[out] = layout
         return out
+
+    def task(self, world: str, case: suites.Case, where: str) -> None:
+        """``case``'s task or cells checked on its world (when this file's worlds were loaded)."""
+        from armtransfer.errors import ArmTransferError
+        from armtransfer.tasks.catalog import custom_task, world_task
+
+        layout = self.layouts.get(world)
+        if layout is None:
+            return
+        try:
+            if case.start is not None and case.goal is not None:
+                custom_task(case.start, case.goal, layout)
+            elif case.task is not None:
+                world_task(layout, case.task)
+        except ArmTransferError as err:
+            raise _fail(where, str(err)) from None
 
 
 def _case(table: object, where: str, world: str, worlds: _Worlds, check: bool) -> suites.Case:
@@ -208,11 +226,14 @@ def _case(table: object, where: str, world: str, worlds: _Worlds, check: bool) -
         raise _fail(where, "distance and cells apply to a drawn task (a case with no task, start or goal)")
     state = t.get("state", "discrete")
     try:
-        return suites.Case(source, target, task, _number(t.get("wind", 0.0), where, "wind"), distance, cells,
+        case = suites.Case(source, target, task, _number(t.get("wind", 0.0), where, "wind"), distance, cells,
                            worlds(t.get("world", world), where), state, _noise(t.get("noise", 0.0), where),
                            start, goal)
     except InvalidParameterError as err:
         raise _fail(where, str(err)) from None
+    if check:
+        worlds.task(case.world, case, where)
+    return case
 
 
 def _noise(value: object, where: str) -> float:

@@ -184,8 +184,14 @@ def write_figures(summary: dict, suite: suites.Suite, out: Path) -> None:
                            f"{section.name}: learning curves", out / curves_name(section.name))
 
 
+def record_warnings(records: list[dict]) -> list[str]:
+    """Every distinct warning of the records (a potential of one's own squashed, constant or not
+    0 at the goal: ``potentials.notes``), in order."""
+    return list(dict.fromkeys(w for r in records for w in r.get("warnings") or ()))
+
+
 def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str], missing: list[str],
-                    failures: list[dict] | None = None) -> str:
+                    failures: list[dict] | None = None, warnings: list[str] | None = None) -> str:
     from armtransfer.experiments.benchmark import baselines_of, registered_baseline
 
     from armtransfer.experiments.benchmark import parse_label
@@ -218,6 +224,8 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
                 "shortest path, its steps those at the first of them; otherwise censored at the cap."]
     if missing:
         out += ["", f"Not in this build's method registry, so not run: {', '.join(missing)}."]
+    if warnings:
+        out += ["", "## Warnings", "", *(f"- {w}" for w in warnings)]
     if failures:
         out += ["", "## Runs that failed", "",
                 f"{sum(f['failed_runs'] for f in failures)} runs failed, so {len(failures)} records are left out of "
