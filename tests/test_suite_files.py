@@ -35,7 +35,7 @@ def test_the_built_in_suites_are_files_with_the_bytes_they_had():
     for name, suite in suites.SUITES.items():
         assert (suite_files.DATA / f"{name}.toml").is_file()
         again = suite_files.from_dict(json.loads(json.dumps(suite.to_dict())), name)
-        assert again.to_dict() == suite.to_dict() and again.builtin
+        assert again.to_dict() == suite.to_dict() and suites.is_builtin(again)
 
 
 def write_suite(tmp_path: Path, body: str) -> Path:
@@ -128,7 +128,7 @@ def test_a_failed_run_keeps_its_traceback_and_the_report_lists_it(tmp_path):
         for run in plan.all_trial_runs(pair, result):
             if pair.source_seed == 1 and run["method"] == "pseudo":
                 with pytest.raises(benchmark_runs.RunFailed) as caught:
-                    benchmark_runs.execute(run, {})  # no robots: a KeyError in the worker
+                    benchmark_runs.execute_recorded(run, {})  # no robots: a KeyError in the worker
                 broken = run
                 store.write_failure(run, str(caught.value), 1)
             else:
@@ -136,7 +136,7 @@ def test_a_failed_run_keeps_its_traceback_and_the_report_lists_it(tmp_path):
     store.unlock()
     failed = json.loads((store.failed_dir / f"{broken['key']}.json").read_text())
     assert failed["error"].startswith("KeyError") and "Traceback" in failed["traceback"]
-    assert "execute_here" in failed["traceback"]
+    assert "in execute" in failed["traceback"]
     from armtransfer.commands.benchmark import write_report
 
     write_report(store, plan)

@@ -24,7 +24,7 @@ from armtransfer.commands import common
 from armtransfer.errors import InvalidParameterError
 from armtransfer.commands.sweep import add_executor_arguments, check_executor_options
 from armtransfer.experiments import benchmark, suites
-from armtransfer.experiments.benchmark_runs import execute
+from armtransfer.experiments.benchmark_runs import execute_recorded as execute
 from armtransfer.experiments.reports import benchmark_report
 from armtransfer.experiments.stats import benchmark_stats
 from armtransfer.experiments.store import ResultStore, StoreError
@@ -265,7 +265,7 @@ def plan_of(store: ResultStore) -> benchmark.Plan:
         raise StoreError(f"{str(store.root)!r} holds a benchmark of a suite this build does not have") from None
     plan = benchmark.plan(suite, spec["seed"], ran=spec["methods"], missing=spec["not_in_registry"],
                           preset=spec.get("preset", "default"), learners=spec.get("learners"))
-    if content_key(plan.spec()) != store.meta.get("key") or (suite.name in suites.SUITES and not suite.builtin):
+    if content_key(plan.spec()) != store.meta.get("key") or (suite.name in suites.SUITES and not suites.is_builtin(suite)):
         raise StoreError(f"{str(store.root)!r} holds a benchmark of suite {suite.name!r} as another build defined "
                          "it (its version, methods or learner settings differ); rebuild it with that build")
     return plan
@@ -277,7 +277,7 @@ def summarize(store: ResultStore) -> int:
     try:
         write_report(store, plan)
     except benchmark.IncompleteError as err:
-        named = plan.suite.name if plan.suite.builtin else "FILE (its suite file)"
+        named = plan.suite.name if suites.is_builtin(plan.suite) else "FILE (its suite file)"
         raise StoreError(f"{str(store.root)!r}: {err}; finish it with armtransfer benchmark --suite "
                          f"{named} --seed {plan.seed} --out {str(store.root)}") from None
     print(f"wrote {store.root / 'report.md'}")

@@ -67,7 +67,7 @@ def report_from_file(path: Path, out: str | None) -> int:
     except InvalidParameterError:
         suite = None
     if suite is None or json.loads(json.dumps(suite.to_dict())) != data["suite"] or (
-            builtin is not None and not suite.builtin):
+            builtin is not None and not suites.is_builtin(suite)):
         have = f"version {builtin.version}" if builtin is not None else "no such suite"
         raise InvalidParameterError(f"{str(path)!r} holds suite {name!r} version {version}; this build has {have}, "
                                     "so it cannot recompute it (use the build that wrote it)")

@@ -167,15 +167,6 @@ class Robots:
         return self.resolved[key]
 
 
-def unreachable_hint(case: suites.Case) -> str:
-    """What to try when a robot cannot reach a goal of a case's world: an arm's reach on it
-    (``arms list --world``) or a larger cell (``--cell-size``); nothing to add on the rooms."""
-    if case.world == suites.DEFAULT_WORLD:
-        return ""
-    return ("; `armtransfer arms list --world WORLD` shows which cells each arm reaches on a world, and an arm "
-            "with a larger --cell-size reaches farther (docs/worlds.md)")
-
-
 def case_cells(case: suites.Case, source: DiscreteRobot, target: DiscreteRobot, seed: int, section: str,
                index: int, source_seed: int) -> tuple[int, int]:
     if case.start is not None and case.goal is not None:
@@ -472,7 +463,9 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
                     placed.add(start)
                 path = target.shortest_path(target.start_state(start), goal)
                 if path is None:
-                    raise InvalidTaskError(f"{case.label}: {target.name} cannot reach the goal{unreachable_hint(case)}")
+                    from armtransfer.tasks.unreachable import hint
+
+                    raise InvalidTaskError(f"{case.label}: {target.name} cannot reach the goal{hint(target)}")
                 pairs.append(Pair(section, ci, case, j, run_seed(seed, section.name, ci, j), target.layout.xy(start),
                                   target.layout.xy(goal), len(path) - 1, learner))
     return Plan(suite, int(seed), tuple(ran), tuple(missing), tuple(pairs), preset,
@@ -492,9 +485,9 @@ def run_suite(suite: suites.Suite, seed: int = 0, tick: Callable[[], None] | Non
     seconds: dict[str, float] = {}
     for pair in p.pairs:
         src = pair.source_run()
-        results[src["key"]], seconds[src["key"]] = benchmark_runs.execute_here(src, robots.resolved)
+        results[src["key"]], seconds[src["key"]] = benchmark_runs.execute(src, robots.resolved)
         runs = p.all_trial_runs(pair, results[src["key"]])
-        done = experiment.map_trials(lambda i: benchmark_runs.execute_here(runs[i], robots.resolved), len(runs), threads,
+        done = experiment.map_trials(lambda i: benchmark_runs.execute(runs[i], robots.resolved), len(runs), threads,
                                      on_trial=tick)
         for run, (result, secs) in zip(runs, done):
             results[run["key"]], seconds[run["key"]] = result, secs

@@ -226,17 +226,17 @@ def with_traceback(err: BaseException) -> str:
     return (first[0] if first else type(err).__name__) + "\n" + "".join(parts)
 
 
-def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
-    """(result, seconds) of one benchmark run; what a worker runs (``robots``: by spec). A run
-    that raises is :class:`RunFailed`, its message carrying the traceback."""
+def execute_recorded(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
+    """:func:`execute` as a benchmark's workers run it: a run that raises is :class:`RunFailed`,
+    its message carrying the traceback, which the store keeps beside the failure."""
     try:
-        return execute_here(run, robots)
+        return execute(run, robots)
     except Exception as err:  # noqa: BLE001 - a failed run, its traceback kept for the store
         raise RunFailed(with_traceback(err)) from None
 
 
-def execute_here(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
-    """:func:`execute` in this process: what a run raises propagates as it is."""
+def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
+    """(result, seconds) of one benchmark run (``robots``: by spec); what it raises propagates."""
     t0 = time.perf_counter()
     if run["format"] == SOURCE_FORMAT:
         source = robots[robot_key(run["source"], run.get("world"))]

@@ -38,7 +38,7 @@ from pathlib import Path
 from typing import Any
 
 from armtransfer.errors import InvalidParameterError
-from armtransfer.experiments import suites
+from armtransfer.experiments import suite_model as suites
 
 DATA = Path(__file__).resolve().parent / "suite_data"
 MAX_BYTES = 1 << 20
@@ -62,8 +62,9 @@ def is_file_name(text: str) -> bool:
     return text.lower().endswith((".toml", ".json")) or "/" in text
 
 
-def load(path: str | Path) -> suites.Suite:
-    """The suite of the file ``path``, every key, world, robot name and method checked."""
+def load(path: str | Path, builtin: dict[str, suites.Suite] | None = None) -> suites.Suite:
+    """The suite of the file ``path``, every key, world, robot name and method checked;
+    ``builtin``: the built-in suites (which ``include`` may name, and whose names are taken)."""
     p = Path(path)
     where = f"suite file {str(p)[:120]!r}"
     if p.suffix.lower() not in (".toml", ".json"):
@@ -83,7 +84,7 @@ def load(path: str | Path) -> suites.Suite:
         raise SuiteFileError(f"{where}: not UTF-8 text") from None
     except (tomllib.TOMLDecodeError, json.JSONDecodeError) as err:
         raise SuiteFileError(f"{where}: not valid {p.suffix[1:].upper()}: {str(err).splitlines()[0]}") from None
-    return parse(data, where, p.parent)
+    return parse(data, where, p.parent, builtin=builtin)
 
 
 def _fail(where: str, what: str) -> SuiteFileError:
@@ -332,9 +333,10 @@ def parse(data: object, where: str, base: Path | None = None, known_worlds: dict
     name = _text(t["name"], where, "name")
     if not NAME.fullmatch(name):
         raise _fail(where, f"a suite's name is lower-case letters, digits, '_', '.' or '-', got {name!r}")
-    if check and name in suites.SUITES:
+    have = builtin or {}
+    if check and name in have:
         raise _fail(where, f"name {name!r} is a built-in suite's; name yours otherwise (built-in suites: "
-                           f"{', '.join(suites.SUITES)})")
+                           f"{', '.join(have)})")
     version = _int(t.get("version", 1), where, "version", 1)
     held_out = t.get("held_out", False)
     if not isinstance(held_out, bool):
@@ -343,7 +345,6 @@ def parse(data: object, where: str, base: Path | None = None, known_worlds: dict
     inherited = _shared(t, where, {}, check)
     sections: list[suites.Section] = []
     if "include" in t:
-        have = builtin if builtin is not None else suites.SUITES
         for other in _names(t["include"], where, "include"):
             if other not in have:
                 raise _fail(where, f"include: unknown suite {other!r}; valid suites: {', '.join(have)}")

@@ -198,7 +198,7 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
 
     kind = ("held out: no parameter of any method was chosen on it" if suite.held_out
             else "not held out: parameters may be chosen on it")
-    made = (f"Made by `armtransfer benchmark --suite {suite.name} --seed {seed}`." if suite.builtin else
+    made = (f"Made by `armtransfer benchmark --suite {suite.name} --seed {seed}`." if suites.is_builtin(suite) else
             f"Made by `armtransfer benchmark --suite FILE --seed {seed}` from the suite file of `{suite.name}` (its "
             "whole definition is in results.json), on the worlds "
             + ", ".join(f"`{w}`" for w in dict.fromkeys(c.world.partition("#")[0] for sec in suite.sections
