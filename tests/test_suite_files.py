@@ -191,3 +191,38 @@ def test_a_potential_of_ones_own_says_what_the_bound_did_to_it():
     assert any("on every one" in n for n in said["flat"]) and any("not 0, at the goal" in n for n in said["flat"])
     assert any("1000, not 0, at the goal" in n for n in said["offset"])
     assert not methods.build_shaping("dense", robot, [traj], "auto", -1.0).notes  # the built-in ones say nothing
+
+
+@pytest.mark.slow  # examples/suites/zigzag.toml whole, then killed and resumed: about a minute on 2 cores
+def test_a_suite_file_killed_by_sigkill_resumes_to_the_uninterrupted_report(tmp_path):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from contract import settle
+
+    suite = ROOT / "examples" / "suites" / "zigzag.toml"
+    whole, out = tmp_path / "whole", tmp_path / "killed"
+    assert main(["benchmark", "--suite", str(suite), "--out", str(whole), "--workers", "2"]) == 0
+    argv = [sys.executable, "-m", "armtransfer.cli", "benchmark", "--suite", str(suite), "--out", str(out),
+            "--workers", "2"]
+    proc = subprocess.Popen(argv, cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            start_new_session=True)
+    deadline = time.time() + 600
+    while time.time() < deadline and proc.poll() is None and len(list(out.glob("runs/*.json"))) < 8:
+        time.sleep(0.05)
+    assert proc.poll() is None, "the run ended before its kill"
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    assert settle(proc.pid, 30) == [], "processes outlived the killed benchmark"
+    assert not (out / "report.md").exists()
+    last = subprocess.Popen(argv, cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            start_new_session=True)
+    assert last.wait(timeout=600) == 0 and settle(last.pid, 30) == []
+    for name in ("report.md", "results.json"):
+        assert (out / name).read_bytes() == (whole / name).read_bytes(), name
+    (out / "report.md").unlink()
+    assert main(["summarize", str(out)]) == 0
+    assert (out / "report.md").read_bytes() == (whole / "report.md").read_bytes()
