@@ -42,7 +42,7 @@ def write_suite(tmp_path: Path, body: str) -> Path:
     shutil.copy(ZIGZAG, tmp_path / "zigzag.toml")
     path = tmp_path / "mine.toml"
     path.write_text('name = "mine"\nworld = "zigzag.toml"\nmethods = ["pseudo"]\nsource_seeds = 1\ntrials = 1\n'
-                    'max_total_steps = 20_000\n' + body)
+                    'max_total_steps = 5_000\n' + body)
     return path
 
 
@@ -226,3 +226,55 @@ def test_a_suite_file_killed_by_sigkill_resumes_to_the_uninterrupted_report(tmp_
     (out / "report.md").unlink()
     assert main(["summarize", str(out)]) == 0
     assert (out / "report.md").read_bytes() == (whole / "report.md").read_bytes()
+
+
+class _Seen:
+    """A learner that records what ``make`` is handed and steps at random."""
+
+    seen: list = []
+
+    def __init__(self, env, seed, transfer=None):
+        self.env, self.rng, self.obs = env, np.random.default_rng(seed), None
+        _Seen.seen.append(transfer)
+
+    def learn(self, total_timesteps):
+        for _ in range(total_timesteps):
+            if self.obs is None:
+                self.obs, _ = self.env.reset()
+            self.obs, _, done, cut, _ = self.env.step(int(self.rng.integers(self.env.action_space.n)))
+            if done or cut:
+                self.obs = None
+        return self
+
+    def predict(self, observation, deterministic=True):
+        return 0, None
+
+
+@pytest.fixture
+def seen_learner():
+    import armtransfer
+    from armtransfer.learning.learners import LEARNERS
+
+    _Seen.seen = []
+    learner = armtransfer.register_learner(armtransfer.Learner("seen", "records its transfer", _Seen,
+                                                               options={"alpha": 0.5}, transfer=True), replace=True)
+    yield learner
+    del LEARNERS["seen"]
+
+
+def test_a_learner_receives_the_transfer_and_its_options_key_its_runs(seen_learner, capsys):
+    suite = suite_files.parse({"name": "tiny", "world": "rooms11", "methods": ["pseudo"], "source_seeds": 1,
+                               "trials": 1, "max_total_steps": 400, "learners": ["seen"],
+                               "cases": [{"source": "coarse", "target": "fine", "task": 2}]}, "test")
+    plan = benchmark.plan(suite, 0, None, *benchmark.methods_to_run(suite.methods))
+    runs = plan.all_trial_runs(plan.pairs[0], None)  # those that wait for no trajectory: none's
+    assert [r["method"] for r in runs] == ["none"] and runs[0]["learner_options"] == {"alpha": 0.5}
+    records, _ = benchmark.run_suite(suite, 0, learners=["seen"])
+    assert {r["method"] for r in records} == {"none@seen", "pseudo@seen"}
+    shaped = [t for t in _Seen.seen if t.method == "pseudo"]
+    assert shaped and all(len(t.trajectories) == 1 and t.trajectories[0].shape[1] == 2 for t in shaped)
+    assert all(t.shaping is not None and len(t.shaping.bonus) > 0 for t in shaped)
+    plain = [t for t in _Seen.seen if t.method == "none"]
+    assert plain and all(t.shaping is None and t.trajectories == () for t in plain)
+    assert main(["bench", "--learner", "seen", "--steps", "300", "--repeats", "1"]) == 0
+    assert "learner seen: median" in capsys.readouterr().out

@@ -83,6 +83,9 @@ def run(args: argparse.Namespace) -> int:
         if args.address:
             _check_reachable(args.address)
     wanted = suite.methods
+    if not suites.is_builtin(suite) and all(s.methods is not None for s in suite.sections):
+        # a suite file's methods: those its sections name (a section may name its own)
+        wanted = tuple(dict.fromkeys(m for s in suite.sections for m in s.methods or ()))
     if args.method is not None:
         from armtransfer.learning import methods
 
@@ -112,7 +115,7 @@ def run(args: argparse.Namespace) -> int:
           + (f" from the runs that finished; {failed} failed, listed in it and in {out / 'failed'} (with their "
              "tracebacks); run the same command again to retry them" if failed else ""))
     for section in suite.sections:
-        for name, against in summary[section.name]["pooled"].items():
+        for name, against in summary.get(section.name, {}).get("pooled", {}).items():
             for ab in against.values():
                 print(benchmark_report.sentence(name, ab, section.name))
     return 1 if failed else 0
@@ -248,6 +251,10 @@ def write_report_files(out: Path, suite: suites.Suite, seed: int, ran: list[str]
     write_bytes_atomic(out / "results.json", results)
     if timings is not None:
         write_json_atomic(out / "timings.json", timings)
+    if any(s.name not in summary for s in suite.sections):  # a section whose every record failed: in the
+        import dataclasses  # failures' table alone
+
+        suite = dataclasses.replace(suite, sections=tuple(s for s in suite.sections if s.name in summary))
     benchmark_report.write_figures(summary, suite, out)
     write_text_atomic(out / "report.md", benchmark_report.report_markdown(suite, seed, summary, ran, missing,
                                                                          failures or [], warnings or []))

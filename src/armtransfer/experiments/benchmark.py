@@ -385,8 +385,9 @@ class Plan:
             src = pair.source_run()
             source = result(src)
             if source is None:
-                if src["key"] in failed:
-                    lose(pair, "source", [src["key"]])
+                if src["key"] in failed:  # the pair is left out: robot 1's run failed, and any that ran without it
+                    lose(pair, "source", [src["key"], *(run["key"] for run in self.all_trial_runs(pair, None)
+                                                        if run["key"] in failed)])
                 else:
                     missing += 1 + self.trials_of(pair)
                 continue

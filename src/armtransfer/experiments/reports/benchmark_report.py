@@ -198,11 +198,11 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
 
     kind = ("held out: no parameter of any method was chosen on it" if suite.held_out
             else "not held out: parameters may be chosen on it")
-    made = (f"Made by `armtransfer benchmark --suite {suite.name} --seed {seed}`." if suites.is_builtin(suite) else
+    worlds = list(dict.fromkeys(c.world.partition("#")[0] for sec in suite.sections for c in sec.cases))
+    on = f", on the world{'s' * (len(worlds) > 1)} " + ", ".join(f"`{w}`" for w in worlds) if worlds else ""
+    made = (f"Made by `armtransfer benchmark --suite {suite.name} --seed {seed}`." if suite.name in suites.SUITES else
             f"Made by `armtransfer benchmark --suite FILE --seed {seed}` from the suite file of `{suite.name}` (its "
-            "whole definition is in results.json), on the worlds "
-            + ", ".join(f"`{w}`" for w in dict.fromkeys(c.world.partition("#")[0] for sec in suite.sections
-                                                         for c in sec.cases)) + ".")
+            f"whole definition is in results.json){on}.")
     out = [f"# Benchmark `{suite.name}` (version {suite.version})", "",
            f"{made} {suite.description}; {kind}.", "",
            "## Methods and their baselines", "",
@@ -228,9 +228,10 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
         out += ["", "## Warnings", "", *(f"- {w}" for w in warnings)]
     if failures:
         out += ["", "## Runs that failed", "",
-                f"{sum(f['failed_runs'] for f in failures)} runs failed, so {len(failures)} records are left out of "
-                "everything below (each method is paired with its baseline over the source seeds both have); the "
-                "store's `failed/` keeps each run's traceback, and running the same command again retries them.", ""]
+                f"{sum(f['failed_runs'] for f in failures)} runs failed, so the records below are left out of "
+                "everything that follows (method `source`: robot 1's run failed, so every method of that case and "
+                "source seed); each method is paired with its baseline over the source seeds both have. The store's "
+                "`failed/` keeps each run's traceback, and running the same command again retries them.", ""]
         out.append(markdown_table(["section", "case", "source seed", "method", "runs failed", "first error"],
                                   [[f["section"], f["label"], str(f["source_seed"]), f["method"],
                                     str(f["failed_runs"]), f["error"].replace("|", "\\|")] for f in failures]))
