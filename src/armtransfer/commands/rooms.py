@@ -32,6 +32,7 @@ def run(args: argparse.Namespace) -> int:
     total = experiment.count_trials(args.method, args.trials, not args.no_controls and args.learner == "sarsa")
     with common.progress_bar(total, "learning") as bar:
         result = api.transfer(args.source, args.target, progress=bar.update, **common.transfer_kwargs(args))
+    common.print_warnings(result)
     out = result.to_json()
     print_results(out)
     if args.json:

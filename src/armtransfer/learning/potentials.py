@@ -105,10 +105,11 @@ def notes(name: str, phi: np.ndarray, at_goal: np.ndarray, gamma: float, step_re
         out.append(f"method {name!r}: its potential is below -B = -{b:g} on {low:.0%} of the {len(phi)} states, "
                    f"where every potential is squashed into (-B, 0] by -B*tanh(-phi/B), flattening its differences; "
                    "scale it down (docs/extending.md)")
-    if at_goal.any() and (off := float(np.max(np.abs(phi[at_goal])))) > 1e-9:
-        out.append(f"method {name!r}: its potential is {phi[at_goal][np.argmax(np.abs(phi[at_goal]))]:g}, not 0, at "
-                   f"the goal, which the kernel counts as 0: entering the goal pays {off:g} less or more than a "
-                   "step; subtract the goal's value (docs/extending.md)")
+    if at_goal.any() and float(np.max(np.abs(phi[at_goal]))) > 1e-9:
+        value = float(phi[at_goal][np.argmax(np.abs(phi[at_goal]))])
+        out.append(f"method {name!r}: its potential is {value:g}, not 0, at the goal, which the kernel counts as 0: "
+                   f"every move into the goal is shaped by about {-value:g}; subtract the goal's value "
+                   "(docs/extending.md)")
     return out
 
 
