@@ -26,7 +26,7 @@ benchmark runs it directly, not through ``make``.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from dataclasses import replace as with_fields
 from typing import Any, Protocol
 
@@ -88,7 +88,7 @@ class Learner:
     make: Callable[..., Model]
     origin: str = RUN_TIME
     """Where it comes from: ``armtransfer``, an installed plugin (named), or registered at run time."""
-    options: Mapping[str, Any] | None = None
+    options: Mapping[str, Any] | None = field(default=None, hash=False)  # a dict: a Learner stays hashable
     transfer: bool = False
 
 
