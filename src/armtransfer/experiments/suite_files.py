@@ -19,7 +19,9 @@ Cases may instead be grouped in ``[[sections]]`` (each with a ``name`` and its o
 ``[[sections.cases]]``; a section's keys override the file's). A case with neither ``task`` nor
 ``start``/``goal`` draws its task per source seed (``distance = [low, high]`` or ``[low]``, ``cells
 = "any" | "even" | "odd"``). ``include = ["paper", ...]`` takes the sections of built-in suites.
-``version``, ``held_out`` and ``description`` describe the suite in its report. A layout file is
+``source_seeds`` defaults to 10 (the fewest a report makes a claim from) and ``trials`` to 2;
+``max_total_steps`` is required. ``version``, ``held_out`` and ``description`` describe the suite
+in its report. A layout file is
 read relative to the suite file; the suite carries the world's content (``Suite.worlds``) under an
 id naming the world and a hash of that content, so its runs are keyed by the world itself and
 ``armtransfer summarize`` needs no file. Every fault is one line naming the file and the key.
@@ -48,6 +50,10 @@ SHARED = ("world", "methods", "learners", "source_seeds", "trials", "max_total_s
 SECTION = ("name", "description", "cases", *SHARED)
 CASE = ("source", "target", "task", "start", "goal", "wind", "world", "distance", "cells", "state", "noise")
 
+
+DEFAULT_TRIALS = 2
+"""Trials of every method per source seed when a file gives none: two, so the spread within a
+source seed is seen beside the spread between them."""
 
 NAME = re.compile(r"[a-z0-9][a-z0-9_.-]{0,63}")
 """A suite's name, as a method's: it is typed on command lines and written in file names."""
@@ -307,9 +313,10 @@ def _section(t: dict, where: str, inherited: dict, worlds: _Worlds, default_name
     if name is None:
         raise _fail(where, "a section needs a name")
     where = f"{where.split(': ')[0]}: section {name!r}" if default_name is None else where
-    for key in ("source_seeds", "trials", "max_total_steps"):
-        if key not in s:
-            raise _fail(where, f"needs {key} (in the section or at the top of the file)")
+    s.setdefault("source_seeds", suites.MIN_SEEDS_FOR_CLAIM)  # the fewest a report makes a claim from
+    s.setdefault("trials", DEFAULT_TRIALS)
+    if "max_total_steps" not in s:
+        raise _fail(where, "needs max_total_steps, a trial's step cap (in the section or at the top of the file)")
     cases = t.get("cases")
     if not isinstance(cases, list) or not cases:
         raise _fail(where, "needs at least one case ([[cases]] with source, target and a task)")
