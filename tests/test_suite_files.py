@@ -278,3 +278,24 @@ def test_a_learner_receives_the_transfer_and_its_options_key_its_runs(seen_learn
     assert plain and all(t.shaping is None and t.trajectories == () for t in plain)
     assert main(["bench", "--learner", "seen", "--steps", "300", "--repeats", "1"]) == 0
     assert "learner seen: median" in capsys.readouterr().out
+
+
+def test_a_sweeps_learner_options_key_its_runs_and_its_store(seen_learner):
+    from dataclasses import replace
+
+    from armtransfer.experiments import sweep
+    from armtransfer.learning.learners import LEARNERS
+
+    raw = {"sweep": {"name": "o", "world": "rooms11", "tasks": ["1"], "pairs": [["coarse", "fine"]],
+                     "methods": ["none"], "learner": ["sarsa", "seen"], "max_total_steps": 400, "trials": 1,
+                     "trajectory": "optimal"}}
+    spec = sweep.normalise(raw)
+    assert spec["learner_options"] == {"seen": {"alpha": 0.5}}
+    runs = sweep.expand(spec)
+    assert [r.get("learner_options") for r in runs] == [None, {"alpha": 0.5}]  # sarsa's run keeps its key
+    stored = json.loads(json.dumps(spec))
+    assert sweep.check_stored(stored, "store") == stored
+    LEARNERS["seen"] = replace(LEARNERS["seen"], options={"alpha": 0.25})
+    with pytest.raises(sweep.SweepFileError, match=r"had the options \{'seen': \{'alpha': 0.5\}\}"):
+        sweep.check_stored(stored, "store")
+    assert [r.get("learner_options") for r in sweep.expand(sweep.normalise(raw))] == [None, {"alpha": 0.25}]
