@@ -299,3 +299,12 @@ def test_a_sweeps_learner_options_key_its_runs_and_its_store(seen_learner):
     with pytest.raises(sweep.SweepFileError, match=r"had the options \{'seen': \{'alpha': 0.5\}\}"):
         sweep.check_stored(stored, "store")
     assert [r.get("learner_options") for r in sweep.expand(sweep.normalise(raw))] == [None, {"alpha": 0.25}]
+
+
+def test_an_unreachable_goal_behind_a_door_on_an_odd_cell_names_the_even_cell_rule(tmp_path, monkeypatch, capsys):
+    world = tmp_path / "odd.toml"
+    world.write_text('name = "odd"\ngrid = """\n.......\n.......\n.......\n##D####\n.......\n.......\n.......\n"""\n'
+                     '[tasks]\n1 = { start = [0, 2], goal = [0, -2] }\n')
+    err = refused(["rooms", "--world", str(world), "--trials", "1"], tmp_path, monkeypatch, capsys)
+    assert "robot coarse cannot reach the goal" in err and "door at (-1, 0) is on an odd cell" in err
+    assert "docs/worlds.md" in err
