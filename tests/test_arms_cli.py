@@ -68,3 +68,33 @@ def test_arms_list_includes_a_bring_your_own_arm(scara_xml, capsys):
     assert set(rows) == {"planar2:joint", "my_scara:joint"}
     assert "given mount --base-pos=-0.1,0,0" in notes and "joints shoulder-elbow" in notes
     assert rows["my_scara:joint"][1] == "2"
+
+
+def test_arms_list_on_a_new_machine_prints_at_once_and_compiles_nothing(tmp_path):
+    """An empty arm cache: every built-in robot listed, none compiled, within 10 s (a cold
+    interpreter included); then a robot in the cache shows its figures."""
+    import os
+    import subprocess
+    import sys
+    import time
+
+    from armtransfer.tasks.arms import robot_specs, spatial_joint_specs
+
+    env = dict(os.environ, ARMTRANSFER_CACHE=str(tmp_path / "cache"))
+    t0 = time.perf_counter()
+    done = subprocess.run([sys.executable, "-m", "armtransfer", "arms", "list"], env=env, capture_output=True,
+                          text=True, timeout=60)
+    seconds = time.perf_counter() - t0
+    assert done.returncode == 0, done.stderr
+    rows = {line.split()[0]: line.split() for line in done.stdout.splitlines()[1:] if line[:1].isalpha() and ":" in line.split()[0]}
+    assert set(rows) == set(robot_specs() + spatial_joint_specs())
+    assert all(r[3] == "-" and r[-1] == "none" for r in rows.values())
+    assert "not compiled yet" in done.stdout and "--arm" in done.stdout
+    assert not list((tmp_path / "cache").rglob("*.npz")), "the listing compiled a robot"
+    assert seconds < 10, f"{seconds:.1f} s"
+    subprocess.run([sys.executable, "-m", "armtransfer", "arms", "list", "--arm", "planar2", "--actions", "joint"],
+                   env=env, capture_output=True, text=True, timeout=300, check=True)
+    again = subprocess.run([sys.executable, "-m", "armtransfer", "arms", "list"], env=env, capture_output=True,
+                           text=True, timeout=60, check=True).stdout
+    row = next(line.split() for line in again.splitlines() if line.startswith("planar2:joint "))
+    assert row[2] == "4" and row[-1] == "hit"

@@ -415,11 +415,13 @@ def _as_sequence(value, what: str) -> Sequence:
 def _with_walls_cause(message: str, robot: DiscreteRobot) -> str:
     """``message``, and why, when an arm misses cells because its geometry meets the walls."""
     from armtransfer.tasks.arms import walls_cause
+    from armtransfer.tasks.unreachable import hint
 
     if robot.arm is None:
-        return message
+        return message + hint(robot)
     cause = walls_cause(robot)
-    return f"{message}: it reaches {robot.arm.reach:.1%} of the free cells; {cause}" if cause else message
+    return (f"{message}: it reaches {robot.arm.reach:.1%} of the free cells; {cause}" if cause else message) \
+        + hint(robot)
 
 
 ARM_OPTIONS = ("tip_site", "tip_body", "tip_offset", "tool", "arm_name", "base_pos", "base_yaw", "cell_size", "joint_step",

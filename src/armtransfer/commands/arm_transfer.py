@@ -187,6 +187,7 @@ def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target
     total = experiment.count_trials(args.method, kwargs["trials"], kwargs["controls"] and "learner" not in kwargs)
     with common.progress_bar(total, "learning") as bar:
         result = api.transfer(source, target, progress=bar.update, **kwargs)
+    common.print_warnings(result)
     out_json = result.to_json()
     out_json["arms"] = {label: arm_json(r) for label, r in (("source", source), ("target", target))
                         if r.arm is not None}

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from typing import Any
 
 from armtransfer.commands import common
@@ -14,15 +15,17 @@ EXAMPLE = "armtransfer arms --fast --out runs/demo"
 
 
 ARM_FILE_OPTIONS = {"arm_xml", "tip_site", "tip_body", "tip_offset", "tool", "arm_name", "base_pos", "base_yaw", "cell_size"}
-LIST_ONLY = {"arm", "actions"}
-LIST_OPTIONS = LIST_ONLY | ARM_FILE_OPTIONS | {"no_cache", "world"}
+LIST_ONLY = {"arm", "actions", "compile"}
+LIST_OPTIONS = LIST_ONLY | ARM_FILE_OPTIONS | {"no_cache", "world", "compile"}
 GENERATE_ONLY = {"family", "dof"}
 GENERATE_OPTIONS = GENERATE_ONLY | {"seed", "out"}
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("action", nargs="?", choices=["list", "generate"],
-                        help="'list': compile (or load) every arm robot and report it; 'generate': draw "
+                        help="'list': every built-in arm robot at once, with the figures of those in the arm cache; "
+                             "the robots --arm, --actions or --arm-xml name (every one with --compile) are compiled "
+                             "(or loaded) and reported, with progress; 'generate': draw "
                              "an arm from --family with --dof joints and --seed into --out; without "
                              "either, run a transfer")
     parser.add_argument("--family", default=None, help="arms generate: planar, spatial6 or spatial7")
@@ -37,6 +40,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="cell size in metres (default 0.01 on rooms; on a world of another size, the size "
                              "that keeps the table 0.51 m wide)")
     parser.add_argument("--no-cache", action="store_true", help="compile without the cache")
+    parser.add_argument("--compile", action="store_true",
+                        help="arms list: compile every built-in robot not in the cache yet (minutes on a new machine)")
     from armtransfer.commands import arm_transfer
 
     arm_transfer.add_arguments(parser)
@@ -93,23 +98,50 @@ def run(args: argparse.Namespace) -> int:
                   **{k: v for k, v in options.items() if k != "arm_name"})
         for a in custom:
             jobs.append(dict(arm=None, actions=a, xml_path=args.arm_xml, **options))
-    from armtransfer.tasks.arms import tasks_solvable, walls_cause
+    from armtransfer.tasks.arms import NotCached, tasks_solvable, walls_cause
 
-    def build(job: dict):
+    # compiled: the robots asked for by name (--arm, --actions), the arm file's, every one with --compile;
+    # the others are listed at once, with their figures when the cache has them
+    asked = args.arm is not None or args.actions is not None or args.compile
+    to_compile = [i for i, job in enumerate(jobs) if asked or job.get("xml_path")]
+    done = 0
+
+    def build(i: int, job: dict):
+        nonlocal done
         job = dict(job)
+        if i not in to_compile:
+            try:
+                return arm_robot(job.pop("arm"), job.pop("actions"), cell_size=args.cell_size, layout=layout,
+                                 only_cached=True, cache=not args.no_cache, **job)
+            except NotCached:
+                return None
+        done += 1
+        spec = f"{job['arm']}:{job['actions']}" if job.get("arm") else f"{job.get('xml_path')}:{job['actions']}"
+        if common.interactive():
+            print(f"[{done}/{len(to_compile)}] {spec}", file=sys.stderr, flush=True)
         return arm_robot(job.pop("arm"), job.pop("actions"), cell_size=args.cell_size, cache=not args.no_cache,
                          progress=common.interactive(), layout=layout, **job)
 
-    # the bring-your-own arm first: a file that cannot be compiled fails before the long listing
-    built = {i: build(job) for i, job in enumerate(jobs) if job.get("xml_path")}
-    robots = [built[i] if i in built else build(job) for i, job in enumerate(jobs)]
+    # the bring-your-own arm first: a file that cannot be compiled fails before the listing
+    built = {i: build(i, job) for i, job in enumerate(jobs) if job.get("xml_path")}
     tasks = "tableI" if is_default(layout) else "tasks"
     header = f"{'robot':<24} {'dof':>3} {'actions':>7} {'states':>7} {'reach':>6} {tasks:>6} {'cache':>6}"
-    print(header)
-    for r in robots:
+    print(header, flush=True)
+    robots, missing = [], []
+    for i, job in enumerate(jobs):
+        r = built[i] if i in built else build(i, job)
+        if r is None:
+            missing.append(f"{job['arm']}:{job['actions']}")
+            print(f"{missing[-1]:<24} {ARMS[job['arm']].dof:>3} {'-':>7} {'-':>7} {'-':>6} {'-':>6} {'none':>6}",
+                  flush=True)
+            continue
+        robots.append(r)
         solved = tasks_solvable(r)
         print(f"{r.name:<24} {r.arm.dof:>3} {r.n_actions:>7} {r.n_states:>7} "
-              f"{r.arm.reach:>6.1%} {solved:>4}/{len(layout.tasks)} {r.arm.cache:>6}")
+              f"{r.arm.reach:>6.1%} {solved:>4}/{len(layout.tasks)} {r.arm.cache:>6}", flush=True)
+    if missing:
+        print(f"\n{len(missing)} robots are not compiled yet ('-'); a run that uses one compiles it once, or "
+              "`armtransfer arms list --arm ARM[,ARM...]` (or --compile, every one: minutes) compiles and reports them")
     spatial = [r for r in robots if is_spatial_joint(r)]
     custom = [r for r in robots if r.arm.kind == "custom"]
     if spatial or custom:

@@ -23,15 +23,24 @@ HELP = "Measure how many learning steps per second the learner runs on this mach
 EXAMPLE = "armtransfer bench --repeats 3"
 
 
+STEPS = 2_000_000
+LEARNER_STEPS = 20_000
+"""``--steps``' default with ``--learner``: a learner of Python code runs thousands of steps a second."""
+
+
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--steps", type=positive_int, default=2_000_000,
-                   help="learner steps per repeat, at least (default 2,000,000)")
+    p.add_argument("--steps", type=positive_int, default=None,
+                   help=f"learner steps per repeat, at least (default {STEPS:,}; {LEARNER_STEPS:,} with --learner)")
     p.add_argument("--repeats", type=positive_int, default=5, help="timed repeats (default 5)")
     p.add_argument("--seed", type=non_negative_int, default=0, help="random seed, >= 0 (default 0)")
     p.add_argument("--baseline-steps", type=positive_int, default=2_000,
                    help="steps per repeat of the plain-Python baseline, at least (default 2,000)")
     p.add_argument("--baseline-repeats", type=non_negative_int, default=3, help="baseline repeats (default 3; 0 skips it)")
     p.add_argument("--json", default=None, metavar="PATH", help="write the figures as JSON here")
+    p.add_argument("--learner", default=None, metavar="NAME",
+                   help="measure this learner instead of the built-in sarsa: a learner of an installed plugin "
+                        "(docs/extending.md), its model made on the world's first task's environment (fine robot, no "
+                        "transfer) and its learn(--steps) timed, the steps counted by the harness; no baseline")
     add_world_argument(p)
 
 
@@ -67,7 +76,66 @@ def measure_reference(steps: int, seed: int, layout: Layout = ROOMS) -> tuple[in
     return done, time.perf_counter() - t0
 
 
+def measure_learner(name: str, steps: int, seed: int, layout: Layout = ROOMS) -> tuple[int, float]:
+    """``steps`` steps of learner ``name`` (``learning.learners``) on the world's first task, fine
+    robot, no transfer, in the harness's environment (``learner_trial``): (steps it took, seconds)."""
+    import gymnasium as gym
+
+    from armtransfer.experiments import learner_trial
+    from armtransfer.learning.learners import get
+    from armtransfer.registration import MAX_EPISODE_STEPS
+
+    learner = get(name)
+    robot = grid_robot("fine", layout)
+    task = world_task(layout)
+    start, goal = (list(layout.xy(c)) for c in task.cells())
+    config = LearnerConfig()
+    said = learner_trial.where(learner)
+    env = learner_trial.Monitor(gym.wrappers.TimeLimit(learner_trial.case_env(robot, start, goal, 0.0, config),
+                                                       max_episode_steps=MAX_EPISODE_STEPS), said)
+    env.reset(seed=seed)
+    model = learner_trial._call(said, "make", learner.make, env, seed,
+                                *learner_trial.handed(learner, "none", robot, None, None))
+    t0 = time.perf_counter()
+    learner_trial._call(said, "learn", model.learn, steps)
+    return env.total, time.perf_counter() - t0
+
+
+def run_learner(args: argparse.Namespace, layout: Layout) -> int:
+    """``bench --learner NAME``: an outside learner's steps per second."""
+    from armtransfer.learning.learners import BUILTIN, get
+
+    name = get(args.learner).name  # a typo lists the valid names
+    if name in BUILTIN:
+        args.learner = None
+        return run(args)
+    refuse_other_options(args, {a.dest for a in options_of(args)} - {"baseline_steps", "baseline_repeats"},
+                         f"bench --learner {name} (no baseline)")
+    args.steps = args.steps or LEARNER_STEPS
+    if args.json:
+        check_writable(args.json)
+    measure_learner(name, 1_000, args.seed, layout)  # imports and first calls outside the timing
+    rates = []
+    for r in range(args.repeats):
+        done, secs = measure_learner(name, args.steps, args.seed + r, layout)
+        rates.append(done / secs)
+        print(f"repeat {r + 1}: {done:,} steps in {secs:.3f} s = {done / secs:,.0f} steps/s")
+    med = statistics.median(rates)
+    print(f"learner {name}: median {med:,.0f} steps/s over {args.repeats} repeats (steps counted by the harness)")
+    if args.json:
+        write_json_atomic(args.json, {
+            "benchmark": f"learner {name} steps per second, the world's first task, fine robot, no transfer",
+            "learner": name, **({} if layout is ROOMS else {"world": layout.name}),
+            "steps_per_repeat": args.steps, "steps_per_second": rates, "median_steps_per_second": med,
+            "machine": {"cpus": os.cpu_count(), "processor": platform.processor() or platform.machine(),
+                        "python": platform.python_version()}})
+    return 0
+
+
 def run(args: argparse.Namespace) -> int:
+    if getattr(args, "learner", None) is not None:
+        return run_learner(args, world_of(args))
+    args.steps = args.steps or STEPS
     if args.baseline_repeats == 0:
         refuse_other_options(args, {a.dest for a in options_of(args)} - {"baseline_steps"},
                              "bench with --baseline-repeats 0 (no baseline)")

@@ -21,9 +21,10 @@ import time
 from pathlib import Path
 
 from armtransfer.commands import common
+from armtransfer.errors import InvalidParameterError
 from armtransfer.commands.sweep import add_executor_arguments, check_executor_options
 from armtransfer.experiments import benchmark, suites
-from armtransfer.experiments.benchmark_runs import execute
+from armtransfer.experiments.benchmark_runs import execute_recorded as execute
 from armtransfer.experiments.reports import benchmark_report
 from armtransfer.experiments.stats import benchmark_stats
 from armtransfer.experiments.store import ResultStore, StoreError
@@ -38,7 +39,9 @@ EXAMPLE = "armtransfer benchmark --suite fast --out runs/bench-fast"
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     listing = "; ".join(f"{s.name}{' (held out)' if s.held_out else ''}: {s.description}" for s in suites.SUITES.values())
-    p.add_argument("--suite", required=True, metavar="NAME", help=f"the suite to run. {listing}")
+    p.add_argument("--suite", required=True, metavar="NAME|FILE",
+                   help="the suite to run: a built-in one, or a suite file PATH.toml or PATH.json of your own cases on "
+                        f"your own world (docs/benchmark.md). Built-in suites: {listing}")
     p.add_argument("--out", default=None,
                    help="result store directory: absent, empty, or this suite and seed's store to resume; the "
                         "report is written into it when every run is in (default runs/benchmark-<suite>-<timestamp>)")
@@ -59,16 +62,19 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def results_bytes(suite: suites.Suite, seed: int, ran: list[str], missing: list[str], records: list[dict],
-                  summary: dict) -> bytes:
-    """results.json's bytes: the same for the same suite, seed and build."""
+                  summary: dict, failures: list[dict] | None = None) -> bytes:
+    """results.json's bytes: the same for the same suite, seed and build. ``failures``: the
+    records left out because a run of theirs failed (``Plan.failures``), listed when there are."""
     data = {"suite": suite.to_dict(), "seed": seed, "methods": ran, "not_in_registry": missing,
             "baselines": {m: list(benchmark.baselines_of(m)) for m in ran}, "records": records, "summary": summary}
+    if failures:  # a whole benchmark keeps the bytes it had before failures were reported
+        data["failed"] = failures
     return (json.dumps(data, indent=1, sort_keys=False) + "\n").encode()
 
 
 def run(args: argparse.Namespace) -> int:
-    common.refuse_world(args, "benchmark", "its suites are fixed, with their tasks set in the rooms world")
-    suite = suites.get(args.suite)
+    suite = suites.named(args.suite)
+    refuse_other_world(args, suite)
     check_executor_options(args)
     out = Path(args.out) if args.out else Path("runs") / _dt.datetime.now().strftime(
         f"benchmark-{suite.name}-%Y%m%d-%H%M%S")
@@ -77,7 +83,10 @@ def run(args: argparse.Namespace) -> int:
         _import_ray()  # say how to install Ray before anything is written
         if args.address:
             _check_reachable(args.address)
-    wanted = None
+    wanted = suite.methods
+    if not suites.is_builtin(suite) and all(s.methods is not None for s in suite.sections):
+        # a suite file's methods: those its sections name (a section may name its own)
+        wanted = tuple(dict.fromkeys(m for s in suite.sections for m in s.methods or ()))
     if args.method is not None:
         from armtransfer.learning import methods
 
@@ -99,18 +108,37 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     store = ResultStore.open_for(out, Sweep(plan.name, plan.spec(), ()))
     try:
-        code = _run_into(store, plan, robots.resolved, args)
-        if code:
-            return code
+        failed = _run_into(store, plan, robots.resolved, args)
         summary = write_report(store, plan)  # under the lock: a summarize waits for the report
     finally:
         store.unlock()  # and its lock file is removed
-    print(f"wrote {out / 'report.md'} ({time.perf_counter() - t0:.0f} s)")
+    print(f"wrote {out / 'report.md'} ({time.perf_counter() - t0:.0f} s)"
+          + (f" from the runs that finished; {failed} failed, listed in it and in {out / 'failed'} (with their "
+             "tracebacks); run the same command again to retry them" if failed else ""))
     for section in suite.sections:
-        for name, against in summary[section.name]["pooled"].items():
+        for name, against in summary.get(section.name, {}).get("pooled", {}).items():
             for ab in against.values():
                 print(benchmark_report.sentence(name, ab, section.name))
-    return 0
+    return 1 if failed else 0
+
+
+def worlds_of(suite: suites.Suite) -> list[str]:
+    """The worlds ``suite``'s cases run on, as they are named (a layout file's by its name)."""
+    return list(dict.fromkeys(c.world.partition("#")[0] for s in suite.sections for c in s.cases))
+
+
+def refuse_other_world(args: argparse.Namespace, suite: suites.Suite) -> None:
+    """``--world`` names the world a suite's cases are on, or it is a one-line error: a suite sets
+    its cases' worlds (its tasks are the world's), so another world is a suite file's."""
+    if getattr(args, "world", None) is None:
+        return
+    common.world_of(args)  # a world that does not load names its own fault first
+    have = worlds_of(suite)
+    if have != [str(args.world)]:
+        raise InvalidParameterError(
+            f"--world {str(args.world)[:100]} does not apply to suite {suite.name!r}: a suite sets the worlds of its "
+            f"cases (this one: {', '.join(have)}); to run cases on another world, write a suite file with "
+            "world = \"NAME or PATH\" (docs/benchmark.md); valid worlds: " + ", ".join(have))
 
 
 def probe_learners(plan: benchmark.Plan, robots: benchmark.Robots, seconds: float = 60.0) -> None:
@@ -140,7 +168,7 @@ def probe_learners(plan: benchmark.Plan, robots: benchmark.Robots, seconds: floa
 
 def _run_into(store: ResultStore, plan: benchmark.Plan, robots: dict, args: argparse.Namespace) -> int:
     """Run every run of ``plan`` not in ``store`` yet; a trial run that reads robot 1's path is
-    released when its source run is in. Returns 1 when a run failed, else 0."""
+    released when its source run is in. Returns how many runs failed."""
     todo, waiting, done = [], {}, 0
     for pair in plan.pairs:
         src = pair.source_run()
@@ -173,7 +201,7 @@ def _run_into(store: ResultStore, plan: benchmark.Plan, robots: dict, args: argp
 
         def on_failed(run: dict, error: str, attempts: int) -> None:
             store.write_failure(run, error, attempts)
-            failed.append(f"{run['key']}: {error}")
+            failed.append(f"{run['key']}: {error.splitlines()[0] if error else error}")
             bar.update(1 + (plan.waiting(waiting[run["key"]]) if run["key"] in waiting else 0))
 
         if args.executor == "ray":
@@ -182,11 +210,10 @@ def _run_into(store: ResultStore, plan: benchmark.Plan, robots: dict, args: argp
             run_local(todo, robots, args.workers or os.cpu_count() or 1, on_done, on_failed, retries=args.retries,
                       fn=execute)
     if failed:
-        print(f"{len(failed)} runs failed, so no report yet; run the same command again to retry them")
+        print(f"{len(failed)} runs failed; the report is written from the runs that finished")
         for line in failed[:10]:
             print(f"  failed {line}")
-        return 1
-    return 0
+    return len(failed)
 
 
 def write_report(store: ResultStore, plan: benchmark.Plan) -> dict:
@@ -203,31 +230,45 @@ def write_report(store: ResultStore, plan: benchmark.Plan) -> dict:
         except (OSError, ValueError, KeyError, TypeError):
             return None
 
-    records = plan.records(result)
+    failed = {f["key"]: f["error"] for f in store.failures()}
+    records = plan.records(result, failed)
+    failures = plan.failures(result, failed)
     summary = benchmark_stats.summarize(records)
     write_report_files(store.root, plan.suite, plan.seed, plan.labels(), list(plan.missing), summary,
-                       results_bytes(plan.suite, plan.seed, plan.labels(), list(plan.missing), records, summary),
-                       timings=plan.timings(result, seconds))
+                       results_bytes(plan.suite, plan.seed, plan.labels(), list(plan.missing), records, summary,
+                                     failures),
+                       timings=plan.timings(result, seconds), failures=failures,
+                       warnings=benchmark_report.record_warnings(records))
+    for line in benchmark_report.record_warnings(records):
+        print(f"warning: {line}")
     return summary
 
 
 def write_report_files(out: Path, suite: suites.Suite, seed: int, ran: list[str], missing: list[str], summary: dict,
-                       results: bytes, timings: dict | None = None) -> None:
+                       results: bytes, timings: dict | None = None, failures: list[dict] | None = None,
+                       warnings: list[str] | None = None) -> None:
     """A benchmark's report files in ``out``: results.json (``results``, its bytes), timings.json
     when given, the figures, and report.md last, so that it is there only when the rest is."""
     write_bytes_atomic(out / "results.json", results)
     if timings is not None:
         write_json_atomic(out / "timings.json", timings)
+    if any(s.name not in summary for s in suite.sections):  # a section whose every record failed: in the
+        import dataclasses  # failures' table alone
+
+        suite = dataclasses.replace(suite, sections=tuple(s for s in suite.sections if s.name in summary))
     benchmark_report.write_figures(summary, suite, out)
-    write_text_atomic(out / "report.md", benchmark_report.report_markdown(suite, seed, summary, ran, missing))
+    write_text_atomic(out / "report.md", benchmark_report.report_markdown(suite, seed, summary, ran, missing,
+                                                                         failures or [], warnings or []))
 
 
 def plan_of(store: ResultStore) -> benchmark.Plan:
     """The plan of a benchmark store, made again by this build; a store of a suite this build
     defines otherwise (another version) or does not have is a one-line error."""
+    from armtransfer.experiments import suite_files
+
     spec = store.meta["spec"]["benchmark"]
     try:
-        suite = suites.get(spec["suite"]["name"])
+        suite = suite_files.from_dict(spec["suite"], f"{str(store.root)!r}")
     except Exception:  # noqa: BLE001 - any malformed spec is the same one-line refusal
         raise StoreError(f"{str(store.root)!r} holds a benchmark of a suite this build does not have") from None
     seed = spec.get("seed")
@@ -236,7 +277,7 @@ def plan_of(store: ResultStore) -> benchmark.Plan:
                          f"integer 0..{MAX_COUNT}); it was not written by armtransfer")
     plan = benchmark.plan(suite, seed, ran=spec["methods"], missing=spec["not_in_registry"],
                           preset=spec.get("preset", "default"), learners=spec.get("learners"))
-    if content_key(plan.spec()) != store.meta.get("key"):
+    if content_key(plan.spec()) != store.meta.get("key") or (suite.name in suites.SUITES and not suites.is_builtin(suite)):
         raise StoreError(f"{str(store.root)!r} holds a benchmark of suite {suite.name!r} as another build defined "
                          "it (its version, methods or learner settings differ); rebuild it with that build")
     return plan
@@ -248,7 +289,8 @@ def summarize(store: ResultStore) -> int:
     try:
         write_report(store, plan)
     except benchmark.IncompleteError as err:
+        named = plan.suite.name if suites.is_builtin(plan.suite) else "FILE (its suite file)"
         raise StoreError(f"{str(store.root)!r}: {err}; finish it with armtransfer benchmark --suite "
-                         f"{plan.suite.name} --seed {plan.seed} --out {str(store.root)}") from None
+                         f"{named} --seed {plan.seed} --out {str(store.root)}") from None
     print(f"wrote {store.root / 'report.md'}")
     return 0

@@ -16,7 +16,8 @@ from pathlib import Path
 from armtransfer.errors import InvalidParameterError
 from armtransfer.checks import MAX_COUNT
 from armtransfer.io import parse_json_bytes, read_input, staged_directory
-from armtransfer.experiments import suites
+from armtransfer.experiments import suite_files, suites
+from armtransfer.experiments.reports import benchmark_report
 from armtransfer.experiments.stats import benchmark_stats
 
 MAX_UNPACKED_BYTES = 1 << 30
@@ -65,14 +66,21 @@ def report_from_file(path: Path, out: str | None) -> int:
         raise InvalidParameterError("a results file needs --out DIR: an absent or empty directory for its report")
     data, raw = read_results(path)
     name, version = data["suite"].get("name"), data["suite"].get("version")
-    suite = suites.get(name) if isinstance(name, str) else None
-    if suite is None or json.loads(json.dumps(suite.to_dict())) != data["suite"]:
-        have = f"version {suite.version}" if suite is not None else "no such suite"
+    builtin = suites.SUITES.get(name) if isinstance(name, str) else None
+    try:  # a built-in suite as it ships, or any suite file's (its definition is in the results)
+        suite = suite_files.from_dict(data["suite"], f"results file {str(path)!r}")
+    except InvalidParameterError:
+        suite = None
+    if suite is None or json.loads(json.dumps(suite.to_dict())) != data["suite"] or (
+            builtin is not None and not suites.is_builtin(suite)):
+        have = f"version {builtin.version}" if builtin is not None else "no such suite"
         raise InvalidParameterError(f"{str(path)!r} holds suite {name!r} version {version}; this build has {have}, "
                                     "so it cannot recompute it (use the build that wrote it)")
+    failures = data.get("failed")
     try:
         summary = benchmark_stats.summarize(data["records"])
-        again = results_bytes(suite, data["seed"], data["methods"], data["not_in_registry"], data["records"], summary)
+        again = results_bytes(suite, data["seed"], data["methods"], data["not_in_registry"], data["records"], summary,
+                              failures)
     except (KeyError, TypeError, ValueError, IndexError) as err:
         raise InvalidParameterError(f"results file {str(path)!r} has a malformed record ({type(err).__name__}: "
                                     f"{err})") from None
@@ -80,7 +88,8 @@ def report_from_file(path: Path, out: str | None) -> int:
         raise InvalidParameterError(f"{str(path)!r}: the statistics this build recomputes from its "
                                     f"{len(data['records'])} records differ from the file's (another build wrote it)")
     with staged_directory(out) as tmp:
-        write_report_files(tmp, suite, data["seed"], data["methods"], data["not_in_registry"], summary, again)
+        write_report_files(tmp, suite, data["seed"], data["methods"], data["not_in_registry"], summary, again,
+                           failures=failures, warnings=benchmark_report.record_warnings(data["records"]))
     print(f"recomputed the statistics of {len(data['records'])} records: the same bytes as {str(path)!r}; "
           f"wrote {str(Path(out) / 'report.md')!r}")
     return 0

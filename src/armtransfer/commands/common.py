@@ -300,6 +300,14 @@ def refuse_other_options(args: argparse.Namespace, allowed: set[str], mode: str)
             raise InvalidParameterError(f"{_flag(action)} does not apply to {mode}; its options: {valid}")
 
 
+def print_warnings(result) -> None:
+    """One ``warning:`` line on stderr for each distinct warning of a transfer's methods (a
+    potential of one's own that the bound squashed, constant or not 0 at the goal)."""
+    said = dict.fromkeys(w for m in result.methods.values() for w in m.extra.get("warnings", ()))
+    for line in said:
+        print(f"warning: {line}", file=sys.stderr)
+
+
 def interactive() -> bool:
     """Progress output only on a terminal."""
     return sys.stderr.isatty()

@@ -1,4 +1,4 @@
-"""armtransfer rooms: transfer between robots in the rooms world (the paper's grid robots by default)."""
+"""armtransfer rooms: transfer between robots in a world (the paper's grid robots in its rooms by default)."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ from armtransfer.io import check_distinct_outputs, check_writable, write_json_at
 from armtransfer.experiments import experiment
 
 from armtransfer.experiments.reports import report
-HELP = ("Transfer a trajectory between two grid robots of the paper's rooms world and print its "
-        "Table II-style table.")
+HELP = ("Transfer a trajectory between two grid robots in a world (the paper's rooms by default; --world: rooms11, "
+        "rooms15, generated:SEED or your layout file) and print its Table II-style table.")
 EXAMPLE = "armtransfer rooms --task 2 --trials 5"
 
 
@@ -33,6 +33,7 @@ def run(args: argparse.Namespace) -> int:
     total = experiment.count_trials(args.method, args.trials, not args.no_controls and args.learner == "sarsa")
     with common.progress_bar(total, "learning") as bar:
         result = api.transfer(args.source, args.target, progress=bar.update, **common.transfer_kwargs(args))
+    common.print_warnings(result)
     out = result.to_json()
     print_results(out)
     if args.json:

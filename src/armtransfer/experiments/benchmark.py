@@ -23,8 +23,7 @@ from __future__ import annotations
 
 import zlib
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
-from typing import cast
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -149,6 +148,8 @@ class Robots:
     """Robots by spec, each resolved (and, for an arm, compiled or loaded) once per run."""
 
     resolved: dict
+    worlds: dict = field(default_factory=dict)
+    """The worlds a suite carries (``Suite.layouts``), by id: a suite file's layout files."""
 
     def __call__(self, spec: str, world: str = suites.DEFAULT_WORLD) -> DiscreteRobot:
         key = benchmark_runs.robot_key(spec, world)
@@ -157,6 +158,8 @@ class Robots:
 
             if world == suites.DEFAULT_WORLD:
                 self.resolved[key] = resolve(spec)
+            elif world in self.worlds:
+                self.resolved[key] = resolve(spec, layout=self.worlds[world])
             else:
                 from armtransfer.worlds.resolve import world as layout_of
 
@@ -166,6 +169,10 @@ class Robots:
 
 def case_cells(case: suites.Case, source: DiscreteRobot, target: DiscreteRobot, seed: int, section: str,
                index: int, source_seed: int) -> tuple[int, int]:
+    if case.start is not None and case.goal is not None:
+        from armtransfer.tasks.catalog import custom_task
+
+        return custom_task(case.start, case.goal, target.layout).cells(target.layout)
     if case.task is not None:
         if case.world == suites.DEFAULT_WORLD:
             if isinstance(case.task, bool) or not isinstance(case.task, int):
@@ -224,10 +231,15 @@ class Pair:
                    learner: str = benchmark_runs.LEARNER) -> list[dict]:
         """Every trial run of the methods ``names`` by ``learner``, in (method, trial) order;
         without the source run's result, only those of the methods that read no trajectory."""
+        options = None
+        if learner != benchmark_runs.LEARNER:
+            from armtransfer.learning.learners import options_of
+
+            options = options_of(learner)
         return [benchmark_runs.trial_run(name, k, self.case.source, self.case.target, list(self.start),
                                          list(self.goal), self.case.wind, self.seed, self.config, source_result,
                                          learner=learner, world=self.case.world, state=self.case.state,
-                                         noise=self.case.noise)
+                                         noise=self.case.noise, learner_options=options)
                 for name in names if source_result is not None or not benchmark_runs.needs_trajectory(name)
                 for k in range(self.section.trials)]
 
@@ -268,6 +280,9 @@ def record(pair: Pair, name: str, source_result: dict, trials: list[dict]) -> di
         rec.update(first_exposure=[None] * n, converged=[False] * n, convergence_steps=[None] * n,
                    greedy_steps=[None] * n, episodes=[0] * n, area=[None] * n, curves=[])
         return rec
+    said = list(dict.fromkeys(w for t in trials for w in t.get("warnings") or ()))
+    if said:  # a potential of one's own that was squashed, constant or not 0 at the goal
+        rec["warnings"] = said
     rec.update({key: [t[field] for t in trials] for key, field in (
         ("first_exposure", "first_exposure"), ("converged", "converged"), ("convergence_steps", "convergence_steps"),
         ("greedy_steps", "greedy_steps"), ("episodes", "episodes"), ("area", "area"), ("curves", "curve"))})
@@ -344,24 +359,49 @@ class Plan:
         return sum(benchmark_runs.needs_trajectory(m) for _, ms in self.entries(pair) for m in ms) \
             * pair.section.trials
 
-    def records(self, result: Lookup) -> list[dict]:
+    def records(self, result: Lookup, failed: dict[str, str] | None = None) -> list[dict]:
         """One record per (section, case, source seed, method), in the plan's order, from the
-        runs' results; :class:`IncompleteError` when a run's result is not there."""
-        out, missing = [], 0
+        runs' results; :class:`IncompleteError` when a run's result is not there and it did not
+        fail. ``failed``: the runs that failed, by key (their first error line): a record one of
+        whose runs failed is left out (the statistics pair records by source seed, so the others
+        stay paired) and named in :meth:`failures`."""
+        return self._records(result, failed or {})[0]
+
+    def failures(self, result: Lookup, failed: dict[str, str]) -> list[dict]:
+        """The records :meth:`records` leaves out because a run of theirs failed: per (section,
+        case, source seed, method; ``source`` for robot 1's run) the runs that failed and the
+        first error, in the plan's order."""
+        return self._records(result, failed)[1]
+
+    def _records(self, result: Lookup, failed: dict[str, str]) -> tuple[list[dict], list[dict]]:
+        out, lost, missing = [], [], 0
+
+        def lose(pair: Pair, name: str, keys: list[str]) -> None:
+            lost.append({"section": pair.section.name, "case": pair.index, "label": pair.case.label,
+                         "source_seed": pair.source_seed, "method": name, "failed_runs": len(keys),
+                         "error": failed[keys[0]]})
+
         for pair in self.pairs:
-            source = result(pair.source_run())
+            src = pair.source_run()
+            source = result(src)
             if source is None:
-                missing += 1 + self.trials_of(pair)
+                if src["key"] in failed:  # the pair is left out: robot 1's run failed, and any that ran without it
+                    lose(pair, "source", [src["key"], *(run["key"] for run in self.all_trial_runs(pair, None)
+                                                        if run["key"] in failed)])
+                else:
+                    missing += 1 + self.trials_of(pair)
                 continue
             trials = [(run, result(run)) for run in self.all_trial_runs(pair, source)]
-            missing += sum(r is None for _, r in trials)
+            missing += sum(r is None and run["key"] not in failed for run, r in trials)
             for name in self.labels(pair):
-                mine = [r for run, r in trials if label(run["method"], run["learner"]) == name]
-                if all(r is not None for r in mine):
-                    out.append(record(pair, name, source, cast(list, mine)))
+                mine = [(run, r) for run, r in trials if label(run["method"], run["learner"]) == name]
+                if all(r is not None for _, r in mine):
+                    out.append(record(pair, name, source, [r for _, r in mine if r is not None]))
+                elif keys := [run["key"] for run, r in mine if r is None and run["key"] in failed]:
+                    lose(pair, name, keys)
         if missing:
             raise IncompleteError(f"{missing} of {self.size()} runs are not in yet", missing)
-        return out
+        return out, lost
 
     def timings(self, result: Lookup, seconds: Callable[[dict], float | None]) -> dict:
         """Each pair's seconds: its source run's and, per method, its trial runs' summed;
@@ -393,6 +433,7 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
     if ran is None:
         ran, missing = methods_to_run()
     robots = robots if robots is not None else Robots({})
+    robots.worlds.update(suite.layouts())
     pairs = []
     for section in suite.sections:
         outside = [lr for lr in (section.learners if learners is None else learners) if lr != benchmark_runs.LEARNER]
@@ -410,8 +451,11 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
                 except ArmTransferError as err:
                     raise InvalidParameterError(f"{case.label}: {err}") from None
             for j in range(section.source_seeds):
-                start, goal = case_cells(case, source, target, seed, section.name, ci, j)
-                source.start_state(start)
+                try:
+                    start, goal = case_cells(case, source, target, seed, section.name, ci, j)
+                    source.start_state(start)
+                except ArmTransferError as err:  # the case named, before anything runs
+                    raise InvalidTaskError(f"{case.label}: {err}") from None
                 if arm is not None and start not in placed:
                     try:
                         arm.place(start)
@@ -420,7 +464,9 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
                     placed.add(start)
                 path = target.shortest_path(target.start_state(start), goal)
                 if path is None:
-                    raise InvalidTaskError(f"{case.label}: {target.name} cannot reach the goal")
+                    from armtransfer.tasks.unreachable import hint
+
+                    raise InvalidTaskError(f"{case.label}: {target.name} cannot reach the goal{hint(target)}")
                 pairs.append(Pair(section, ci, case, j, run_seed(seed, section.name, ci, j), target.layout.xy(start),
                                   target.layout.xy(goal), len(path) - 1, learner))
     return Plan(suite, int(seed), tuple(ran), tuple(missing), tuple(pairs), preset,

@@ -28,6 +28,7 @@ the bytes of running them together.
 from __future__ import annotations
 
 import time
+import traceback
 from collections.abc import Callable
 
 from armtransfer.errors import ArmTransferError, PluginError
@@ -90,16 +91,21 @@ target's compiled table (every run written before continuous targets, with its k
 
 def trial_run(method: str, trial: int, source: str, target: str, start: list[int], goal: list[int], wind: float,
               seed: int, config: LearnerConfig, source_result: dict | None, learner: str = LEARNER,
-              world: str = DEFAULT_WORLD, state: str = "discrete", noise: float = 0.0) -> dict:
+              world: str = DEFAULT_WORLD, state: str = "discrete", noise: float = 0.0,
+              learner_options: dict | None = None) -> dict:
     """Trial ``trial`` of ``method`` on robot 2 (``target``). A method that reads the trajectory
     is handed ``source_result``'s (the result of the case's source run: its path, or why there
     is none); the others carry neither. Where robot 1 handed nothing over, the run also names
     ``told_nothing``: the method's baseline, which the trial then runs (:func:`trial_result`).
     ``state`` ``continuous``: robot 2 is ``target``'s continuous arm with actuation noise
-    ``noise`` (the run names both; a discrete run names neither, keeping its key)."""
+    ``noise`` (the run names both; a discrete run names neither, keeping its key).
+    ``learner_options``: an outside learner's own settings (``Learner.options``), in the run's
+    configuration and so its key (none: the key it had before learners had options)."""
     run = {"format": TRIAL_FORMAT, "learner": learner, "method": method, "trial": int(trial), "source": source,
            "target": target, "start": list(start), "goal": list(goal), "wind": wind, "seed": int(seed),
            "config": config.to_dict()}
+    if learner_options:
+        run["learner_options"] = dict(learner_options)
     _in_world(run, world)
     if state == CONTINUOUS:
         run["state"], run["noise"] = CONTINUOUS, float(noise)
@@ -167,7 +173,7 @@ def _fields(res: experiment.MethodResult) -> dict:
     return {"error": None, "first_exposure": t.exploration_steps, "converged": bool(t.converged),
             "convergence_steps": t.total_steps if t.converged else None, "greedy_steps": t.greedy_steps,
             "episodes": int(t.episodes), "area": float(curve.sum()), "curve": [float(v) for v in curve],
-            "K": res.extra.get("K")}
+            "K": res.extra.get("K"), **({"warnings": res.extra["warnings"]} if res.extra.get("warnings") else {})}
 
 
 def _continuous_trial(run: dict, target: DiscreteRobot) -> dict:
@@ -205,8 +211,32 @@ refuses the case: recorded as the run's ``error``). A learner not here, of
 ``armtransfer.learning.learners.LEARNERS`` (a plugin's), runs through ``learner_trial``."""
 
 
+class RunFailed(ArmTransferError):
+    """A run that raised: the first line of the message says what, the rest is the traceback
+    (the store keeps it beside the failure, ``ResultStore.write_failure``)."""
+
+
+def with_traceback(err: BaseException) -> str:
+    """``err`` in one line, then its traceback: that of the exception it was raised from or
+    while handling first (a plugin's own fault, which the one-line error names), then its own."""
+    first = (str(err) if isinstance(err, ArmTransferError) else f"{type(err).__name__}: {err}").splitlines()
+    inner = err.__cause__ or err.__context__
+    parts = [] if inner is None else traceback.format_exception(inner)
+    parts += traceback.format_exception(err, chain=False)
+    return (first[0] if first else type(err).__name__) + "\n" + "".join(parts)
+
+
+def execute_recorded(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
+    """:func:`execute` as a benchmark's workers run it: a run that raises is :class:`RunFailed`,
+    its message carrying the traceback, which the store keeps beside the failure."""
+    try:
+        return execute(run, robots)
+    except Exception as err:  # noqa: BLE001 - a failed run, its traceback kept for the store
+        raise RunFailed(with_traceback(err)) from None
+
+
 def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
-    """(result, seconds) of one benchmark run; what a worker runs (``robots``: by spec)."""
+    """(result, seconds) of one benchmark run (``robots``: by spec); what it raises propagates."""
     t0 = time.perf_counter()
     if run["format"] == SOURCE_FORMAT:
         source = robots[robot_key(run["source"], run.get("world"))]

@@ -217,6 +217,8 @@ def run_method(
                             trials, threads, on_trial)
     if made is not None:
         out.extra["K"] = made.K
+        if made.notes:
+            out.extra["warnings"] = list(made.notes)
     return out
 
 

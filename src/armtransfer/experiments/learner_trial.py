@@ -238,7 +238,7 @@ def trial(learner: Learner, run: dict, target: DiscreteRobot,
         raise ArmTransferError(f"{target.name} cannot reach the goal")
     optimal = max(len(path) - 1, 1)
     cap, good = EVAL_CAP * optimal, (1 + TOLERANCE) * optimal
-    model = _call(said, "make", learner.make, env, model_seed)
+    model = _call(said, "make", learner.make, env, model_seed, *handed(learner, run["method"], target, trajectory, term))
     chunk = max(budget // CHUNKS, 1)
     evals: list[list[int | None]] = []
     converged_at: int | None = None
@@ -276,6 +276,20 @@ def _say(line: str) -> None:
     tqdm.write(line, file=sys.stderr)
 
 
+def handed(learner: Learner, method: str, target: DiscreteRobot, trajectory: Trajectory | list[Trajectory] | None,
+           term: TransferReward | None) -> tuple:
+    """``make``'s arguments after (env, seed): the :class:`~armtransfer.learning.learners.Transfer`
+    for a learner that asks for it (``Learner.transfer``), else none."""
+    if not learner.transfer:
+        return ()
+    from armtransfer.learning.learners import Transfer
+    from armtransfer.learning.plugins import trajectory_xy
+
+    trajs = [] if trajectory is None else trajectory if isinstance(trajectory, list) else [trajectory]
+    return (Transfer(method, tuple(trajectory_xy(t, target) for t in trajs),
+                     None if term is None else term.transfer.shaping),)
+
+
 def probe(learner: Learner, target: DiscreteRobot, start: list[int], goal: list[int],
           seconds: float = plugin_calls.PROBE_SECONDS) -> None:
     """``learner`` made on the case's environment (no reward term), learning :data:`PROBE_STEPS`
@@ -290,7 +304,7 @@ def probe(learner: Learner, target: DiscreteRobot, start: list[int], goal: list[
         env = Monitor(gym.wrappers.TimeLimit(case_env(target, start, goal, 0.0, config),
                                              max_episode_steps=MAX_EPISODE_STEPS), said)
         env.reset(seed=0)
-        model = _call(said, "make", learner.make, env, 0)
+        model = _call(said, "make", learner.make, env, 0, *handed(learner, "none", target, None, None))
         if model is None or not all(callable(getattr(model, m, None)) for m in ("learn", "predict")):
             raise PluginError(f"{said}: its make returned {type(model).__name__}, not a model with learn and predict")
         _call_method(said, model, "learn", PROBE_STEPS)

@@ -241,8 +241,13 @@ class ResultStore:
         (self.failed_dir / f"{key}.json").unlink(missing_ok=True)
 
     def write_failure(self, run: dict, error: str, attempts: int) -> None:
-        write_json_atomic(self.failed_dir / f"{run['key']}.json",
-                          {"key": run["key"], "config": run, "error": error, "attempts": attempts})
+        """Record that ``run`` failed: ``error``'s first line, and the rest (a traceback, when the
+        worker sent one) under ``traceback``."""
+        first, _, rest = error.partition("\n")
+        record = {"key": run["key"], "config": run, "error": first, "attempts": attempts}
+        if rest.strip():
+            record["traceback"] = rest
+        write_json_atomic(self.failed_dir / f"{run['key']}.json", record)
 
     def records(self) -> list[dict]:
         """Every finished run, sorted by key (so summaries do not depend on finishing order)."""

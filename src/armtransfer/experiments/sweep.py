@@ -323,6 +323,9 @@ def _learners(body: dict, spec: dict, where: str) -> None:
                 raise SweepFileError(f"{where}: {err}") from None
     if names != [SARSA]:
         spec["learner"] = names
+    options = {n: learners.options_of(n) for n in outside if learners.options_of(n)}
+    if options:  # a learner's own settings key its runs and the store (a learner without them: the keys it had)
+        spec["learner_options"] = options
     if "max_total_steps" in body:
         spec["max_total_steps"] = _check_number(f"{where}: max_total_steps", body["max_total_steps"], 1,
                                                 LearnerConfig.__dataclass_fields__["max_total_steps"].metadata["hi"],
@@ -340,18 +343,23 @@ def check_stored(spec: object, where: str) -> dict:
     form; else ``SweepFileError``, one line naming ``where`` and the field."""
     if not isinstance(spec, dict):
         raise SweepFileError(f"{where}: field 'spec' " + ("is missing" if spec is None else f"must be a table, got {type(spec).__name__}"))
-    optional = {*_OPTIONAL, "preset"}  # written only when not the default (the default keeps the old key)
+    optional = {*_OPTIONAL, "preset", "learner_options"}  # written only when not the default (the old key)
     keys = {*_SCALARS, *_AXES, "arms"} - optional
     for key in sorted(keys - set(spec)):
         raise SweepFileError(f"{where}: field 'spec' has no {key!r}")
     for key in sorted(set(spec) - keys - optional, key=str):
         raise SweepFileError(f"{where}: field 'spec' has an unknown key {key!r}; valid keys: "
                              f"{', '.join(sorted(keys | optional))}")
-    body = {k: v for k, v in spec.items() if k != "arms"}  # a world is stored as its layout's data
+    # a world is stored as its layout's data; learner_options are the installed learners' (compared below)
+    body = {k: v for k, v in spec.items() if k not in ("arms", "learner_options")}
     if isinstance(spec["start_goal"], list):  # stored as cells; a sweep file writes "X,Y"
         body["start_goal"] = [[f"{c[0]},{c[1]}" if isinstance(c, list) and len(c) == 2 else c for c in sg]
                               if isinstance(sg, list) else sg for sg in spec["start_goal"]]
     again = normalise({"sweep": body, "arms": spec["arms"]}, f"{where}: field 'spec'", max_runs=2**62)
+    if json.dumps(again.get("learner_options")) != json.dumps(spec.get("learner_options")):
+        raise SweepFileError(f"{where}: its runs' learners had the options {spec.get('learner_options') or {}!r:.120}, "
+                             f"the installed ones have {again.get('learner_options') or {}!r:.120}: a store holds one "
+                             "learner's settings; choose a new --out, or install the learner as it was")
     for key in sorted(optional & set(spec)):
         if json.dumps(again.get(key)) != json.dumps(spec[key]):
             raise SweepFileError(f"{where}: field 'spec': {key} is not as a sweep writes it ({spec[key]!r:.80})")
@@ -429,6 +437,8 @@ def expand(spec: dict) -> list[dict]:
             run["max_total_steps"] = spec["max_total_steps"]
         if learner != SARSA:  # sarsa's runs keep the keys they had before learners
             run["learner"] = learner
+            if spec.get("learner_options", {}).get(learner):
+                run["learner_options"] = spec["learner_options"][learner]
         used = {p.partition(":")[0] for p in pair} & set(spec.get("arms", {}))
         if used:  # a named arm's definition is part of the run (and of its key)
             run["arms"] = {name: spec["arms"][name] for name in sorted(used)}

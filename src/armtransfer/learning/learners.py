@@ -26,8 +26,8 @@ benchmark runs it directly, not through ``make``.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
 from dataclasses import replace as with_fields
 from typing import Any, Protocol
 
@@ -60,15 +60,37 @@ class Model(Protocol):
 
 
 @dataclass(frozen=True)
+class Transfer:
+    """What a learner with ``Learner.transfer`` is handed beside its environment: the method of
+    the trial, robot 1's trajectories as (x, y) cells (each an (m, 2) int64 array, its start
+    first and its goal last; none for a method that reads none or when robot 1 handed nothing
+    over), and the shaping the method built for this robot (``learning.shaping.Shaping``: its
+    ``phi`` per state for a potential method, bounded as the kernel's; None for ``none``). The
+    environment already pays the method's reward term; a learner may use these to carry its own
+    transfer (an initial Q, an exploration bias)."""
+
+    method: str
+    trajectories: tuple
+    shaping: Any = None
+
+
+@dataclass(frozen=True)
 class Learner:
     """A learner: ``make(env, seed)`` is a :class:`Model` learning on ``env``, every random draw
-    of it from ``seed``."""
+    of it from ``seed``.
+
+    ``options``: the settings ``make`` uses (a JSON-able mapping, e.g. ``{"alpha": 0.5}``): they
+    are in each of its benchmark runs' configuration and key, so a changed option runs anew
+    instead of resuming the old runs. ``transfer``: ``make`` is called ``make(env, seed,
+    transfer)`` with the trial's :class:`Transfer`."""
 
     name: str
     description: str
-    make: Callable[[gymnasium.Env, int], Model]
+    make: Callable[..., Model]
     origin: str = RUN_TIME
     """Where it comes from: ``armtransfer``, an installed plugin (named), or registered at run time."""
+    options: Mapping[str, Any] | None = field(default=None, hash=False)  # a dict: a Learner stays hashable
+    transfer: bool = False
 
 
 def _sarsa_make(env: gymnasium.Env, seed: int) -> Model:
@@ -98,7 +120,27 @@ def check(learner: object, where: str) -> Learner:
     if not callable(learner.make):
         raise PluginError(f"{where}: learner {learner.name!r}: make must be a function (env, seed) -> model, "
                           f"got {learner.make!r}")
+    if learner.options is not None:
+        import json
+
+        try:
+            if not isinstance(learner.options, Mapping) or not all(isinstance(k, str) for k in learner.options):
+                raise TypeError("not a mapping of names")
+            json.dumps(dict(learner.options), allow_nan=False)
+        except (TypeError, ValueError) as err:
+            raise PluginError(f"{where}: learner {learner.name!r}: options must be a mapping of names to JSON "
+                              f"values (numbers, strings, lists), got {learner.options!r:.80} ({err})") from None
+    if not isinstance(learner.transfer, bool):
+        raise PluginError(f"{where}: learner {learner.name!r}: transfer must be True or False")
     return learner
+
+
+def options_of(name: str) -> dict | None:
+    """The options of learner ``name`` as its runs record them (None: it has none)."""
+    if name in BUILTIN:
+        return None
+    opts = get(name).options
+    return dict(opts) if opts else None
 
 
 def load_entry_points(registry: Registry[Learner]) -> None:

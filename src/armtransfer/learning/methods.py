@@ -287,7 +287,11 @@ def build_shaping(
     sh = build(robot, trajs, k, potentials.DENSE_BETA if beta is None else float(beta))
     _check_scaled(m.name, k, sh)
     if sh.mode == modes.MODE_POTENTIAL:
-        sh = replace(sh, phi=potentials.bounded(sh.phi, gamma, step_reward))
+        said: tuple[str, ...] = ()
+        if m.origin != "armtransfer" and trajs:  # a potential of one's own says what happened to it
+            goal = np.isin(robot.label % robot.layout.n_cells, [t.goal % robot.layout.n_cells for t in trajs])
+            said = tuple(potentials.notes(m.name, sh.phi, goal, gamma, step_reward))
+        sh = replace(sh, phi=potentials.bounded(sh.phi, gamma, step_reward), notes=said)
     return sh
 
 

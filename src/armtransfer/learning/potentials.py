@@ -79,6 +79,40 @@ def bounded(phi: np.ndarray, gamma: float, step_reward: float, margin: float = L
     return np.where(phi < 0.0, -b * np.tanh(-np.minimum(phi, 0.0) / b), phi)
 
 
+SQUASH_SHARE = 0.25
+"""A potential of one's own below -B on more than this share of the states is said to be
+squashed (:func:`notes`): the bound flattens its differences there."""
+
+
+def bound(gamma: float, step_reward: float, margin: float = LOOP_MARGIN) -> float:
+    """B of :func:`bounded`: 35 with the default step reward -1 and discount 0.99 (inf with gamma 1)."""
+    return float("inf") if gamma >= 1.0 else margin * -step_reward / (1.0 - gamma)
+
+
+def notes(name: str, phi: np.ndarray, at_goal: np.ndarray, gamma: float, step_reward: float,
+          share: float = SQUASH_SHARE) -> list[str]:
+    """What happened to method ``name``'s potential ``phi`` (before :func:`bounded`), one line
+    each: below -B on more than ``share`` of the states (squashed); the same on every state
+    (it shapes nothing); not 0 on the goal's states ``at_goal`` (a bool mask; the kernel counts
+    the goal as 0, so entering it pays -phi(s) on top of the step)."""
+    phi = np.asarray(phi, dtype=np.float64)
+    out = []
+    b = bound(gamma, step_reward)
+    if len(phi) and float(np.ptp(phi)) == 0.0:
+        out.append(f"method {name!r}: its potential is {phi[0]:g} on every one of the {len(phi)} states, so it shapes "
+                   "nothing (it learns as none)")
+    elif np.isfinite(b) and (low := float(np.mean(phi < -b))) > share:
+        out.append(f"method {name!r}: its potential is below -B = -{b:g} on {low:.0%} of the {len(phi)} states, "
+                   f"where every potential is squashed into (-B, 0] by -B*tanh(-phi/B), flattening its differences; "
+                   "scale it down (docs/extending.md)")
+    if at_goal.any() and float(np.max(np.abs(phi[at_goal]))) > 1e-9:
+        value = float(phi[at_goal][np.argmax(np.abs(phi[at_goal]))])
+        out.append(f"method {name!r}: its potential is {value:g}, not 0, at the goal, which the kernel counts as 0: "
+                   f"every move into the goal is shaped by about {-value:g}; subtract the goal's value "
+                   "(docs/extending.md)")
+    return out
+
+
 def _label_xy(robot: DiscreteRobot, layout: Layout) -> np.ndarray:
     return layout.xy_of(robot.label % layout.n_cells).astype(np.float64)  # a voxel label: the cell under it
 

@@ -34,6 +34,9 @@ class Shaping:
     guide: object | None = None
     """Optional ``armtransfer.learning.guide.Guide``: a model of robot 2's own actions that
     breaks the ties of epsilon-greedy (method ``guided``); None: ties are broken at random."""
+    notes: tuple[str, ...] = ()
+    """What happened to a potential of one's own as it was built (``potentials.notes``: squashed,
+    constant, not 0 at the goal), one line each; empty for the built-in methods."""
 
     @staticmethod
     def potential(phi: np.ndarray, K: float = 0.0) -> "Shaping":

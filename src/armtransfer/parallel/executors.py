@@ -240,7 +240,10 @@ def run_ray(
                     result, secs = ray.get(ref)
                 except Exception as err:  # noqa: BLE001 - recorded, not lost
                     cause = getattr(err, "cause", None) or err
-                    on_failed(run, f"{type(cause).__name__}: {cause}".splitlines()[0], retries + 1)
+                    # a benchmark run's failure is its one line, then its traceback (the store keeps both)
+                    said = str(cause) if "\nTraceback" in str(cause) else \
+                        f"{type(cause).__name__}: {cause}".splitlines()[0]
+                    on_failed(run, said, retries + 1)
                     continue
                 not_done += [submit(more) for more in on_done(run, result, secs) or ()]
     finally:

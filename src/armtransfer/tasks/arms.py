@@ -43,6 +43,11 @@ COVERS = 0.95
 cell reached) is taken without trying mounts on the table."""
 
 
+class NotCached(Exception):
+    """An arm asked for ``only_cached`` that the cache does not hold (no user error: the caller's
+    signal to show it as not compiled)."""
+
+
 def parse_robot_spec(spec: str) -> tuple[str, str]:
     """'planar2:joint' -> ('planar2', 'joint'); the action model defaults to the arm's first."""
     arm, _, actions = spec.partition(":")
@@ -177,7 +182,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
               tip_body: str | None = None, tip_offset=None, arm_name: str | None = None,
               base_pos: tuple[float, float, float] | None = None, base_yaw: float | None = None,
               joint_step: float | None = None, tip_down: bool | None = None, layout: Layout = ROOMS,
-              cache: bool = True, progress: bool = False, tool=None) -> DiscreteRobot:
+              cache: bool = True, progress: bool = False, tool=None, only_cached: bool = False) -> DiscreteRobot:
     """Compile (or load from the cache) the discrete robot of an arm and action model.
 
     Built-in arms are named by ``arm``. A bring-your-own arm is the MJCF file ``xml_path``
@@ -189,7 +194,8 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
     bring-your-own arm keeps its tool pointing down unless ``tip_down=False``. ``tool`` puts a
     pen in the hand, ``"stylus[:LENGTH[:RADIUS]]"`` (metres; see ``ik.tool.Stylus``), for any arm
     whose tool is kept pointing down; the cell is read at the pen's end. The cell size is the
-    world's (``ik.workspace.world_cell``: 1 cm on the rooms) unless given.
+    world's (``ik.workspace.world_cell``: 1 cm on the rooms) unless given. ``only_cached``: load
+    it from the cache or raise :class:`NotCached`, never compile (``arms list``'s listing).
     """
     model = action_model(actions)
     stylus = parse_held(tool) if tool is not None else None
@@ -268,7 +274,12 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
             print(f"compiling {robot_name} ...", file=sys.stderr, flush=True)
         return _compile(_scene(path, tool, mount, yaw, cell_size, layout), model, tip_down, step, progress, spatial)
 
-    if not cache:
+    if only_cached:
+        loaded = _cache.load(robot_name, key, _arrays_check(layout, _levels(spatial)))[0] if cache else None
+        if loaded is None:
+            raise NotCached(f"robot {robot_name} is not in the arm cache")
+        arrays, status = loaded, "hit"
+    elif not cache:
         arrays = build()
     else:
         _check_cache_dir()

@@ -184,15 +184,27 @@ def write_figures(summary: dict, suite: suites.Suite, out: Path) -> None:
                            f"{section.name}: learning curves", out / curves_name(section.name))
 
 
-def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str], missing: list[str]) -> str:
+def record_warnings(records: list[dict]) -> list[str]:
+    """Every distinct warning of the records (a potential of one's own squashed, constant or not
+    0 at the goal: ``potentials.notes``), in order."""
+    return list(dict.fromkeys(w for r in records for w in r.get("warnings") or ()))
+
+
+def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str], missing: list[str],
+                    failures: list[dict] | None = None, warnings: list[str] | None = None) -> str:
     from armtransfer.experiments.benchmark import baselines_of, registered_baseline
 
     from armtransfer.experiments.benchmark import parse_label
 
     kind = ("held out: no parameter of any method was chosen on it" if suite.held_out
             else "not held out: parameters may be chosen on it")
+    worlds = list(dict.fromkeys(c.world.partition("#")[0] for sec in suite.sections for c in sec.cases))
+    on = f", on the world{'s' * (len(worlds) > 1)} " + ", ".join(f"`{w}`" for w in worlds) if worlds else ""
+    made = (f"Made by `armtransfer benchmark --suite {suite.name} --seed {seed}`." if suite.name in suites.SUITES else
+            f"Made by `armtransfer benchmark --suite FILE --seed {seed}` from the suite file of `{suite.name}` (its "
+            f"whole definition is in results.json){on}.")
     out = [f"# Benchmark `{suite.name}` (version {suite.version})", "",
-           f"Made by `armtransfer benchmark --suite {suite.name} --seed {seed}`. {suite.description}; {kind}.", "",
+           f"{made} {suite.description}; {kind}.", "",
            "## Methods and their baselines", "",
            "Every method's gain is measured against the baseline that shares its learner and differs only "
            "in what is transferred; each baseline is run beside it on the same random streams.", ""]
@@ -212,6 +224,17 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
                 "shortest path, its steps those at the first of them; otherwise censored at the cap."]
     if missing:
         out += ["", f"Not in this build's method registry, so not run: {', '.join(missing)}."]
+    if warnings:
+        out += ["", "## Warnings", "", *(f"- {w}" for w in warnings)]
+    if failures:
+        out += ["", "## Runs that failed", "",
+                f"{sum(f['failed_runs'] for f in failures)} runs failed, so the records below are left out of "
+                "everything that follows (method `source`: robot 1's run failed, so every method of that case and "
+                "source seed); each method is paired with its baseline over the source seeds both have. The store's "
+                "`failed/` keeps each run's traceback, and running the same command again retries them.", ""]
+        out.append(markdown_table(["section", "case", "source seed", "method", "runs failed", "first error"],
+                                  [[f["section"], f["label"], str(f["source_seed"]), f["method"],
+                                    str(f["failed_runs"]), f["error"].replace("|", "\\|")] for f in failures]))
     out += ["", "## Claims", ""]
     for section in suite.sections:
         for name, against in summary[section.name]["pooled"].items():
