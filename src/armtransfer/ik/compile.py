@@ -38,10 +38,11 @@ import numpy as np
 
 from armtransfer.errors import ArmModelError, UnreachableTableError
 from armtransfer.ik.labels import OFF_TABLE, cells_of_xy
-from armtransfer.ik.scene import ArmScene, ContactChecker
+from armtransfer.ik.scene import ArmScene, ContactChecker, _support
 from armtransfer.ik.diagnose import why_unreachable
 from armtransfer.ik.seeds import RING, SEED_RESTARTS, _cells_by_distance, reach_bound, seed_cells  # noqa: F401
 from armtransfer.ik.solve import MAX_TIP_HEIGHT, TIP_HEIGHT, TipIK
+from armtransfer.ik.sweep import SweepChecker
 
 
 def near_wall_mask(layout) -> np.ndarray:
@@ -53,6 +54,56 @@ def near_wall_mask(layout) -> np.ndarray:
         for dx in (-1, 0, 1):
             near |= pad[1 + dy:1 + dy + w.shape[0], 1 + dx:1 + dx + w.shape[1]]
     return near.reshape(-1)
+
+
+def near_wall_cells(layout, k: int) -> np.ndarray:
+    """Boolean over cell ids: a wall cell or a cell within ``k`` cells of one (along x and y)."""
+    w = layout.wall_mask
+    pad = np.pad(w, k)
+    near = np.zeros_like(w)
+    for dy in range(-k, k + 1):
+        for dx in range(-k, k + 1):
+            near |= pad[k + dy:k + dy + w.shape[0], k + dx:k + dx + w.shape[1]]
+    return near.reshape(-1)
+
+
+def wall_reach(scene: ArmScene, contact: ContactChecker) -> tuple[np.ndarray, bool]:
+    """(the cells over which a planar arm's tip may bring its geometry into a wall, whether it
+    may anywhere). Only geoms that reach below the walls' tops can meet them; a planar arm's
+    heights never change. Those rigid with the tool point reach at most their horizontal
+    extent from it: the cells within that (plus the three quarters of a cell a tip sampled
+    every half cell may be from the samples' cells) of a wall. Any other such geom, or geoms
+    of the arm that may collide with each other, make every cell count."""
+    m = scene.model
+    data = mujoco.MjData(m)
+    data.qpos[:] = scene.home
+    mujoco.mj_kinematics(m, data)
+    walls = np.flatnonzero(contact.walls)
+    if contact.can_self_collide:
+        return np.ones(scene.layout.n_cells, dtype=bool), True
+    if len(walls) == 0:
+        return np.zeros(scene.layout.n_cells, dtype=bool), False
+    up, down = np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, -1.0])
+    top = float(max(data.geom_xpos[w, 2] + _support(m, data, int(w), up) for w in walls))
+    tip = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, scene.tip)
+    tool_weld = m.body_weldid[m.site_bodyid[tip]]
+    point = data.site_xpos[tip]
+    hits = np.zeros(m.ngeom, dtype=bool)
+    for w in walls:
+        hits |= ((m.geom_contype & m.geom_conaffinity[w]) | (m.geom_conaffinity & m.geom_contype[w])) != 0
+    extent = 0.0
+    for g in np.flatnonzero(hits & scene.arm_geoms):
+        if data.geom_xpos[g, 2] - _support(m, data, int(g), down) >= top:
+            continue  # rides above the walls
+        if m.body_weldid[m.geom_bodyid[g]] != tool_weld:
+            return np.ones(scene.layout.n_cells, dtype=bool), True
+        # a support function is sublinear: along any horizontal direction at most sqrt(2) times
+        # the largest along +-x, +-y
+        side = max(_support(m, data, int(g), np.array(u, dtype=float))
+                   for u in ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0)))
+        extent = max(extent, float(np.linalg.norm(data.geom_xpos[g, :2] - point[:2]) + np.sqrt(2.0) * side))
+    k = max(1, int(np.ceil(extent / scene.cell + 0.75)))
+    return near_wall_cells(scene.layout, k), False
 
 
 def _progress(enabled: bool, text: str) -> None:
@@ -100,6 +151,7 @@ def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = 
     free = layout.free
     ik = TipIK(scene, tip_down)
     contact = ContactChecker(scene)
+    sweep = SweepChecker(scene, contact)
 
     home_tip = ik.configuration
     home_tip.update(scene.home)
@@ -165,7 +217,7 @@ def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = 
             return s
         key = (min(s, t), max(s, t))
         if key not in checked:
-            checked[key] = _segment_clear(contact, qpos[s], qpos[t], np.array([x, y]) * cell,
+            checked[key] = _segment_clear(contact, sweep, qpos[s], qpos[t], np.array([x, y]) * cell,
                                           np.array([x + dx * steps, y + dy * steps]) * cell,
                                           3 * steps, cell, layout)
         return t if checked[key] else s
@@ -183,20 +235,19 @@ def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = 
                 canonical=canonical, qpos=qpos, tip=tips)
 
 
-def _segment_clear(contact: ContactChecker, qa, qb, pa, pb, n_points: int, cell, layout) -> bool:
+def _segment_clear(contact: ContactChecker, sweep: SweepChecker, qa, qb, pa, pb, n_points: int, cell,
+                   layout) -> bool:
     d = pb - pa
     length2 = float(d @ d)
     for t in np.linspace(0.0, 1.0, n_points + 2)[1:-1]:
-        hit, tip = contact.touches_and_tip(qa + (qb - qa) * t)
-        if hit:
-            return False
+        tip = contact.tip(qa + (qb - qa) * t)
         c = int(cells_of_xy(tip, cell, layout))
         if c == OFF_TABLE or not layout.free[c]:
             return False
         u = np.clip(((tip[:2] - pa) @ d) / length2, 0.0, 1.0)
         if np.linalg.norm(tip[:2] - (pa + u * d)) > 0.75 * cell:
             return False
-    return True
+    return sweep.clear(qa, qb)
 
 
 # --------------------------------------------------------------------------- joint lattice
@@ -310,7 +361,8 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
     fk = PlanarFK(scene)
     contact = ContactChecker(scene)
     free = layout.free
-    near = near_wall_mask(layout)
+    sweep = SweepChecker(scene, contact)
+    near, everywhere = wall_reach(scene, contact)
     _check_tip_height(scene, fk.tip_z)
     home = _lattice_origin(scene, fk)
     dof = len(home)
@@ -327,7 +379,7 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
     Q = home + (grids + n_lo) * step
     cells = cells_of_xy(fk.tip(Q), cell, layout)
     valid = (cells >= 0) & free[np.maximum(cells, 0)]
-    ask = np.ones(total, dtype=bool) if contact.can_self_collide else near[np.maximum(cells, 0)]
+    ask = np.ones(total, dtype=bool) if everywhere else near[np.maximum(cells, 0)]
     check = np.flatnonzero(valid & ask)
     for i in check:
         if contact.touches(Q[i]):
@@ -351,14 +403,10 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
             inside = c >= 0
             ok &= inside & free[np.maximum(c, 0)]
             near_any |= inside & near[np.maximum(c, 0)]
-        probe = ts[np.unique(np.linspace(0, m - 1, min(m, 3)).round().astype(int))]
-        for e in np.flatnonzero(ok & (near_any | contact.can_self_collide)):
-            for t in probe:
-                q = Q[idx[e]].copy()
-                q[j] += t * step
-                if contact.touches(q):
-                    ok[e] = False
-                    break
+        for e in np.flatnonzero(ok & (near_any | everywhere)):
+            q = Q[idx[e]]
+            if not sweep.clear(q, Q[idx[e] + strides[j]]):
+                ok[e] = False
         plus[idx[ok], j] = idx[ok] + strides[j]
 
     # Breadth-first search from home over the valid edges.
