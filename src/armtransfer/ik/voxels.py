@@ -187,7 +187,7 @@ def compile_spatial_joint(scene: ArmScene, step: float | None, progress: bool = 
                 if t >= 0:
                     pair = (min(s, t), max(s, t))
                     if pair not in clear:
-                        clear[pair] = _move_clear(sweep, fk, qs[s], qs[t], tips[s], tips[t], cell, vox)
+                        clear[pair] = _swept_clear(sweep, fk, qs[s], qs[t], tips[s], tips[t], cell, vox)
                     if clear[pair]:
                         edges.append((s, a, t))
                 continue
@@ -198,7 +198,7 @@ def compile_spatial_joint(scene: ArmScene, step: float | None, progress: bool = 
             if v < 0:
                 index[nidx] = -1
                 continue
-            if not _move_clear(sweep, fk, qs[s], q, tips[s], tip, cell, vox):
+            if not _swept_clear(sweep, fk, qs[s], q, tips[s], tip, cell, vox):
                 continue  # this move is blocked; the point may still be reached another way
             clear[(s, len(qs))] = True
             index[nidx] = len(qs)
@@ -250,7 +250,19 @@ def _centres(label: np.ndarray, vox: Voxels, cell: float) -> np.ndarray:
     return np.column_stack([xy, z])
 
 
-def _move_clear(sweep: SweepChecker, fk: SpatialFK, qa, qb, pa, pb, cell: float, vox: Voxels) -> bool:
+def _move_clear(contact: ContactChecker, fk: SpatialFK, qa, qb, pa, pb, cell: float, vox: Voxels) -> bool:
+    """The straight joint move qa -> qb: at points at most half a cell of tool travel apart,
+    the tool in a free voxel and no contact (the ends are checked by the caller)."""
+    m = max(1, int(math.ceil(2.0 * float(np.linalg.norm(np.asarray(pb) - np.asarray(pa))) / cell)))
+    for t in np.arange(1, m + 1) / (m + 1):
+        hit, tip = contact.touches_and_tip(qa + (qb - qa) * t)
+        v = voxel_of_point(tip, cell, vox)
+        if hit or v < 0 or not vox.free[v]:
+            return False
+    return True
+
+
+def _swept_clear(sweep: SweepChecker, fk: SpatialFK, qa, qb, pa, pb, cell: float, vox: Voxels) -> bool:
     """The straight joint move qa -> qb: at points at most half a cell of tool travel apart,
     the tool in a free voxel (the ends are checked by the caller), and no contact anywhere
     along it (``ik.sweep``)."""
