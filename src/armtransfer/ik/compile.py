@@ -31,6 +31,7 @@ nearest to the joint step a Jacobian step predicts (blocked when none is).
 from __future__ import annotations
 
 import itertools
+import math
 from collections import deque
 
 import mujoco
@@ -67,9 +68,9 @@ def near_wall_cells(layout, k: int) -> np.ndarray:
     return near.reshape(-1)
 
 
-def wall_reach(scene: ArmScene, contact: ContactChecker) -> tuple[np.ndarray, bool]:
+def wall_reach(scene: ArmScene, contact: ContactChecker) -> tuple[np.ndarray, bool, float]:
     """(the cells over which a planar arm's tip may bring its geometry into a wall, whether it
-    may anywhere). Only geoms that reach below the walls' tops can meet them; a planar arm's
+    may anywhere, how far (m) across the table that geometry reaches from the tool point). Only geoms that reach below the walls' tops can meet them; a planar arm's
     heights never change. Those rigid with the tool point reach at most their horizontal
     extent from it: the cells within that (plus the three quarters of a cell a tip sampled
     every half cell may be from the samples' cells) of a wall. Any other such geom, or geoms
@@ -80,9 +81,9 @@ def wall_reach(scene: ArmScene, contact: ContactChecker) -> tuple[np.ndarray, bo
     mujoco.mj_kinematics(m, data)
     walls = np.flatnonzero(contact.walls)
     if contact.can_self_collide:
-        return np.ones(scene.layout.n_cells, dtype=bool), True
+        return np.ones(scene.layout.n_cells, dtype=bool), True, np.inf
     if len(walls) == 0:
-        return np.zeros(scene.layout.n_cells, dtype=bool), False
+        return np.zeros(scene.layout.n_cells, dtype=bool), False, 0.0
     up, down = np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, -1.0])
     top = float(max(data.geom_xpos[w, 2] + _support(m, data, int(w), up) for w in walls))
     tip = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, scene.tip)
@@ -96,14 +97,38 @@ def wall_reach(scene: ArmScene, contact: ContactChecker) -> tuple[np.ndarray, bo
         if data.geom_xpos[g, 2] - _support(m, data, int(g), down) >= top:
             continue  # rides above the walls
         if m.body_weldid[m.geom_bodyid[g]] != tool_weld:
-            return np.ones(scene.layout.n_cells, dtype=bool), True
-        # a support function is sublinear: along any horizontal direction at most sqrt(2) times
-        # the largest along +-x, +-y
-        side = max(_support(m, data, int(g), np.array(u, dtype=float))
-                   for u in ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0)))
-        extent = max(extent, float(np.linalg.norm(data.geom_xpos[g, :2] - point[:2]) + np.sqrt(2.0) * side))
+            return np.ones(scene.layout.n_cells, dtype=bool), True, np.inf
+        if m.geom_type[g] in (mujoco.mjtGeom.mjGEOM_SPHERE, mujoco.mjtGeom.mjGEOM_CAPSULE,
+                              mujoco.mjtGeom.mjGEOM_CYLINDER):  # its radius, and its half length as it tilts
+            tilt = float(data.geom_xmat[g].reshape(3, 3)[2, 2])
+            half = 0.0 if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_SPHERE else float(m.geom_size[g, 1])
+            side = float(m.geom_size[g, 0]) + half * math.sqrt(max(0.0, 1.0 - tilt * tilt))
+        else:  # a support function is sublinear: along any horizontal direction at most sqrt(2)
+            # times the largest along +-x, +-y
+            side = math.sqrt(2.0) * max(_support(m, data, int(g), np.array(u, dtype=float))
+                                        for u in ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0)))
+        extent = max(extent, float(np.linalg.norm(data.geom_xpos[g, :2] - point[:2]) + side))
     k = max(1, int(np.ceil(extent / scene.cell + 0.75)))
-    return near_wall_cells(scene.layout, k), False
+    return near_wall_cells(scene.layout, k), False, extent
+
+
+def wall_boxes(scene: ArmScene, contact: ContactChecker) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """The walls across the table: (centre [2], rotation [2, 2], half sizes [2]) of each box."""
+    m = scene.model
+    data = mujoco.MjData(m)
+    mujoco.mj_kinematics(m, data)
+    return [(data.geom_xpos[w, :2].copy(), data.geom_xmat[w].reshape(3, 3)[:2, :2].copy(), m.geom_size[w, :2].copy())
+            for w in np.flatnonzero(contact.walls)]
+
+
+def wall_distance(boxes, xy: np.ndarray) -> np.ndarray:
+    """Distance (m) across the table from points ``xy`` [..., 2] to the nearest of the wall
+    ``boxes`` (:func:`wall_boxes`; 0 inside one)."""
+    best = np.full(xy.shape[:-1], np.inf)
+    for centre, rot, half in boxes:
+        gap = np.maximum(np.abs((xy - centre) @ rot) - half, 0.0)  # in the box's frame (it stands upright)
+        best = np.minimum(best, np.hypot(gap[..., 0], gap[..., 1]))
+    return best
 
 
 def _progress(enabled: bool, text: str) -> None:
@@ -328,6 +353,9 @@ def _lattice_origin(scene: ArmScene, fk: PlanarFK) -> np.ndarray:
     raise UnreachableTableError("the arm's tip cannot reach the table near its home configuration")
 
 
+FINE_SPACING = 5e-4
+"""Most tip travel (m) between the samples at which a planar joint move near a wall is shown
+clear of the walls without MuJoCo (``compile_joint``)."""
 MAX_LATTICE = 1_000_000
 """The most joint-lattice points the ``joint`` model lays out (memory grows with them)."""
 STEP_LADDER = (0.05, 0.08, 0.12, 0.18, 0.25, 0.35, 0.5)
@@ -362,7 +390,8 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
     contact = ContactChecker(scene)
     free = layout.free
     sweep = SweepChecker(scene, contact)
-    near, everywhere = wall_reach(scene, contact)
+    near, everywhere, extent = wall_reach(scene, contact)
+    boxes = wall_boxes(scene, contact)
     _check_tip_height(scene, fk.tip_z)
     home = _lattice_origin(scene, fk)
     dof = len(home)
@@ -403,7 +432,23 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
             inside = c >= 0
             ok &= inside & free[np.maximum(c, 0)]
             near_any |= inside & near[np.maximum(c, 0)]
-        for e in np.flatnonzero(ok & (near_any | everywhere)):
+        # Shown clear of the walls without MuJoCo: geometry within ``extent`` of the tip, the
+        # tip ``g_i`` from the walls at sample i, so clear while it travels less than g_i - extent
+        # from there; the tip travels at most ``step * reach_from(j)`` in all, evenly in t, so
+        # the move is clear when each two neighbouring samples' clear stretches meet.
+        certain = np.zeros(len(idx), dtype=bool)
+        travel = step * fk.reach_from(j)
+        if not everywhere:
+            rest = np.flatnonzero(ok & near_any)
+            for n_fine in (m + 1, max(m + 1, int(np.ceil(travel / FINE_SPACING)))):
+                for chunk in np.array_split(rest, max(1, len(rest) * (n_fine + 1) // 200_000)):
+                    Qt = np.repeat(Q[idx[chunk]][:, None, :], n_fine + 1, axis=1)
+                    Qt[:, :, j] += np.linspace(0.0, step, n_fine + 1)[None, :]
+                    room = wall_distance(boxes, fk.tip(Qt)) - extent
+                    certain[chunk] = np.all(room > 0, axis=1) & np.all(room[:, 1:] + room[:, :-1] > travel / n_fine,
+                                                                        axis=1)
+                rest = rest[~certain[rest]]
+        for e in np.flatnonzero(ok & (near_any | everywhere) & ~certain):
             q = Q[idx[e]]
             if not sweep.clear(q, Q[idx[e] + strides[j]]):
                 ok[e] = False
