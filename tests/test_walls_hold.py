@@ -14,7 +14,7 @@ import pytest
 
 import menagerie_like as ml
 import wallcheck as wc
-from armtransfer.ik.replay import robot_scene
+from armtransfer.ik.replay import PENETRATION_TOLERANCE, replay, robot_scene
 from armtransfer.ik.sweep import TOLERANCE, SweepChecker
 from armtransfer.tasks.arms import arm_robot, robot, robot_specs, spatial_joint_specs, tasks_solvable, walls_cause
 from armtransfer.tasks.catalog import TABLE_I
@@ -82,6 +82,26 @@ def test_a_sample_of_door_crossings_keeps_out_of_the_walls(spec):
     assert wc.door_crossing(r, chosen).sum() >= 5
     worst = max(wc.check(r, chosen), key=lambda m: m.depth)
     assert worst.depth <= LIMIT, worst
+
+
+def test_a_replay_through_a_wall_is_not_reached_and_says_how_deep(planar2):
+    """Two states either side of a wall, replayed as if they were one move: the stylus is
+    pushed through the wall and ends over the goal, but the replay does not call that reached."""
+    for a, b in _across_a_wall(planar2):
+        rp = replay(planar2, [a, b], servos="scene")
+        if rp.ended_on_goal:
+            break
+    report = rp.report()
+    assert rp.ended_on_goal and not rp.reached_goal
+    assert report["max_penetration_mm"] > 1000 * PENETRATION_TOLERANCE and "wall wall_" in report["penetration_contact"]
+    assert "mm into a wall" in report["shortfall"]
+
+
+def test_a_replay_of_a_shortest_path_keeps_out_of_the_walls(planar2):
+    lay = planar2.layout
+    path = planar2.shortest_path(planar2.start_state(lay.free_cell(0, 0)), lay.free_cell(4, 5))
+    rp = replay(planar2, [s for s, _ in path])
+    assert rp.reached_goal and rp.report()["max_penetration_mm"] <= 1000 * PENETRATION_TOLERANCE
 
 
 # --------------------------------------------------------------------------- slow: all door crossings
