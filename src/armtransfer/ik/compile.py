@@ -4,9 +4,10 @@
 breadth-first sweep over cells from the home cell (each IK warm-started from the
 neighbour it was reached from). A move of k cells is a table lookup, blocked when the
 target or a cell passed over is a wall or off the table, when IK found no configuration
-for the target, or when the straight joint-space move between the two configurations
-(checked at 3k interpolated points) touches the table, a wall or the arm itself in MuJoCo, or
-strays more than 0.75 cell from the straight line between the cells. (A self-contact is
+for the target, when the tip, at 3k points of the straight joint-space move between the two
+configurations, passes over a wall cell, leaves the table or strays more than 0.75 cell from
+the straight line between the cells, or when the arm touches the table, a wall or itself
+anywhere along the move (the swept check of ``ik.sweep``). (A self-contact is
 one between two arm bodies that MuJoCo reports and that is not there at home already; see
 ``ik.scene.ContactChecker``.)
 
@@ -16,12 +17,16 @@ cell and not touching a wall or itself. The lattice's forward kinematics is vect
 (vertical joint axes: the tip is a sum of rotated link vectors taken from MuJoCo at
 q = 0; the tests check it against mink). A move is blocked when it leaves the limits,
 the tip passes over a wall cell or off the table at any of the interpolated points
-(spaced at most half a cell apart), or MuJoCo reports contact with the table, a wall or
-the arm itself at up to 3 points along the move; MuJoCo is asked only near walls (tip
-within one cell of a wall cell), since a planar arm's links ride above the walls and only
-the stylus can touch them, unless the arm's own geoms may collide with each other
-(``ContactChecker.can_self_collide``; the built-in arms' may not), when it is asked at
-every lattice point and move.
+(spaced at most half a cell apart), or the arm touches the table, a wall or itself anywhere
+along the move (the swept check of ``ik.sweep``). Only the arm's geoms that reach below the
+walls' tops can touch them (a planar arm's heights never change), and when all of those are
+fixed to the tool they ride within ``extent`` of the tool point (``wall_reach``): a lattice
+point is asked about contacts only over a cell that near a wall, and a move only when its tip
+passes that near one and cannot be shown clear in 2D (the tip sampled every ``FINE_SPACING``,
+each sample's distance from the wall boxes less ``extent`` a stretch it is clear for, and the
+stretches meeting). Any other low geom, or arm geoms that may collide with each other
+(``ContactChecker.can_self_collide``; the built-in arms' may not), make every lattice point
+and move asked.
 
 Wind pushes the tip one cell towards +x: for cartesian robots it is the 1-cell +x move;
 for joint robots it is the lattice state labelled with the cell to the right that is
