@@ -136,6 +136,38 @@ def wall_distance(boxes, xy: np.ndarray) -> np.ndarray:
     return best
 
 
+def _shown_clear(q0: np.ndarray, j: int, step: float, n: int, reach: float, extent: float, boxes,
+                 fk: PlanarFK) -> np.ndarray:
+    """Which of the moves from ``q0`` [k, dof] by ``step`` on joint ``j`` keep a planar arm's low
+    geometry (within ``extent`` of the tip) clear of the wall boxes, shown in 2D.
+
+    The tip travels at most ``step * reach`` along a move, evenly in the joint angle. At ``n + 1``
+    evenly spaced samples it is ``g_i`` from the walls, so it may travel ``g_i - extent`` from
+    there clear of them: an interval between two samples is clear when their two stretches
+    meet. An interval that is not is cut into pieces of at most ``FINE_SPACING`` of travel
+    and asked the same of those; the move is clear when every interval is."""
+    k = len(q0)
+    if k == 0:
+        return np.zeros(0, dtype=bool)
+    travel = step * reach
+    room = np.empty((k, n + 1))
+    for s in range(n + 1):
+        q = q0.copy()
+        q[:, j] += step * s / n
+        room[:, s] = wall_distance(boxes, fk.tip(q)) - extent
+    inside = (room[:, :-1] > 0) & (room[:, 1:] > 0)
+    open_ = inside & (room[:, :-1] + room[:, 1:] > travel / n)
+    edge, at = np.nonzero(inside & ~open_)  # intervals to look at more finely
+    pieces = max(1, int(np.ceil(travel / n / FINE_SPACING)))
+    for chunk in np.array_split(np.arange(len(edge)), max(1, len(edge) * (pieces + 1) // 200_000)):
+        ec, ic = edge[chunk], at[chunk]
+        q = np.repeat(q0[ec][:, None, :], pieces + 1, axis=1)
+        q[:, :, j] += step * (ic[:, None] + np.linspace(0.0, 1.0, pieces + 1)[None, :]) / n
+        r = wall_distance(boxes, fk.tip(q)) - extent
+        open_[ec, ic] = np.all(r > 0, axis=1) & np.all(r[:, 1:] + r[:, :-1] > travel / n / pieces, axis=1)
+    return np.all(open_, axis=1)
+
+
 def _progress(enabled: bool, text: str) -> None:
     if enabled:
         import sys
@@ -442,17 +474,9 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
         # from there; the tip travels at most ``step * reach_from(j)`` in all, evenly in t, so
         # the move is clear when each two neighbouring samples' clear stretches meet.
         certain = np.zeros(len(idx), dtype=bool)
-        travel = step * fk.reach_from(j)
         if not everywhere:
             rest = np.flatnonzero(ok & near_any)
-            for n_fine in (m + 1, max(m + 1, int(np.ceil(travel / FINE_SPACING)))):
-                for chunk in np.array_split(rest, max(1, len(rest) * (n_fine + 1) // 200_000)):
-                    Qt = np.repeat(Q[idx[chunk]][:, None, :], n_fine + 1, axis=1)
-                    Qt[:, :, j] += np.linspace(0.0, step, n_fine + 1)[None, :]
-                    room = wall_distance(boxes, fk.tip(Qt)) - extent
-                    certain[chunk] = np.all(room > 0, axis=1) & np.all(room[:, 1:] + room[:, :-1] > travel / n_fine,
-                                                                        axis=1)
-                rest = rest[~certain[rest]]
+            certain[rest] = _shown_clear(Q[idx[rest]], j, step, m + 1, fk.reach_from(j), extent, boxes, fk)
         for e in np.flatnonzero(ok & (near_any | everywhere) & ~certain):
             q = Q[idx[e]]
             if not sweep.clear(q, Q[idx[e] + strides[j]]):
