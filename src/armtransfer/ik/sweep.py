@@ -105,8 +105,6 @@ class SweepChecker:
         """Collision queries made so far."""
         self._env = scene.env_geoms
         self._moving = scene.arm_geoms
-        self._arm = ~scene.env_geoms & (model.geom_bodyid != 0)
-        self._allowed = contact._allowed
         table_body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "table")
         self._table = (model.geom_bodyid == table_body) & ~contact.walls
         self._half = scene.layout.width * scene.cell / 2
@@ -120,9 +118,10 @@ class SweepChecker:
         self._round = np.isin(kind, [mujoco.mjtGeom.mjGEOM_SPHERE, mujoco.mjtGeom.mjGEOM_CAPSULE,
                                      mujoco.mjtGeom.mjGEOM_CYLINDER])
         self._jnt = np.argsort(model.jnt_qposadr)
-        env, moving, arm = self._env, self._moving, self._arm
-        self._count = ((env[:, None] & moving[None, :]) | (moving[:, None] & env[None, :])
-                       | (arm[:, None] & arm[None, :] & (moving[:, None] | moving[None, :]) & ~self._allowed))
+        env, moving = self._env, self._moving
+        g1, g2 = (g.reshape(-1) for g in np.meshgrid(np.arange(model.ngeom), np.arange(model.ngeom), indexing="ij"))
+        own = contact._own(g1, g2).reshape(model.ngeom, model.ngeom)  # the self-contacts the checker counts
+        self._count = (env[:, None] & moving[None, :]) | (moving[:, None] & env[None, :]) | own
 
     def clear(self, qa: np.ndarray, qb: np.ndarray) -> bool:
         """No counted contact deeper than ``TOLERANCE`` anywhere on the move ``qa -> qb``."""
