@@ -75,8 +75,9 @@ def near_wall_cells(layout, k: int) -> np.ndarray:
 
 def wall_reach(scene: ArmScene, contact: ContactChecker) -> tuple[np.ndarray, bool, float]:
     """(the cells over which a planar arm's tip may bring its geometry into a wall, whether it
-    may anywhere, how far (m) across the table that geometry reaches from the tool point). Only geoms that reach below the walls' tops can meet them; a planar arm's
-    heights never change. Those rigid with the tool point reach at most their horizontal
+    may anywhere, how far (m) across the table that geometry reaches from the tool point).
+    Only geoms that reach below the walls' tops can meet them; a planar arm's heights never
+    change. Those rigid with the tool point reach at most their horizontal
     extent from it: the cells within that (plus the three quarters of a cell a tip sampled
     every half cell may be from the samples' cells) of a wall. Any other such geom, or geoms
     of the arm that may collide with each other, make every cell count."""

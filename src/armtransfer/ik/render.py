@@ -366,8 +366,8 @@ def caption(image: np.ndarray, panel: RolloutPanel, step: int, ended: bool) -> n
     font.draw_lines(image, lines, scale=scale)
     if panel.show_step and ended:
         reached = rp.reached_goal
-        said = ("reached the goal" if reached else f"ended on the goal through {rp.penetrated_into()}" if rp.ended_on_goal
-                else "ended off the goal")
+        said = ("reached the goal" if reached
+                else f"ended on the goal through {rp.penetrated_into()}" if rp.ended_on_goal else "ended off the goal")
         font.draw_lines(image, [said, rp.penetration_line()], corner="bottom-left",
                         scale=scale, color=REACHED_RGB if reached else MISSED_RGB)
     return image

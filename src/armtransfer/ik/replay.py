@@ -209,7 +209,8 @@ class Replay:
         "0.2 mm into a wall (at most 0.5 allowed)"."""
         if self.max_penetration <= 0.0:
             return "no wall or table contact"
-        return f"{self.max_penetration * 1000:.1f} mm into {self.penetrated_into()} (at most {PENETRATION_TOLERANCE * 1000:g} allowed)"
+        return (f"{self.max_penetration * 1000:.1f} mm into {self.penetrated_into()} "
+                f"(at most {PENETRATION_TOLERANCE * 1000:g} allowed)")
 
     def frame_indices(self, fps: float) -> np.ndarray:
         """Sample index for each video frame at ``fps`` (frames at t = k / fps, last at the end)."""
@@ -532,7 +533,8 @@ def _contact_name(model: mujoco.MjModel, scene: ArmScene, g1: int, g2: int) -> s
     """"link4 with wall wall_2", "hand with the table": a contact between an arm geom and the scenery."""
     if scene.env_geoms[g1]:
         g1, g2 = g2, g1
-    arm = (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, int(model.geom_bodyid[g1])) or "the arm").removeprefix(PREFIX)
+    body = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, int(model.geom_bodyid[g1]))
+    arm = (body or "the arm").removeprefix(PREFIX)
     name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, g2) or ""
     return f"{arm} with {'wall ' + name if name.startswith('wall_') else 'the table'}"
 
