@@ -17,7 +17,9 @@ arm-arm pair), a geom with no reported pair not before ``QUERY / rate``. The che
 the smallest of these, and by no less than ``TOLERANCE / rate``, so no point of the move is
 checked farther than ``TOLERANCE`` of geometry travel from a point found clear: between two
 checks a geom penetrates by at most ``TOLERANCE``. Far from everything a move is one or two
-checks; near a wall the checks close in as the gap closes.
+checks; near a wall the checks close in as the gap closes. MuJoCo's general convex collider
+(cylinders, meshes, ellipsoids) reports no pair it finds apart, whatever the margin: those
+geoms' distances to the partners whose boxes are near are asked of ``mj_geomDistance``.
 
 The tabletop is horizontal: a joint whose axis stays vertical (the first joints of the chain
 while their axes are vertical: every joint of a planar arm) moves nothing up or down, so
@@ -112,6 +114,13 @@ class SweepChecker:
         self._Rz = self._R.copy()
         self._Rz[:, :level_joints(scene)] = 0.0  # level joints move nothing up or down
         self._rb = model.geom_rbound.copy()
+        # MuJoCo's general convex collider (cylinders, meshes, ellipsoids) reports no pair it
+        # finds apart, whatever the margin: those geoms' distances are asked of mj_geomDistance
+        kind = model.geom_type
+        special = [mujoco.mjtGeom.mjGEOM_PLANE, mujoco.mjtGeom.mjGEOM_SPHERE, mujoco.mjtGeom.mjGEOM_CAPSULE,
+                   mujoco.mjtGeom.mjGEOM_BOX]
+        self._gjk = [int(g) for g in np.flatnonzero(scene.arm_geoms & ~np.isin(kind, special))]
+        self._fromto = np.zeros(6)
         self._level = level_joints(scene)
         kind = model.geom_type
         self._size = np.where((kind == mujoco.mjtGeom.mjGEOM_SPHERE)[:, None], [1.0, 0.0, 0.0], 1.0) * model.geom_size
@@ -122,6 +131,19 @@ class SweepChecker:
         g1, g2 = (g.reshape(-1) for g in np.meshgrid(np.arange(model.ngeom), np.arange(model.ngeom), indexing="ij"))
         own = contact._own(g1, g2).reshape(model.ngeom, model.ngeom)  # the self-contacts the checker counts
         self._count = (env[:, None] & moving[None, :]) | (moving[:, None] & env[None, :]) | own
+        collide = ((model.geom_contype[:, None] & model.geom_conaffinity[None, :])
+                   | (model.geom_conaffinity[:, None] & model.geom_contype[None, :])) != 0
+        partners = {g: np.flatnonzero(self._count[g] & collide[g]) for g in self._gjk}
+        data = mujoco.MjData(model)
+        mujoco.mj_kinematics(model, data)
+        self._boxes = {}  # the scenery's partners of each: ids, world box centres and half sizes (fixed)
+        for g, hs in partners.items():
+            fixed = hs[env[hs]]
+            rot = np.abs(data.geom_xmat[fixed].reshape(-1, 3, 3))
+            centre = data.geom_xpos[fixed] + np.einsum("nij,nj->ni", data.geom_xmat[fixed].reshape(-1, 3, 3),
+                                                       model.geom_aabb[fixed, :3])
+            self._boxes[g] = (fixed, centre, np.einsum("nij,nj->ni", rot, model.geom_aabb[fixed, 3:]))
+        self._arm_partners = {g: hs[~env[hs]] for g, hs in partners.items()}
 
     def clear(self, qa: np.ndarray, qb: np.ndarray) -> bool:
         """No counted contact deeper than ``TOLERANCE`` anywhere on the move ``qa -> qb``."""
@@ -165,11 +187,43 @@ class SweepChecker:
                         inside = np.all(np.abs(d.geom_xpos[arm_g, :2]) + self._rb[arm_g, None] < self._half, axis=1)
                         r = np.where(table & level & inside, rate_z[arm_g], r)
                     step = min(step, float(np.min(np.maximum(dist, TOLERANCE) / np.maximum(r, 1e-12))))
+            for g in self._gjk:
+                near = self._apart(g)
+                if near is None:
+                    return False
+                for h, dist_h, level in near:
+                    r_h = rate[g] + rate[h] if not self._env[h] else (rate_z[g] if level else rate[g])
+                    step = min(step, max(dist_h, TOLERANCE) / max(r_h, 1e-12))
             if t >= 1.0:
                 return True
             t = min(1.0, t + step)
             d.qpos[:] = qa + t * dq
             mujoco.mj_kinematics(m, d)
+
+    def _apart(self, g: int) -> list[tuple[int, float, bool]] | None:
+        """(partner, distance, against the tabletop from above) of geom ``g``'s counted partners
+        within ``QUERY`` (by their bounding boxes, then ``mj_geomDistance``); None when one is
+        in contact."""
+        m, d = self.model, self.data
+        out = []
+        centre, radius = d.geom_xpos[g], self._rb[g]
+        hs, box_c, box_h = self._boxes[g]
+        if self._arm_partners[g].size:  # boxes of the arm's own geoms move: take them now
+            a = self._arm_partners[g]
+            hs = np.concatenate([hs, a])
+            box_c = np.concatenate([box_c, d.geom_xpos[a]])
+            box_h = np.concatenate([box_h, np.repeat(self._rb[a, None], 3, axis=1)])
+        gap = np.linalg.norm(np.maximum(np.abs(centre - box_c) - box_h, 0.0), axis=1) - radius
+        for h in hs[gap < QUERY]:
+            dist = mujoco.mj_geomDistance(m, d, g, int(h), QUERY, self._fromto)
+            if dist < 0.0:
+                return None
+            if dist < QUERY:
+                way = self._fromto[3:] - self._fromto[:3]
+                level = bool(self._table[h] and dist > 0 and abs(way[2]) > (1.0 - 1e-9) * np.linalg.norm(way)
+                             and np.all(np.abs(centre[:2]) + radius < self._half))
+                out.append((int(h), float(dist), level))
+        return out
 
     def _turn_rate(self, j: int) -> np.ndarray:
         """Per geom, a bound on its points' distance from joint ``j``'s axis at the configuration
