@@ -91,6 +91,24 @@ def level_joints(scene: ArmScene) -> int:
     return int(np.argmin(vertical)) if not vertical.all() else len(vertical)
 
 
+def _not_filtered(model: mujoco.MjModel) -> np.ndarray:
+    """[ngeom, ngeom]: the geom pairs MuJoCo's collision does not filter out by their bodies
+    (not on one welded body, not a body and its parent unless the parent is the world, not an
+    ``<exclude>`` pair)."""
+    weld = model.body_weldid[model.geom_bodyid]
+    parent = model.body_weldid[model.body_parentid[model.body_weldid[model.geom_bodyid]]]
+    keep = weld[:, None] != weld[None, :]
+    if not model.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_FILTERPARENT:
+        keep &= ~((parent[:, None] == weld[None, :]) & (weld[None, :] != 0))
+        keep &= ~((parent[None, :] == weld[:, None]) & (weld[:, None] != 0))
+    body = model.geom_bodyid
+    for sig in model.exclude_signature:
+        b1, b2 = int(sig) >> 16, int(sig) & 0xFFFF
+        pair = (body[:, None] == b1) & (body[None, :] == b2)
+        keep &= ~(pair | pair.T)
+    return keep
+
+
 class SweepChecker:
     """Whether straight joint moves of a scene's arm are clear along their whole sweep (see the
     module docstring). Counts the contacts ``ContactChecker`` counts."""
@@ -133,6 +151,7 @@ class SweepChecker:
         self._count = (env[:, None] & moving[None, :]) | (moving[:, None] & env[None, :]) | own
         collide = ((model.geom_contype[:, None] & model.geom_conaffinity[None, :])
                    | (model.geom_conaffinity[:, None] & model.geom_contype[None, :])) != 0
+        collide &= _not_filtered(model)
         partners = {g: np.flatnonzero(self._count[g] & collide[g]) for g in self._gjk}
         data = mujoco.MjData(model)
         mujoco.mj_kinematics(model, data)
