@@ -52,7 +52,7 @@ def test_a_spatial_arms_joint_spec_parses_and_a_planar_arms_joint_robot_is_as_be
     assert not is_spatial_joint(planar) and planar.arm is not None and planar.arm.levels == 0
     # the key and arrays of the swept move check: main's before the 3D workspace (2026-12-04,
     # commit 5659c26) less the one move (both ways) whose stylus went 0.73 mm into wall_7
-    assert planar.arm.key == "e23926fbab0705b7f4cb002e8465098034f6f746de1a65e83e71caa9a802e44b"
+    assert planar.arm.key == "46782b8a60d204e2cb4d33f855fb41905bb4f2fedb372408c99e8fd55a67fd77"
     digest = hashlib.sha256(planar.next_state.tobytes() + planar.label.tobytes()).hexdigest()
     assert digest == "71d88ac99a2d6dee1e0586650caaa3f77f26086ec109da870212b9bc59be7585"
 
