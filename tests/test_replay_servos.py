@@ -4,7 +4,7 @@ servos) runs again with the scene's own servos, with gravity compensation, and s
 import pytest
 
 import menagerie_like as ml
-from armtransfer.ik.replay import ReplayError, replay
+from armtransfer.ik.replay import MAX_SLOWDOWN, ReplayError, replay
 from armtransfer.tasks.arms import arm_robot
 from armtransfer.worlds.layout import ROOMS
 
@@ -42,3 +42,20 @@ def test_weak_file_servos_give_way_to_the_scenes_own(small):
 def test_servos_must_be_named(small):
     with pytest.raises(ReplayError, match="auto, file, scene"):
         replay(small, _states(small), servos="strong")
+
+
+def test_saturated_file_servos_run_the_segment_slower_and_reach_the_goal(small):
+    """At 0.06 s a segment the file's wrist servo is at its force limit and the tip misses;
+    the replay runs the missed segment again at twice the time until the waypoint is met
+    (at most ``MAX_SLOWDOWN`` times), and says how slow it went."""
+    states = _states(small)
+    hurried = replay(small, states, segment_seconds=0.06, settle_seconds=0.2, servos="file", max_slowdown=1)
+    assert not hurried.reached_goal and "force limit" in hurried.shortfall()
+    assert hurried.settings["slowdown"] == 1 and hurried.settings["slowed_segments"] == 0
+    slowed = replay(small, states, segment_seconds=0.06, settle_seconds=0.2, servos="file")
+    report = slowed.report()
+    assert slowed.reached_goal, report
+    assert 1 < report["slowdown"] <= MAX_SLOWDOWN == report["max_slowdown"] and report["slowed_segments"] >= 1
+    assert slowed.duration > hurried.duration
+    with pytest.raises(ReplayError, match="max_slowdown"):
+        replay(small, states, max_slowdown=0)

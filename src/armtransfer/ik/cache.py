@@ -30,7 +30,7 @@ import numpy as np
 
 # the compiling modules, beside this one: a change to any of them is a new key
 _SOURCES = ("compile.py", "seeds.py", "solve.py", "scene.py", "labels.py", "workspace.py", "tool.py", "mount.py",
-            "quick.py")
+            "quick.py", "sweep.py", "voxels.py")
 _HERE = Path(__file__).resolve().parent
 
 

@@ -4,9 +4,10 @@
 breadth-first sweep over cells from the home cell (each IK warm-started from the
 neighbour it was reached from). A move of k cells is a table lookup, blocked when the
 target or a cell passed over is a wall or off the table, when IK found no configuration
-for the target, or when the straight joint-space move between the two configurations
-(checked at 3k interpolated points) touches the table, a wall or the arm itself in MuJoCo, or
-strays more than 0.75 cell from the straight line between the cells. (A self-contact is
+for the target, when the tip, at 3k points of the straight joint-space move between the two
+configurations, passes over a wall cell, leaves the table or strays more than 0.75 cell from
+the straight line between the cells, or when the arm touches the table, a wall or itself
+anywhere along the move (the swept check of ``ik.sweep``). (A self-contact is
 one between two arm bodies that MuJoCo reports and that is not there at home already; see
 ``ik.scene.ContactChecker``.)
 
@@ -16,12 +17,16 @@ cell and not touching a wall or itself. The lattice's forward kinematics is vect
 (vertical joint axes: the tip is a sum of rotated link vectors taken from MuJoCo at
 q = 0; the tests check it against mink). A move is blocked when it leaves the limits,
 the tip passes over a wall cell or off the table at any of the interpolated points
-(spaced at most half a cell apart), or MuJoCo reports contact with the table, a wall or
-the arm itself at up to 3 points along the move; MuJoCo is asked only near walls (tip
-within one cell of a wall cell), since a planar arm's links ride above the walls and only
-the stylus can touch them, unless the arm's own geoms may collide with each other
-(``ContactChecker.can_self_collide``; the built-in arms' may not), when it is asked at
-every lattice point and move.
+(spaced at most half a cell apart), or the arm touches the table, a wall or itself anywhere
+along the move (the swept check of ``ik.sweep``). Only the arm's geoms that reach below the
+walls' tops can touch them (a planar arm's heights never change), and when all of those are
+fixed to the tool they ride within ``extent`` of the tool point (``wall_reach``): a lattice
+point is asked about contacts only over a cell that near a wall, and a move only when its tip
+passes that near one and cannot be shown clear in 2D (the tip sampled every ``FINE_SPACING``,
+each sample's distance from the wall boxes less ``extent`` a stretch it is clear for, and the
+stretches meeting). Any other low geom, or arm geoms that may collide with each other
+(``ContactChecker.can_self_collide``; the built-in arms' may not), make every lattice point
+and move asked.
 
 Wind pushes the tip one cell towards +x: for cartesian robots it is the 1-cell +x move;
 for joint robots it is the lattice state labelled with the cell to the right that is
@@ -31,6 +36,7 @@ nearest to the joint step a Jacobian step predicts (blocked when none is).
 from __future__ import annotations
 
 import itertools
+import math
 from collections import deque
 
 import mujoco
@@ -38,10 +44,11 @@ import numpy as np
 
 from armtransfer.errors import ArmModelError, UnreachableTableError
 from armtransfer.ik.labels import OFF_TABLE, cells_of_xy
-from armtransfer.ik.scene import ArmScene, ContactChecker
+from armtransfer.ik.scene import ArmScene, ContactChecker, _support
 from armtransfer.ik.diagnose import why_unreachable
 from armtransfer.ik.seeds import RING, SEED_RESTARTS, _cells_by_distance, reach_bound, seed_cells  # noqa: F401
 from armtransfer.ik.solve import MAX_TIP_HEIGHT, TIP_HEIGHT, TipIK
+from armtransfer.ik.sweep import SweepChecker
 
 
 def near_wall_mask(layout) -> np.ndarray:
@@ -53,6 +60,113 @@ def near_wall_mask(layout) -> np.ndarray:
         for dx in (-1, 0, 1):
             near |= pad[1 + dy:1 + dy + w.shape[0], 1 + dx:1 + dx + w.shape[1]]
     return near.reshape(-1)
+
+
+def near_wall_cells(layout, k: int) -> np.ndarray:
+    """Boolean over cell ids: a wall cell or a cell within ``k`` cells of one (along x and y)."""
+    w = layout.wall_mask
+    pad = np.pad(w, k)
+    near = np.zeros_like(w)
+    for dy in range(-k, k + 1):
+        for dx in range(-k, k + 1):
+            near |= pad[k + dy:k + dy + w.shape[0], k + dx:k + dx + w.shape[1]]
+    return near.reshape(-1)
+
+
+def wall_reach(scene: ArmScene, contact: ContactChecker) -> tuple[np.ndarray, bool, float]:
+    """(the cells over which a planar arm's tip may bring its geometry into a wall, whether it
+    may anywhere, how far (m) across the table that geometry reaches from the tool point).
+    Only geoms that reach below the walls' tops can meet them; a planar arm's heights never
+    change. Those rigid with the tool point reach at most their horizontal
+    extent from it: the cells within that (plus the three quarters of a cell a tip sampled
+    every half cell may be from the samples' cells) of a wall. Any other such geom, or geoms
+    of the arm that may collide with each other, make every cell count."""
+    m = scene.model
+    data = mujoco.MjData(m)
+    data.qpos[:] = scene.home
+    mujoco.mj_kinematics(m, data)
+    walls = np.flatnonzero(contact.walls)
+    if contact.can_self_collide:
+        return np.ones(scene.layout.n_cells, dtype=bool), True, np.inf
+    if len(walls) == 0:
+        return np.zeros(scene.layout.n_cells, dtype=bool), False, 0.0
+    up, down = np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, -1.0])
+    top = float(max(data.geom_xpos[w, 2] + _support(m, data, int(w), up) for w in walls))
+    tip = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, scene.tip)
+    tool_weld = m.body_weldid[m.site_bodyid[tip]]
+    point = data.site_xpos[tip]
+    hits = np.zeros(m.ngeom, dtype=bool)
+    for w in walls:
+        hits |= ((m.geom_contype & m.geom_conaffinity[w]) | (m.geom_conaffinity & m.geom_contype[w])) != 0
+    extent = 0.0
+    for g in np.flatnonzero(hits & scene.arm_geoms):
+        if data.geom_xpos[g, 2] - _support(m, data, int(g), down) >= top:
+            continue  # rides above the walls
+        if m.body_weldid[m.geom_bodyid[g]] != tool_weld:
+            return np.ones(scene.layout.n_cells, dtype=bool), True, np.inf
+        if m.geom_type[g] in (mujoco.mjtGeom.mjGEOM_SPHERE, mujoco.mjtGeom.mjGEOM_CAPSULE,
+                              mujoco.mjtGeom.mjGEOM_CYLINDER):  # its radius, and its half length as it tilts
+            tilt = float(data.geom_xmat[g].reshape(3, 3)[2, 2])
+            half = 0.0 if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_SPHERE else float(m.geom_size[g, 1])
+            side = float(m.geom_size[g, 0]) + half * math.sqrt(max(0.0, 1.0 - tilt * tilt))
+        else:  # a support function is sublinear: along any horizontal direction at most sqrt(2)
+            # times the largest along +-x, +-y
+            side = math.sqrt(2.0) * max(_support(m, data, int(g), np.array(u, dtype=float))
+                                        for u in ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0)))
+        extent = max(extent, float(np.linalg.norm(data.geom_xpos[g, :2] - point[:2]) + side))
+    k = max(1, int(np.ceil(extent / scene.cell + 0.75)))
+    return near_wall_cells(scene.layout, k), False, extent
+
+
+def wall_boxes(scene: ArmScene, contact: ContactChecker) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """The walls across the table: (centre [2], rotation [2, 2], half sizes [2]) of each box."""
+    m = scene.model
+    data = mujoco.MjData(m)
+    mujoco.mj_kinematics(m, data)
+    return [(data.geom_xpos[w, :2].copy(), data.geom_xmat[w].reshape(3, 3)[:2, :2].copy(), m.geom_size[w, :2].copy())
+            for w in np.flatnonzero(contact.walls)]
+
+
+def wall_distance(boxes, xy: np.ndarray) -> np.ndarray:
+    """Distance (m) across the table from points ``xy`` [..., 2] to the nearest of the wall
+    ``boxes`` (:func:`wall_boxes`; 0 inside one)."""
+    best = np.full(xy.shape[:-1], np.inf)
+    for centre, rot, half in boxes:
+        gap = np.maximum(np.abs((xy - centre) @ rot) - half, 0.0)  # in the box's frame (it stands upright)
+        best = np.minimum(best, np.hypot(gap[..., 0], gap[..., 1]))
+    return best
+
+
+def _shown_clear(q0: np.ndarray, j: int, step: float, n: int, reach: float, extent: float, boxes,
+                 fk: PlanarFK) -> np.ndarray:
+    """Which of the moves from ``q0`` [k, dof] by ``step`` on joint ``j`` keep a planar arm's low
+    geometry (within ``extent`` of the tip) clear of the wall boxes, shown in 2D.
+
+    The tip travels at most ``step * reach`` along a move, evenly in the joint angle. At ``n + 1``
+    evenly spaced samples it is ``g_i`` from the walls, so it may travel ``g_i - extent`` from
+    there clear of them: an interval between two samples is clear when their two stretches
+    meet. An interval that is not is cut into pieces of at most ``FINE_SPACING`` of travel
+    and asked the same of those; the move is clear when every interval is."""
+    k = len(q0)
+    if k == 0:
+        return np.zeros(0, dtype=bool)
+    travel = step * reach
+    room = np.empty((k, n + 1))
+    for s in range(n + 1):
+        q = q0.copy()
+        q[:, j] += step * s / n
+        room[:, s] = wall_distance(boxes, fk.tip(q)) - extent
+    inside = (room[:, :-1] > 0) & (room[:, 1:] > 0)
+    open_ = inside & (room[:, :-1] + room[:, 1:] > travel / n)
+    edge, at = np.nonzero(inside & ~open_)  # intervals to look at more finely
+    pieces = max(1, int(np.ceil(travel / n / FINE_SPACING)))
+    for chunk in np.array_split(np.arange(len(edge)), max(1, len(edge) * (pieces + 1) // 200_000)):
+        ec, ic = edge[chunk], at[chunk]
+        q = np.repeat(q0[ec][:, None, :], pieces + 1, axis=1)
+        q[:, :, j] += step * (ic[:, None] + np.linspace(0.0, 1.0, pieces + 1)[None, :]) / n
+        r = wall_distance(boxes, fk.tip(q)) - extent
+        open_[ec, ic] = np.all(r > 0, axis=1) & np.all(r[:, 1:] + r[:, :-1] > travel / n / pieces, axis=1)
+    return np.all(open_, axis=1)
 
 
 def _progress(enabled: bool, text: str) -> None:
@@ -100,6 +214,7 @@ def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = 
     free = layout.free
     ik = TipIK(scene, tip_down)
     contact = ContactChecker(scene)
+    sweep = SweepChecker(scene, contact)
 
     home_tip = ik.configuration
     home_tip.update(scene.home)
@@ -165,7 +280,7 @@ def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = 
             return s
         key = (min(s, t), max(s, t))
         if key not in checked:
-            checked[key] = _segment_clear(contact, qpos[s], qpos[t], np.array([x, y]) * cell,
+            checked[key] = _segment_clear(contact, sweep, qpos[s], qpos[t], np.array([x, y]) * cell,
                                           np.array([x + dx * steps, y + dy * steps]) * cell,
                                           3 * steps, cell, layout)
         return t if checked[key] else s
@@ -183,20 +298,19 @@ def compile_cartesian(scene: ArmScene, tip_down: bool, k: int, progress: bool = 
                 canonical=canonical, qpos=qpos, tip=tips)
 
 
-def _segment_clear(contact: ContactChecker, qa, qb, pa, pb, n_points: int, cell, layout) -> bool:
+def _segment_clear(contact: ContactChecker, sweep: SweepChecker, qa, qb, pa, pb, n_points: int, cell,
+                   layout) -> bool:
     d = pb - pa
     length2 = float(d @ d)
     for t in np.linspace(0.0, 1.0, n_points + 2)[1:-1]:
-        hit, tip = contact.touches_and_tip(qa + (qb - qa) * t)
-        if hit:
-            return False
+        tip = contact.tip(qa + (qb - qa) * t)
         c = int(cells_of_xy(tip, cell, layout))
         if c == OFF_TABLE or not layout.free[c]:
             return False
         u = np.clip(((tip[:2] - pa) @ d) / length2, 0.0, 1.0)
         if np.linalg.norm(tip[:2] - (pa + u * d)) > 0.75 * cell:
             return False
-    return True
+    return sweep.clear(qa, qb)
 
 
 # --------------------------------------------------------------------------- joint lattice
@@ -277,6 +391,9 @@ def _lattice_origin(scene: ArmScene, fk: PlanarFK) -> np.ndarray:
     raise UnreachableTableError("the arm's tip cannot reach the table near its home configuration")
 
 
+FINE_SPACING = 5e-4
+"""Most tip travel (m) between the samples at which a planar joint move near a wall is shown
+clear of the walls without MuJoCo (``compile_joint``)."""
 MAX_LATTICE = 1_000_000
 """The most joint-lattice points the ``joint`` model lays out (memory grows with them)."""
 STEP_LADDER = (0.05, 0.08, 0.12, 0.18, 0.25, 0.35, 0.5)
@@ -310,7 +427,9 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
     fk = PlanarFK(scene)
     contact = ContactChecker(scene)
     free = layout.free
-    near = near_wall_mask(layout)
+    sweep = SweepChecker(scene, contact)
+    near, everywhere, extent = wall_reach(scene, contact)
+    boxes = wall_boxes(scene, contact)
     _check_tip_height(scene, fk.tip_z)
     home = _lattice_origin(scene, fk)
     dof = len(home)
@@ -327,7 +446,7 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
     Q = home + (grids + n_lo) * step
     cells = cells_of_xy(fk.tip(Q), cell, layout)
     valid = (cells >= 0) & free[np.maximum(cells, 0)]
-    ask = np.ones(total, dtype=bool) if contact.can_self_collide else near[np.maximum(cells, 0)]
+    ask = np.ones(total, dtype=bool) if everywhere else near[np.maximum(cells, 0)]
     check = np.flatnonzero(valid & ask)
     for i in check:
         if contact.touches(Q[i]):
@@ -351,14 +470,18 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
             inside = c >= 0
             ok &= inside & free[np.maximum(c, 0)]
             near_any |= inside & near[np.maximum(c, 0)]
-        probe = ts[np.unique(np.linspace(0, m - 1, min(m, 3)).round().astype(int))]
-        for e in np.flatnonzero(ok & (near_any | contact.can_self_collide)):
-            for t in probe:
-                q = Q[idx[e]].copy()
-                q[j] += t * step
-                if contact.touches(q):
-                    ok[e] = False
-                    break
+        # Shown clear of the walls without MuJoCo: geometry within ``extent`` of the tip, the
+        # tip ``g_i`` from the walls at sample i, so clear while it travels less than g_i - extent
+        # from there; the tip travels at most ``step * reach_from(j)`` in all, evenly in t, so
+        # the move is clear when each two neighbouring samples' clear stretches meet.
+        certain = np.zeros(len(idx), dtype=bool)
+        if not everywhere:
+            rest = np.flatnonzero(ok & near_any)
+            certain[rest] = _shown_clear(Q[idx[rest]], j, step, m + 1, fk.reach_from(j), extent, boxes, fk)
+        for e in np.flatnonzero(ok & (near_any | everywhere) & ~certain):
+            q = Q[idx[e]]
+            if not sweep.clear(q, Q[idx[e] + strides[j]]):
+                ok[e] = False
         plus[idx[ok], j] = idx[ok] + strides[j]
 
     # Breadth-first search from home over the valid edges.

@@ -357,7 +357,7 @@ def panel_steps(rp: Replay, indices: np.ndarray) -> np.ndarray:
 def caption(image: np.ndarray, panel: RolloutPanel, step: int, ended: bool) -> np.ndarray:
     """``image`` (a frame of ``panel``, changed in place and returned) with its caption: the
     panel's label lines and ``step k/n`` top left; once ``ended``, whether the replay ended on
-    the goal, bottom left."""
+    the goal, and the deepest it went into a wall or the table, bottom left."""
     rp = panel.replay
     scale = caption_scale(image.shape[1])
     lines = list(panel.label)
@@ -366,7 +366,9 @@ def caption(image: np.ndarray, panel: RolloutPanel, step: int, ended: bool) -> n
     font.draw_lines(image, lines, scale=scale)
     if panel.show_step and ended:
         reached = rp.reached_goal
-        font.draw_lines(image, ["reached the goal" if reached else "ended off the goal"], corner="bottom-left",
+        said = ("reached the goal" if reached
+                else f"ended on the goal through {rp.penetrated_into()}" if rp.ended_on_goal else "ended off the goal")
+        font.draw_lines(image, [said, rp.penetration_line()], corner="bottom-left",
                         scale=scale, color=REACHED_RGB if reached else MISSED_RGB)
     return image
 

@@ -30,6 +30,17 @@ again with the scene's own servos: the same retuned position servos with no forc
 control limit. ``Replay.settings["servos"]`` says which were used (``file`` or ``scene``),
 and when it is ``scene``, ``file_servos`` says how the file's did.
 
+Slowing down. Before the file's actuators are said to miss, a segment whose waypoint they
+missed (the tip more than ``TRACKING_LIMIT`` cell from the planned tips during it or at its
+end) while one of them was at its force limit is run again from its start at twice the time,
+and again, up to ``MAX_SLOWDOWN`` times ``segment_seconds``. ``settings["slowdown"]`` is the
+largest factor a segment needed and ``settings["slowed_segments"]`` how many were slowed.
+
+Walls. Every physics step's collision is read: the deepest contact of a moving arm geom with
+a wall or the table is ``Replay.max_penetration``, in the report as ``max_penetration_mm``. A
+replay that goes deeper than ``PENETRATION_TOLERANCE`` did not reach the goal, whatever cell
+its tip ended over (``ended_on_goal`` says where it ended).
+
 Torque motors. A file may drive a joint with torque motors only (``motor`` actuators, no
 position servo), as files written for torque control do. The scene keeps no such motor
 (``armtransfer.ik.scene``: it gives the joint a servo of its own), so the replay with the
@@ -66,6 +77,13 @@ BANDWIDTH_HZ = 8.0
 TRACKING_LIMIT = 0.5
 """Largest distance (cells) of the tip from the planned tips that the file's servos may
 leave before a replay uses the scene's own servos instead."""
+PENETRATION_TOLERANCE = 5e-4
+"""Deepest contact (m) of the arm with a wall or the table a replay may show and still be said
+to reach the goal: a path that goes deeper went through a wall, whatever cell it ended over."""
+MAX_SLOWDOWN = 8
+"""How many times slower than ``segment_seconds`` a replay may run a segment whose waypoint its
+file's actuators missed at their force limit (it doubles the segment's time until the
+waypoint is met or this bound is reached)."""
 SERVOS = ("auto", "file", "scene")
 """Which servos a replay drives the joints with: the file's, falling back to the scene's
 (``auto``), or one of them."""
@@ -95,6 +113,11 @@ class Replay:
     """[n_steps + 1, 3] tip site position (m) at each sample."""
     waypoint_index: np.ndarray
     """[n_waypoints] the sample at which each waypoint's ramp ends."""
+    penetration: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    """[n_steps + 1] the deepest contact (m, 0 when none) of a moving arm geom with a wall or
+    the table at each sample, as MuJoCo's collision found it during the step."""
+    penetration_what: str = ""
+    """The deepest contact's geoms ("link4 with wall wall_2"), "" when none."""
     settings: dict = field(default_factory=dict)
 
     @property
@@ -119,9 +142,20 @@ class Replay:
         return int(self.tip_cells[-1])
 
     @property
-    def reached_goal(self) -> bool:
+    def ended_on_goal(self) -> bool:
         """The tip ends the replay over the goal cell."""
         return self.final_cell == self.goal_cell != OFF_TABLE
+
+    @property
+    def max_penetration(self) -> float:
+        """The deepest the arm went into a wall or the table during the replay (m)."""
+        return float(self.penetration.max()) if len(self.penetration) else 0.0
+
+    @property
+    def reached_goal(self) -> bool:
+        """The tip ends the replay over the goal cell, and the arm never went deeper than
+        ``PENETRATION_TOLERANCE`` into a wall or the table on the way."""
+        return self.ended_on_goal and self.max_penetration <= PENETRATION_TOLERANCE
 
     @property
     def max_deviation_cells(self) -> float:
@@ -151,14 +185,32 @@ class Replay:
         """One line saying why the tip does not end over the goal cell, or "" when it does."""
         if self.reached_goal:
             return ""
+        if self.ended_on_goal:
+            return (f"the arm went {self.max_penetration * 1000:.1f} mm into {self.penetrated_into()} on the way "
+                    f"({self.penetration_what}; at most {PENETRATION_TOLERANCE * 1000:g} mm allowed)")
         servos = self.settings.get("servos", "file")
         limited = sorted(((n, k) for n, k in self.settings.get("at_limit_steps", {}).items() if k),
                          key=lambda item: -item[1])
         limit = (f"; actuator {limited[0][0]} was at its force limit {limited[0][1]} of {len(self.time) - 1} steps"
                  if limited else "")
+        if self.settings.get("slowed_segments"):
+            limit += (f", with {self.settings['slowed_segments']} segment(s) run up to {self.settings['slowdown']}x "
+                      f"slower (at most {self.settings.get('max_slowdown', 1)}x)")
         return (f"the tip ends {self.goal_offset_cells:.2f} cell (along x or y) from the goal cell's centre "
                 f"(half a cell is allowed) and {self.final_error_cells:.2f} cell from the last waypoint, driven by the "
                 f"{'scene' if servos == 'scene' else 'file'}'s actuators{limit}")
+
+    def penetrated_into(self) -> str:
+        """"the table" or "a wall": what the deepest contact was with."""
+        return "the table" if self.penetration_what.endswith("the table") else "a wall"
+
+    def penetration_line(self) -> str:
+        """One line on the deepest contact with a wall or the table: "no wall or table contact",
+        "0.2 mm into a wall (at most 0.5 allowed)"."""
+        if self.max_penetration <= 0.0:
+            return "no wall or table contact"
+        return (f"{self.max_penetration * 1000:.1f} mm into {self.penetrated_into()} "
+                f"(at most {PENETRATION_TOLERANCE * 1000:g} allowed)")
 
     def frame_indices(self, fps: float) -> np.ndarray:
         """Sample index for each video frame at ``fps`` (frames at t = k / fps, last at the end)."""
@@ -185,6 +237,10 @@ class Replay:
             "final_cell": (list(self.scene.layout.xy(self.final_cell))
                            if self.final_cell != OFF_TABLE else None),
             "reached_goal": self.reached_goal,
+            "ended_on_goal": self.ended_on_goal,
+            "max_penetration_mm": round(self.max_penetration * 1000, 4),
+            "penetration_tolerance_mm": PENETRATION_TOLERANCE * 1000,
+            **({"penetration_contact": self.penetration_what} if self.penetration_what else {}),
             "max_deviation_cells": round(self.max_deviation_cells, 4),
             "max_tracking_error_cells": round(self.max_tracking_error_cells, 4),
             "final_error_cells": round(self.final_error_cells, 4),
@@ -251,23 +307,27 @@ def _dedupe(cells: Sequence[int]) -> list[int]:
 def replay(robot, path_states: Sequence[int], *, goal_cell: int | None = None,
            segment_seconds: float = SEGMENT_SECONDS, settle_seconds: float = SETTLE_SECONDS,
            bandwidth_hz: float = BANDWIDTH_HZ, feedforward: bool = True,
-           scene: ArmScene | None = None, servos: str = "auto") -> Replay:
+           scene: ArmScene | None = None, servos: str = "auto", max_slowdown: int = MAX_SLOWDOWN) -> Replay:
     """Simulate the arm of ``robot`` following ``path_states`` with its position actuators.
 
     ``path_states``: the robot's states in order (e.g. ``[s for s, _ in
     robot.shortest_path(start, goal)]``). ``goal_cell`` defaults to the last state's label.
     Each segment between waypoints lasts ``segment_seconds``; the goal is then held for
     ``settle_seconds``. ``scene`` may be passed to skip rebuilding it (it must be the
-    robot's own scene). ``servos``: one of ``SERVOS`` (see the module docstring).
+    robot's own scene). ``servos``: one of ``SERVOS`` (see the module docstring). ``max_slowdown``:
+    how many times ``segment_seconds`` a segment the file's actuators miss at their force limit
+    may be stretched to (1: never).
     Deterministic: no randomness anywhere.
     """
     if servos not in SERVOS:
         raise ReplayError(f"unknown servos {servos!r}; valid: {', '.join(SERVOS)}")
+    if isinstance(max_slowdown, bool) or not isinstance(max_slowdown, int) or max_slowdown < 1:
+        raise ReplayError(f"max_slowdown must be a whole number of at least 1, got {max_slowdown!r}")
 
     def simulate(own_servos: bool, scene: ArmScene | None) -> Replay:
         return _simulate(robot, path_states, goal_cell=goal_cell, segment_seconds=segment_seconds,
                          settle_seconds=settle_seconds, bandwidth_hz=bandwidth_hz, feedforward=feedforward,
-                         scene=scene, own_servos=own_servos)
+                         scene=scene, own_servos=own_servos, max_slowdown=max_slowdown)
 
     if servos == "scene":
         return simulate(True, scene)
@@ -286,7 +346,7 @@ def replay(robot, path_states: Sequence[int], *, goal_cell: int | None = None,
 
 def _simulate(robot, path_states: Sequence[int], *, goal_cell: int | None, segment_seconds: float,
               settle_seconds: float, bandwidth_hz: float, feedforward: bool, scene: ArmScene | None,
-              own_servos: bool) -> Replay:
+              own_servos: bool, max_slowdown: int = MAX_SLOWDOWN) -> Replay:
     """One replay, with the file's servos or (``own_servos``) the scene's."""
     states = [int(s) for s in path_states]
     if not states:
@@ -343,15 +403,14 @@ def _simulate(robot, path_states: Sequence[int], *, goal_cell: int | None, segme
     dt = float(model.opt.timestep)
     seg_steps = max(1, int(round(segment_seconds / dt)))
     settle_steps = int(round(settle_seconds / dt))
-    n_steps = seg_steps * (len(way) - 1) + settle_steps
-    qpos = np.empty((n_steps + 1, model.nq))
-    tip = np.empty((n_steps + 1, 3))
-    qpos[0], tip[0] = data.qpos, data.site_xpos[tip_id]
+    qpos_l: list[np.ndarray] = [data.qpos.copy()]
+    tip_l: list[np.ndarray] = [data.site_xpos[tip_id].copy()]
+    depth_l: list[float] = [0.0]
     waypoint_index = np.zeros(len(way), dtype=np.int64)
-    k = 0
+    env, moving = scene.env_geoms, scene.arm_geoms
+    deepest: list = [0.0, (-1, -1)]  # depth (m), geoms
 
     def step(ctrl_q: np.ndarray, vel_q: np.ndarray) -> None:
-        nonlocal k
         data.ctrl[:] = ctrl_q[qadr_of]
         mujoco.mj_step1(model, data)
         if feedforward:
@@ -367,31 +426,71 @@ def _simulate(robot, path_states: Sequence[int], *, goal_cell: int | None, segme
         if limited.any():
             force = data.actuator_force[limited]
             at_limit[limited] += (force <= f_lo + 1e-9 * np.abs(f_lo)) | (force >= f_hi - 1e-9 * np.abs(f_hi))
-        k += 1
-        qpos[k] = data.qpos
-        tip[k] = data.site_xpos[tip_id]
+        depth = 0.0
+        n = data.ncon
+        if n:  # the contacts of this step's collision, at its start
+            g1, g2 = data.contact.geom1[:n], data.contact.geom2[:n]
+            hit = (env[g1] & moving[g2]) | (env[g2] & moving[g1])
+            if hit.any():
+                i = int(np.argmin(np.where(hit, data.contact.dist[:n], np.inf)))
+                depth = max(0.0, -float(data.contact.dist[i]))
+                if depth > deepest[0]:
+                    deepest[0], deepest[1] = depth, (int(g1[i]), int(g2[i]))
+        qpos_l.append(data.qpos.copy())
+        tip_l.append(data.site_xpos[tip_id].copy())
+        depth_l.append(depth)
 
+    probe = mujoco.MjData(model)
+    saved = mujoco.MjData(model)
+    miss = TRACKING_LIMIT * scene.cell
+    slow_ok = not own_servos and max_slowdown > 1
+    factors = []
     for i in range(1, len(way)):
         q0, q1 = way[i - 1], way[i]
-        vel = (q1 - q0) / (seg_steps * dt)
-        for j in range(1, seg_steps + 1):
-            step(q0 + (q1 - q0) * (j / seg_steps), vel)
-        waypoint_index[i] = k
+        factor = 1
+        while True:
+            if slow_ok:
+                mujoco.mj_copyData(saved, model, data)
+                mark, limits, before = len(qpos_l), at_limit.copy(), list(deepest)
+            steps = seg_steps * factor
+            vel = (q1 - q0) / (steps * dt)
+            for j in range(1, steps + 1):
+                step(q0 + (q1 - q0) * (j / steps), vel)
+            if slow_ok and 2 * factor <= max_slowdown and np.any(at_limit > limits):
+                seg = _tips_of(model, np.array(qpos_l[mark:]), tip_id, probe)
+                off = polyline_distance(seg, planned_tip[i - 1:i + 1]).max()
+                if off > miss or np.linalg.norm(seg[-1] - planned_tip[i]) > miss:  # missed, saturated: slower
+                    mujoco.mj_copyData(data, model, saved)
+                    del qpos_l[mark:], tip_l[mark:], depth_l[mark:]
+                    at_limit[:] = limits
+                    deepest[:] = before
+                    factor *= 2
+                    continue
+            break
+        factors.append(factor)
+        waypoint_index[i] = len(qpos_l) - 1
     zero = np.zeros(model.nq)
     for _ in range(settle_steps):
         step(way[-1], zero)
+    k = len(qpos_l) - 1
+    qpos, tip, depths = np.array(qpos_l), np.array(tip_l), np.array(depth_l)
     # site_xpos after mj_step2 is from the step's start; refresh the last sample exactly.
     mujoco.mj_kinematics(model, data)
     tip[k] = data.site_xpos[tip_id]
     # Likewise every recorded tip lags its qpos by one step: recompute them from qpos.
-    tip[1:k] = _tips_of(model, qpos[1:k], tip_id)
+    if k > 1:
+        tip[1:k] = _tips_of(model, qpos[1:k], tip_id)
 
     layout = scene.layout
     planned_cells = _dedupe(robot.label[states].tolist())
     planned_xy = np.array([np.array(layout.xy(c % layout.n_cells), dtype=float) * scene.cell for c in planned_cells])
     settings: dict[str, Any] = {"segment_seconds": seg_steps * dt, "settle_seconds": settle_steps * dt,
                                 "bandwidth_hz": bandwidth_hz, "feedforward": feedforward, "timestep": dt,
-                                "servos": "scene" if own_servos else "file"}
+                                "servos": "scene" if own_servos else "file",
+                                "slowdown": max(factors, default=1),
+                                "slowed_segments": sum(f > 1 for f in factors)}
+    if slow_ok:
+        settings["max_slowdown"] = max_slowdown
     if motors:
         settings["torque_motors"] = {m.joint: {"actuators": list(m.actuators), "torque_range": [m.lower, m.upper],
                                                "steps_at_limit": int(at_limit[a])} for a, m in motors}
@@ -401,7 +500,9 @@ def _simulate(robot, path_states: Sequence[int], *, goal_cell: int | None, segme
     settings["at_limit_steps"] = {names[a].removeprefix(PREFIX): int(at_limit[a]) for a in range(model.nu)}
     return Replay(robot=robot.name, scene=scene, path_states=tuple(states), goal_cell=goal,
                   planned_xy=planned_xy, planned_tip=planned_tip, time=np.arange(k + 1) * dt,
-                  qpos=qpos, tip=tip, waypoint_index=waypoint_index, settings=settings)
+                  qpos=qpos, tip=tip, waypoint_index=waypoint_index, penetration=depths,
+                  penetration_what=_contact_name(model, scene, *deepest[1]) if deepest[0] > 0 else "",
+                  settings=settings)
 
 
 def _motors_in(model: mujoco.MjModel, arm: ArmDescription) -> list:
@@ -428,8 +529,18 @@ def _fk(model, data, q, tip_id) -> np.ndarray:
     return data.site_xpos[tip_id].copy()
 
 
-def _tips_of(model, qs: np.ndarray, tip_id: int) -> np.ndarray:
-    d = mujoco.MjData(model)
+def _contact_name(model: mujoco.MjModel, scene: ArmScene, g1: int, g2: int) -> str:
+    """"link4 with wall wall_2", "hand with the table": a contact between an arm geom and the scenery."""
+    if scene.env_geoms[g1]:
+        g1, g2 = g2, g1
+    body = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, int(model.geom_bodyid[g1]))
+    arm = (body or "the arm").removeprefix(PREFIX)
+    name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, g2) or ""
+    return f"{arm} with {'wall ' + name if name.startswith('wall_') else 'the table'}"
+
+
+def _tips_of(model, qs: np.ndarray, tip_id: int, d: mujoco.MjData | None = None) -> np.ndarray:
+    d = d if d is not None else mujoco.MjData(model)
     out = np.empty((len(qs), 3))
     for i, q in enumerate(qs):
         out[i] = _fk(model, d, q, tip_id)

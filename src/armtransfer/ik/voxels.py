@@ -21,7 +21,8 @@ error past ``MAX_STATES`` states.
 
 A move is blocked when it leaves the joint limits, when the tool point, at interpolated
 points no more than half a cell apart, leaves the workspace or enters a solid voxel, or when
-MuJoCo reports a contact at any of them or at the end. Wind pushes the tool one cell towards
+any arm geometry comes into the table, a wall or the arm itself anywhere along it (the swept
+check of ``ik.sweep``; the end is checked with MuJoCo's contacts too). Wind pushes the tool one cell towards
 +x at its level: to the lattice neighbour in that voxel whose tool point is nearest the
 voxel's centre (blocked when no neighbour is there).
 """
@@ -41,6 +42,7 @@ from armtransfer.ik.labels import cells_of_xy
 from armtransfer.ik.scene import ArmScene, ContactChecker
 from armtransfer.ik.seeds import _cells_by_distance
 from armtransfer.ik.solve import TipIK
+from armtransfer.ik.sweep import SweepChecker
 from armtransfer.ik.workspace import WALL_HEIGHT
 from armtransfer.worlds.voxels import LEVELS, Voxels
 
@@ -142,6 +144,7 @@ def compile_spatial_joint(scene: ArmScene, step: float | None, progress: bool = 
     free = vox.free
     fk = SpatialFK(scene)
     contact = ContactChecker(scene)
+    sweep = SweepChecker(scene, contact)
     origin = spatial_origin(scene)
     jac = fk.jacobian(origin)
     moved = moved_joints(jac)
@@ -184,7 +187,7 @@ def compile_spatial_joint(scene: ArmScene, step: float | None, progress: bool = 
                 if t >= 0:
                     pair = (min(s, t), max(s, t))
                     if pair not in clear:
-                        clear[pair] = _move_clear(contact, fk, qs[s], qs[t], tips[s], tips[t], cell, vox)
+                        clear[pair] = _swept_clear(sweep, fk, qs[s], qs[t], tips[s], tips[t], cell, vox)
                     if clear[pair]:
                         edges.append((s, a, t))
                 continue
@@ -195,7 +198,7 @@ def compile_spatial_joint(scene: ArmScene, step: float | None, progress: bool = 
             if v < 0:
                 index[nidx] = -1
                 continue
-            if not _move_clear(contact, fk, qs[s], q, tips[s], tip, cell, vox):
+            if not _swept_clear(sweep, fk, qs[s], q, tips[s], tip, cell, vox):
                 continue  # this move is blocked; the point may still be reached another way
             clear[(s, len(qs))] = True
             index[nidx] = len(qs)
@@ -257,4 +260,16 @@ def _move_clear(contact: ContactChecker, fk: SpatialFK, qa, qb, pa, pb, cell: fl
         if hit or v < 0 or not vox.free[v]:
             return False
     return True
+
+
+def _swept_clear(sweep: SweepChecker, fk: SpatialFK, qa, qb, pa, pb, cell: float, vox: Voxels) -> bool:
+    """The straight joint move qa -> qb: at points at most half a cell of tool travel apart,
+    the tool in a free voxel (the ends are checked by the caller), and no contact anywhere
+    along it (``ik.sweep``)."""
+    m = max(1, int(math.ceil(2.0 * float(np.linalg.norm(np.asarray(pb) - np.asarray(pa))) / cell)))
+    for t in np.arange(1, m + 1) / (m + 1):
+        v = voxel_of_point(fk.tip(qa + (qb - qa) * t), cell, vox)
+        if v < 0 or not vox.free[v]:
+            return False
+    return sweep.clear(qa, qb)
 
