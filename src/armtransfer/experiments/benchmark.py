@@ -266,11 +266,16 @@ def record(pair: Pair, name: str, source_result: dict, trials: list[dict]) -> di
     if errors:
         rec["error"] = errors[0]
         rec.update(first_exposure=[None] * n, converged=[False] * n, convergence_steps=[None] * n,
-                   greedy_steps=[None] * n, episodes=[0] * n, area=[None] * n, curves=[])
+                   greedy_steps=[None] * n, episodes=[0] * n, area=[None] * n, curves=[],
+                   **{name: [None] * n for name in benchmark_runs.CLOCK_FIELDS})
         return rec
     rec.update({key: [t[field] for t in trials] for key, field in (
         ("first_exposure", "first_exposure"), ("converged", "converged"), ("convergence_steps", "convergence_steps"),
         ("greedy_steps", "greedy_steps"), ("episodes", "episodes"), ("area", "area"), ("curves", "curve"))})
+    rec.update({name: [t.get(name) for t in trials] for name in benchmark_runs.CLOCK_FIELDS})
+    notes = sorted({t["clock_note"] for t in trials if t.get("clock_note")})
+    if notes:
+        rec["clock_note"] = notes[0]
     return rec
 
 

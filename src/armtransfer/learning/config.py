@@ -45,6 +45,11 @@ class LearnerConfig:
                             1_000_000)
     """The greedy path has converged when it reaches the goal and stays the same for this
     many consecutive episodes."""
+    quality: float = _param(1.05, "a target's trial ends only on a settled greedy path at most ceil(quality x "
+                            "shortest) steps long (else at a cap); good_path_steps counts the steps until the "
+                            "greedy path is that good and stays so", 1.0, 1000.0)
+    """The harness's threshold of a good path (``learning.clock``); the learner never reads it.
+    Robot 1's learning, handed no shortest path, stops on any settled path."""
 
     def __post_init__(self) -> None:
         for f in fields(self):
