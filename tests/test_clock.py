@@ -137,3 +137,24 @@ def test_quality_below_one_is_refused():
 
     with pytest.raises(InvalidParameterError, match="quality"):
         LearnerConfig(quality=0.9)
+
+
+def test_lazy_cannot_buy_the_good_path_clock_on_a_small_case():
+    """``lazy`` (``plan`` told nothing, exploring less) settles sooner than ``plan`` on worse paths:
+    the settled clock ranks it ahead, the good-path clock behind (fine, Table I task 3, 4 trials;
+    geometric means of the trial-paired factors, a trial never good counted at the cap)."""
+    robot = grid_robot("fine")
+    start, goal = table_task(3).cells()
+    config = LearnerConfig()
+    plan = experiment.run_method("plan", robot, start, goal, None, 4, 11, config, threads=2)
+    lazy = experiment.run_method("lazy", robot, start, goal, None, 4, 11, config, threads=2)
+
+    def factor(name: str) -> float:
+        cap = config.max_total_steps
+        base = [getattr(t, name) or cap for t in plan.trials]
+        mine = [getattr(t, name) or cap for t in lazy.trials]
+        return float(np.exp(np.mean(np.log(np.array(base, float) / np.array(mine, float)))))
+
+    assert factor("total_steps") > 1.5  # the settled clock: lazy "wins"
+    assert factor("good_path_steps") < 1.0  # the good-path clock: it does not
+    assert max(t.settled_ratio for t in lazy.trials) > 1.05 >= max(t.settled_ratio for t in plan.trials)

@@ -53,14 +53,27 @@ def baselines_of(name: str) -> tuple[str, ...]:
     """The methods ``name``'s gain is measured against, each sharing its learner and told less:
     the registry's ``Method.baselines`` (the no-transfer one first; empty for a method that is
     itself no transfer), or, from a registry without that field, ``none`` for every method but
-    ``none``. ``name`` may be a record's label ``METHOD@LEARNER``: its baselines are labelled so."""
+    ``none``; then, for a method that reads the trajectory, its goal-only baseline
+    (:data:`GOAL_ONLY`). ``name`` may be a record's label ``METHOD@LEARNER``: its baselines are
+    labelled so."""
     method, learner = parse_label(name)
     m = methods.get(method)
     if hasattr(m, "baselines"):
         named = tuple(b for b in m.baselines if b in methods.METHODS and b != method)
     else:
         named = () if method == "none" else ("none",)
+    goal = GOAL_ONLY.get(named[0]) if named else None
+    if goal is not None and goal in methods.METHODS and goal not in named and goal != method \
+            and benchmark_runs.needs_trajectory(method):
+        named += (goal,)
     return tuple(label(b, learner) for b in named)
+
+
+GOAL_ONLY = {"none": "goal-dense", "plan": "goal-only"}
+"""The goal-only baseline set beside every method that reads the trajectory, by the baseline told
+nothing that shares its learner: what the route adds beyond the goal (``goal-dense``: ``dense``'s
+potential from the goal alone, on Algorithm 1; ``goal-only``: ``plan``'s learner heading for the
+goal)."""
 
 
 def registered_baseline(name: str) -> bool:
@@ -84,11 +97,18 @@ def baseline_of(name: str) -> str | None:
     return named[0] if named else None
 
 
+CONTROLS_BESIDE = {"plan": ("lazy",)}
+"""Controls run beside a baseline wherever it runs: ``lazy`` (``plan`` exploring less, told
+nothing) beside ``plan``, so that every report shows whether its clock can be bought by exploring
+less (it must not rank ``lazy`` ahead of ``plan``)."""
+
+
 def methods_to_run(wanted: tuple[str, ...] | None = None) -> tuple[list[str], list[str]]:
     """(the methods to run, in registry order: those of ``wanted`` this build has and every
     baseline they name; those of ``wanted`` this build does not have). ``wanted`` defaults to
     ``suites.METHODS`` and every method of an installed plugin or registered in this process:
-    a researcher's method is put through the suite beside the built-in ones."""
+    a researcher's method is put through the suite beside the built-in ones; the controls of
+    :data:`CONTROLS_BESIDE` run beside their baseline."""
     if wanted is None:
         wanted = (*suites.METHODS, *(m for m in methods.METHODS if m not in methods.BUILTIN))
     chosen: set[str] = set()
@@ -98,6 +118,9 @@ def methods_to_run(wanted: tuple[str, ...] | None = None) -> tuple[list[str], li
             chosen.add(name)
             for b in baselines_of(name):
                 add(b)
+            for c in CONTROLS_BESIDE.get(name, ()):
+                if c in methods.METHODS:
+                    add(c)
 
     for m in wanted:
         if m in methods.METHODS:
