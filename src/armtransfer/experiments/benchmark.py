@@ -275,10 +275,12 @@ class Pair:
                 **({} if self.case.state == "discrete" else {"state": self.case.state, "noise": self.case.noise})}
 
 
-def record(pair: Pair, name: str, source_result: dict, trials: list[dict]) -> dict:
+def record(pair: Pair, name: str, source_result: dict, trials: list[dict], ran: Sequence[str] | None = None) -> dict:
     """One record: method ``name``'s trials on ``pair`` (none when it could not run: then
-    ``error`` says why, the first trial's in trial order, and every trial counts as a failure)."""
-    rec = dict(pair.base(source_result), method=name, baselines=list(baselines_of(name)), error=None)
+    ``error`` says why, the first trial's in trial order, and every trial counts as a failure);
+    its baselines those of ``ran`` (None: all it names)."""
+    named = [b for b in baselines_of(name) if ran is None or b in ran]
+    rec = dict(pair.base(source_result), method=name, baselines=named, error=None)
     method, learner = parse_label(name)
     if source_result["trajectory"] is None and benchmark_runs.needs_trajectory(method):
         rec["told_nothing"] = benchmark_runs.told_nothing(method)
@@ -332,6 +334,10 @@ class Plan:
         if pair.section.methods is not None:
             keep = methods_to_run(pair.section.methods)[0]
             ran = [m for m in ran if m in keep]
+        if pair.case.state != "discrete":  # a continuous target runs the methods paid on labels alone
+            from armtransfer.learning.cells import CELL_METHODS
+
+            ran = [m for m in ran if m == "none" or m in CELL_METHODS]
         return [(lr, learner_methods(lr, ran)) for lr in self.learners_of(pair)]
 
     def labels(self, pair: Pair | None = None) -> list[str]:
@@ -383,10 +389,11 @@ class Plan:
                 continue
             trials = [(run, result(run)) for run in self.all_trial_runs(pair, source)]
             missing += sum(r is None for _, r in trials)
-            for name in self.labels(pair):
+            names = self.labels(pair)
+            for name in names:
                 mine = [r for run, r in trials if label(run["method"], run["learner"]) == name]
                 if all(r is not None for r in mine):
-                    out.append(record(pair, name, source, cast(list, mine)))
+                    out.append(record(pair, name, source, cast(list, mine), names))
         if missing:
             raise IncompleteError(f"{missing} of {self.size()} runs are not in yet", missing)
         return out
