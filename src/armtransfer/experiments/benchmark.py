@@ -63,8 +63,8 @@ def baselines_of(name: str) -> tuple[str, ...]:
     else:
         named = () if method == "none" else ("none",)
     goal = GOAL_ONLY.get(named[0]) if named else None
-    if goal is not None and goal in methods.METHODS and goal not in named and goal != method \
-            and benchmark_runs.needs_trajectory(method):
+    reads = getattr(m, "shaped", False) and getattr(m, "uses_trajectory", True)
+    if goal is not None and goal in methods.METHODS and goal not in named and goal != method and reads:
         named += (goal,)
     return tuple(label(b, learner) for b in named)
 
