@@ -6,13 +6,14 @@ falls inside our interval.
 For each seed, ``experiments.calibrated.run_study`` (the prediction of Tables II C and V C with
 the learner fitted to the no-transfer columns only, 30 trials per cell from 10 source seeds
 seed, seed + 1, ..., the improvement's interval resampling source seeds) writes
-``DIR/study-SEED.json``; ``DIR/seeds.md`` tabulates, per cell and seed, our improvement with the
+``DIR/study-SEED.json.gz``; ``DIR/seeds.md`` tabulates, per cell and seed, our improvement with the
 safe K and its interval, whether the paper's value lies inside it, and robot 1's handed-over
 path length against its shortest.
 """
 
 from __future__ import annotations
 
+import gzip
 import json
 import time
 from pathlib import Path
@@ -22,6 +23,12 @@ from armtransfer.experiments import calibrated, paper
 from armtransfer.learning import presets
 
 TABLES = {"table_ii": ("Table II", paper.TABLE_II), "table_v": ("Table V", paper.TABLE_V)}
+
+
+def load(path: Path) -> dict:
+    """A study written by :func:`main` (its tasks' keys back to numbers)."""
+    data = json.loads(gzip.decompress(path.read_bytes()))
+    return {k: ({int(t): v for t, v in tv.items()} if k in TABLES else tv) for k, tv in data.items()}
 
 
 def _pct(x) -> str:
@@ -68,15 +75,14 @@ def main(argv: list[str] | None = None) -> int:
     config = presets.config(presets.PAPER_CALIBRATED)
     studies = {}
     for seed in args.seeds:
-        path = args.out / f"study-{seed}.json"
+        path = args.out / f"study-{seed}.json.gz"
         if path.exists():
-            studies[seed] = {k: ({int(t): v for t, v in tv.items()} if k in TABLES else tv)
-                             for k, tv in json.loads(path.read_text()).items()}
+            studies[seed] = load(path)
             continue
         t0 = time.time()
         studies[seed] = calibrated.run_study(config, args.trials, seed)
         studies[seed]["wall_seconds"] = round(time.time() - t0, 1)
-        path.write_text(json.dumps(studies[seed], indent=1, default=str) + "\n")
+        path.write_bytes(gzip.compress((json.dumps(studies[seed], indent=1, default=str) + "\n").encode(), mtime=0))
         print(f"seed {seed}: {studies[seed]['wall_seconds']} s", flush=True)
     text = summary(studies)
     (args.out / "seeds.md").write_text(text)

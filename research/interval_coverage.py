@@ -6,8 +6,9 @@ Data sets of log factors with true mean 0: either one case of N source seeds (se
 units) or N cases of 5 seeds (cases are the units), two trials per seed; a unit's effect and a
 trial's noise (half its scale) are drawn from a normal, a heavy-tailed (Student t, 3 degrees of
 freedom) or a skewed distribution (gamma of shape 2, skewness 1.4; log-normal of sigma 0.5,
-skewness 1.75), each centred. The log step ratios of the standard benchmark have seed-level
-skewness within +-1 and excess kurtosis up to 1.5 (docs/research-log.md), inside this range.
+skewness 1.75), each centred. In the standard benchmark's records the seed-level mean log
+factors have skewness -0.9 to 0.8 and the trial-level ones excess kurtosis up to 1.5 (10th-90th
+percentiles; docs/benchmark.md), inside this range.
 Prints the share of data sets whose 95% interval holds 0, per design, size and distribution.
 """
 

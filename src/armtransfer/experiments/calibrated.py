@@ -124,7 +124,7 @@ def run_study(config: LearnerConfig, trials: int, seed: int, tick: Callable[[], 
             source_steps = []
             for j in range(SOURCE_SEEDS):
                 traj = experiment.source_trajectory("learned", src, start, goal, config, seed + j)
-                source_steps.append(len(traj.cells) - 1)
+                source_steps.append(len(traj.cells))  # its cells s_t0..s_tn, the goal after them: n + 1 steps
                 for name, (cfg, K) in variants.items():
                     cfg = replace(cfg, max_episodes=1, max_total_steps=STUDY_CAP)
                     r = _pseudo_trials(tgt, start, goal, traj, cfg, K, per_seed, seed + j, tick)

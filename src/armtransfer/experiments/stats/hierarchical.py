@@ -12,9 +12,9 @@ The interval is a bootstrap-t (studentized): each resample's statistic is divide
 standard error across the top-level units (cases; seeds when there is one case), and the
 quantiles of that ratio set the interval around the estimate. It is the union of the
 equal-tailed bootstrap-t interval and the symmetric one (the 95% quantile of |t|): the
-equal-tailed one alone covered 91-93% on heavy-tailed data (t with 3 degrees of freedom, the
-kind log step ratios are) and the symmetric one alone 92-93% on skewed data; their union covers
-at least 93% on normal, heavy-tailed and skewed data at 6 to 24 units (simulated:
+equal-tailed one alone covered 91-93% on heavy-tailed data (t with 3 degrees of freedom) and the
+symmetric one alone 92-94% on skewed data; their union covers at least 93% on normal,
+heavy-tailed and skewed data at 6 to 24 units (simulated:
 ``tests/test_hierarchical.py``, ``research/interval_coverage.py``). A percentile interval covered about
 92% at ten normal units.
 
