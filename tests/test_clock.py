@@ -158,3 +158,22 @@ def test_lazy_cannot_buy_the_good_path_clock_on_a_small_case():
     assert factor("total_steps") > 1.5  # the settled clock: lazy "wins"
     assert factor("good_path_steps") < 1.0  # the good-path clock: it does not
     assert max(t.settled_ratio for t in lazy.trials) > 1.05 >= max(t.settled_ratio for t in plan.trials)
+
+
+def test_a_quality_below_one_is_a_one_line_error_before_the_benchmark_writes(tmp_path, capsys):
+    from armtransfer.cli import main
+
+    out = tmp_path / "b"
+    assert main(["benchmark", "--suite", "fast", "--quality", "0.9", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "quality" in err and len(err.splitlines()) == 1
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_a_benchmark_of_another_quality_is_another_store():
+    from armtransfer.experiments import benchmark, suites
+
+    default = benchmark.plan(suites.get("fast"))
+    exact = benchmark.plan(suites.get("fast"), quality=1.0)
+    assert "quality" not in default.spec()["benchmark"] and exact.spec()["benchmark"]["quality"] == 1.0
+    assert exact.pairs[0].config.quality == 1.0

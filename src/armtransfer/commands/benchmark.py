@@ -52,6 +52,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="the learners every method runs on, each method beside the baseline the same learner runs "
                         "(an outside learner runs none and the reward-term methods; docs/extending.md); default: the "
                         f"suite's own (sarsa). Learners: {learned}")
+    p.add_argument("--quality", type=float, default=None, metavar="Q",
+                   help="a good path is at most ceil(Q x the target's shortest path) steps; a trial ends only on a "
+                        "settled good path and the headline counts the steps until the greedy path is good and stays "
+                        "so (default: the preset's, 1.05)")
     common.add_world_argument(p)
     add_executor_arguments(p)
     common.add_preset_argument(p)
@@ -88,7 +92,8 @@ def run(args: argparse.Namespace) -> int:
 
         learners = parse(args.learner)  # a typo lists the valid names
     robots = benchmark.Robots({})
-    plan = benchmark.plan(suite, args.seed, robots, ran, missing, preset=args.preset, learners=learners)
+    plan = benchmark.plan(suite, args.seed, robots, ran, missing, preset=args.preset, learners=learners,
+                          quality=args.quality)
     from armtransfer.learning.methods import probe_on, refuse_run_time
 
     # a plugin's fault stops the run here, in one line, before its store is opened
@@ -230,7 +235,8 @@ def plan_of(store: ResultStore) -> benchmark.Plan:
     except Exception:  # noqa: BLE001 - any malformed spec is the same one-line refusal
         raise StoreError(f"{str(store.root)!r} holds a benchmark of a suite this build does not have") from None
     plan = benchmark.plan(suite, spec["seed"], ran=spec["methods"], missing=spec["not_in_registry"],
-                          preset=spec.get("preset", "default"), learners=spec.get("learners"))
+                          preset=spec.get("preset", "default"), learners=spec.get("learners"),
+                          quality=spec.get("quality"))
     if content_key(plan.spec()) != store.meta.get("key"):
         raise StoreError(f"{str(store.root)!r} holds a benchmark of suite {suite.name!r} as another build defined "
                          "it (its version, methods or learner settings differ); rebuild it with that build")
