@@ -119,9 +119,8 @@ finding about ``plan``, not about the clock (docs/research-log.md)."""
 
 
 def _lazy(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
-    sh = _plan(robot, trajs, k, beta)
-    assert sh.guide is not None
-    return replace(sh, guide=sh.guide._replace(untried=np.full(robot.n_states, LAZY_UNTRIED)))
+    g = planner_guide(robot)._replace(untried=np.full(robot.n_states, LAZY_UNTRIED))
+    return replace(_plan(robot, trajs, k, beta), guide=g)
 
 
 def _goal_dense(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
