@@ -177,3 +177,26 @@ def test_a_benchmark_of_another_quality_is_another_store():
     exact = benchmark.plan(suites.get("fast"), quality=1.0)
     assert "quality" not in default.spec()["benchmark"] and exact.spec()["benchmark"]["quality"] == 1.0
     assert exact.pairs[0].config.quality == 1.0
+
+
+def test_an_outside_learners_clock_comes_from_its_greedy_evaluations():
+    from armtransfer.experiments.learner_trial import eval_clock
+
+    evals = [[100, None], [200, 21], [300, 25], [400, 21], [500, 20]]
+    out = eval_clock(evals, optimal=20, good_len=21, settled=22, total=510)
+    assert out == {"good_path_steps": 400, "shortest_path_steps": 500, "settled_ratio": 1.1, "final_ratio": 1.0,
+                   "steps_run": 510}
+    assert eval_clock(evals + [[600, 30]], 20, 21, None, 610)["good_path_steps"] is None
+
+
+def test_the_frame_and_the_json_carry_the_clock_per_trial():
+    pytest.importorskip("pandas")
+    import armtransfer
+
+    r = armtransfer.transfer("coarse", "fine", task=1, methods=["none", "pseudo"], trials=2, seed=3, controls=False)
+    df = r.to_frame()
+    for name in ("good_path_steps", "settled_ratio", "shortest_path_steps", "final_ratio", "steps_run"):
+        assert name in df.columns
+    assert list(df.columns[:6]) == ["method", "control", "trial", "reached", "good_path_steps", "settled_ratio"]
+    data = r.to_json()["results"]["pseudo"]
+    assert len(data["good_path_steps"]) == len(data["settled_ratio"]) == 2
