@@ -42,15 +42,17 @@ def _small():
     return robot, robot.start_state(start), goal
 
 
-@pytest.mark.parametrize("seed", [3, 4])
-def test_the_stopping_rule_is_the_dense_references_greedy_paths_read_apart(seed):
+@pytest.mark.parametrize("seed, run_on", [(3, 1000.0), (3, 0.1), (4, 1.0)])
+def test_the_stopping_rule_is_the_dense_references_greedy_paths_read_apart(seed, run_on):
     """The kernel with a good length learns exactly as Algorithm 1 (the dense reference, bit for
     bit) and stops at the first episode after which the reference's own greedy path has stayed the
-    same for ``patience`` episodes and is at most the good length; its settled clock is the first
-    such episode of any length."""
+    same for ``patience`` episodes and is at most the good length, or once it has run ``run_on``
+    times the steps it took to first settle more (seed 3 settles on 14 steps of 12: with a large
+    budget it runs to the episode cap, with 0.1 it stops soon after); its settled clock is the
+    first such episode of any length."""
     robot, s0, goal = _small()
     optimal = len(robot.shortest_path(s0, goal)) - 1
-    config = LearnerConfig(trace_cutoff=0.0, max_episodes=60, patience=3, quality=1.0, epsilon=0.3)
+    config = LearnerConfig(trace_cutoff=0.0, max_episodes=60, patience=3, quality=1.0, epsilon=0.3, run_on=run_on)
     fast = sarsa.learn(robot, s0, goal, config, np.random.default_rng(seed), keep_q=True, optimal=optimal)
     paths: list = []
     Q, steps = reference.learn(robot, s0, goal, config, np.random.default_rng(seed), episodes=fast.episodes,
@@ -63,9 +65,11 @@ def test_the_stopping_rule_is_the_dense_references_greedy_paths_read_apart(seed)
         last = paths[e - config.patience: e + 1]
         return e >= config.patience and last[0] is not None and all(p == last[0] for p in last)
 
-    stops = [e for e in range(len(paths)) if settled(e) and len(paths[e]) - 1 <= optimal]
-    assert (fast.episodes - 1 == stops[0]) if stops else fast.episodes == config.max_episodes
     first = next(e for e in range(len(paths)) if settled(e))
+    budget = sum(abs(x) for x in steps[: first + 1]) * (1 + config.run_on)  # the run-on budget, in steps
+    spent = [e for e in range(first, len(paths)) if sum(abs(x) for x in steps[: e + 1]) >= budget]
+    stops = [e for e in range(len(paths)) if settled(e) and len(paths[e]) - 1 <= optimal] + spent
+    assert (fast.episodes - 1 == min(stops)) if stops else fast.episodes == config.max_episodes
     changed = max(e for e in range(first + 1) if e == 0 or paths[e] != paths[e - 1])
     assert fast.total_steps == sum(abs(x) for x in steps[: changed + 1])
     assert fast.greedy_steps == len(paths[first]) - 1

@@ -128,13 +128,15 @@ class Learning(NamedTuple):
     max_total_steps: int
     max_episode_steps: int
     patience: int
+    run_on: float
+    """A trial settled on a path that is not good runs on to (1 + run_on) x its steps then, at most."""
 
     @staticmethod
     def of(config: LearnerConfig) -> "Learning":
         return Learning(float(config.alpha), float(config.gamma), float(config.lam), float(config.epsilon),
                         float(config.step_reward), float(config.goal_reward), float(config.trace_cutoff),
                         int(config.max_episodes), int(config.max_total_steps), int(config.max_episode_steps),
-                        int(config.patience))
+                        int(config.patience), float(config.run_on))
 
 
 class Outputs(NamedTuple):
@@ -295,7 +297,8 @@ def _make_run_trial(with_guide: bool):
     and what robot 2 learns, ``m`` (``guide.Guide``, ``guide.Model``; None without the guide),
     and ``out`` (:class:`Outputs`; ``out.settled`` gets the first settled path). A settled greedy
     path ends the trial only when it is at most ``world.good_len`` long (-1: any); otherwise the
-    trial goes on to a cap. Returns (episodes, the converged episode or -1, the length
+    trial goes on to a cap or until it has run ``learning.run_on`` times the steps it took to settle
+    more. Returns (episodes, the converged episode or -1, the length
     of ``out.prev_path``, the length of ``out.fp_states``)."""
 
     @numba.njit(cache=True, nogil=True)  # nogil: trials run on threads (experiment.trial_threads)
@@ -326,6 +329,7 @@ def _make_run_trial(with_guide: bool):
         pos = np.full(cap, -1, np.int64)
         n_tr = 0
         decay = gamma * learning.lam
+        run_on_until = max_total_steps  # the run-on budget, set when the greedy path first settles
         total = 0
         prev_n = 0
         stable = 0
@@ -450,6 +454,7 @@ def _make_run_trial(with_guide: bool):
                 if out.settled[0] < 0:  # the first settled path: what the settled clock stops at
                     out.settled[0] = converged_episode
                     out.settled[1] = n
+                    run_on_until = total + int(learning.run_on * total)
                     for i in range(n):
                         settled_path[i] = path_buf[i]
                         x = path_buf[i]
@@ -460,7 +465,7 @@ def _make_run_trial(with_guide: bool):
                         out.settled_actions[i] = ba
                 if world.good_len < 0 or n - 1 <= world.good_len:  # settled on a good path: the trial ends
                     break
-            if total >= max_total_steps:
+            if total >= max_total_steps or total >= run_on_until:  # a cap, or the run-on budget spent
                 break
         if stable < patience:
             converged_episode = -1
