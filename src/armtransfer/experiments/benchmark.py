@@ -321,6 +321,8 @@ class Plan:
     """The learners every method runs on; None: each section's own (``Section.learners``)."""
     quality: float = SOURCE_CONFIG.quality
     """The good path's threshold robot 2's trials run with (``LearnerConfig.quality``)."""
+    run_on: float = SOURCE_CONFIG.run_on
+    """The run-on budget robot 2's trials run with (``LearnerConfig.run_on``)."""
 
     @property
     def name(self) -> str:
@@ -371,6 +373,8 @@ class Plan:
             spec["learners"] = list(self.learners)
         if self.quality != SOURCE_CONFIG.quality:  # the default's store keeps its key
             spec["quality"] = self.quality
+        if self.run_on != SOURCE_CONFIG.run_on:
+            spec["run_on"] = self.run_on
         return {"benchmark": spec}
 
     def size(self) -> int:
@@ -422,15 +426,19 @@ class Plan:
 
 def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
          ran: Sequence[str] | None = None, missing: Sequence[str] = (), preset: str = "default",
-         learners: Sequence[str] | None = None, quality: float | None = None) -> Plan:
+         learners: Sequence[str] | None = None, quality: float | None = None,
+         run_on: float | None = None) -> Plan:
     """Every pair of ``suite`` for ``seed``, its task's cells drawn and checked for both robots
     (an error names the case before anything runs); ``ran``: the methods (default
     :func:`methods_to_run`'s); robot 2 learns with the settings of ``preset`` (robot 1 always
     with the defaults); ``learners``: the learners every method runs on (None: each section's
-    own); ``quality``: the good path's threshold (``LearnerConfig.quality``; None: the preset's)."""
+    own); ``quality``: the good path's threshold (``LearnerConfig.quality``; None: the preset's);
+    ``run_on``: the run-on budget (``LearnerConfig.run_on``; None: the preset's)."""
     learner = presets.config(preset)
     if quality is not None:
         learner = replace(learner, quality=quality)  # checked by LearnerConfig: a one-line error
+    if run_on is not None:
+        learner = replace(learner, run_on=run_on)
     if ran is None:
         ran, missing = methods_to_run()
     robots = robots if robots is not None else Robots({})
@@ -465,7 +473,7 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
                 pairs.append(Pair(section, ci, case, j, run_seed(seed, section.name, ci, j), target.layout.xy(start),
                                   target.layout.xy(goal), len(path) - 1, learner))
     return Plan(suite, int(seed), tuple(ran), tuple(missing), tuple(pairs), preset,
-                None if learners is None else tuple(learners), learner.quality)
+                None if learners is None else tuple(learners), learner.quality, learner.run_on)
 
 
 def run_suite(suite: suites.Suite, seed: int = 0, tick: Callable[[], None] | None = None,
