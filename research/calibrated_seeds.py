@@ -35,6 +35,11 @@ def _pct(x) -> str:
     return "n/a" if x is None else f"{x:.1f}"
 
 
+def table(studies: dict[int, dict]) -> str:
+    """The per cell and seed table of :func:`summary` (what the README shows)."""
+    return summary(studies).split("\n\n", 1)[0] + "\n"
+
+
 def summary(studies: dict[int, dict]) -> str:
     seeds = sorted(studies)
     header = "| cell | paper C % | " + " | ".join(f"seed {s}: ours C % [95%]" for s in seeds) + " | inside |"

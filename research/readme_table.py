@@ -6,8 +6,8 @@ prints markdown tables, one row per section of the suite and one column per meth
 baseline that shares its learner: the good-path clock first (steps until the greedy path is
 within the quality threshold of the shortest and stays so), with the settled quality of the
 method's and the baseline's trials beside it (median and worst first settled path over the
-shortest); then the settled clock (steps until the greedy path first settled, however long) and
-the first exposure. A cell is the factor (baseline / method, above 1 the method is faster), its
+shortest); then the settled clock (steps until the greedy path first settled, however long); the
+first exposure is in the report. A cell is the factor (baseline / method, above 1 the method is faster), its
 95% hierarchical bootstrap-t interval and the worst case x source seed pair; a verdict that
 survives Holm's correction is marked "faster" or "slower"; "n.s." is not told apart at this size,
 "n.s. (Holm)" an interval that excludes 1 before Holm's correction and not after, "too few" no
@@ -74,7 +74,7 @@ def good_cell(block: dict | None) -> str:
     return f"{cell(good)}; settled {_q(settled.get('method'))} vs {_q(settled.get('baseline'))}"
 
 
-def tables(summary: dict) -> str:
+def tables(summary: dict, settled: bool = True) -> str:
     header = "| suite | " + " | ".join(f"`{m}` vs `{b}`" for m, b in COLUMNS) + " |"
     rule = "|---|" + "---|" * len(COLUMNS)
     out = ["**Good path: steps until the greedy path is within 5% of the shortest and stays there; "
@@ -83,8 +83,7 @@ def tables(summary: dict) -> str:
         row = [good_cell(pooled.get(m, {}).get(b)) for m, b in COLUMNS]
         out.append(f"| {SECTIONS.get(section, section)} | " + " | ".join(row) + " |")
     out.append("")
-    for metric, title in (("convergence", "Settled clock: steps until the greedy path first settled, however long"),
-                          ("first_exposure", "First exposure: steps until the goal was first reached")):
+    for metric, title in (("convergence", "Settled clock: steps until the greedy path first settled, however long"),)[:int(settled)]:
         out += [f"**{title}**", "", header, rule]
         for section, pooled in summary.items():
             row = [cell(pooled.get(m, {}).get(b, {}).get(metric)) for m, b in COLUMNS]
@@ -130,11 +129,13 @@ def main(argv: list[str] | None = None) -> int:
 
     p = script.parser(__doc__)
     p.add_argument("results", type=Path, help="a benchmark's results.json or results.json.gz")
+    p.add_argument("--good-only", action="store_true", help="the good-path table alone (the README's)")
     p.add_argument("--learners", action="store_true",
                    help="one row per learner (a suite with several, such as small) instead of one per section")
     args = p.parse_args(argv)
     try:
-        text = (learner_table if args.learners else tables)(pooled(args.results))
+        summary = pooled(args.results)
+        text = learner_table(summary) if args.learners else tables(summary, settled=not args.good_only)
     except ArmTransferError as err:
         print(f"readme_table.py: error: {err}", file=sys.stderr)
         return 2
