@@ -123,7 +123,7 @@ def test_learner_config_fields_are_the_flags(tmp_path):
     path = tmp_path / "r.json"
     args = ["rooms", "--method", "none", "--trials", "1", "--no-controls", "--json", str(path)]
     expected = dict(alpha=0.2, gamma=0.98, lam=0.8, epsilon=0.05, step_reward=-2.0, goal_reward=1.0,
-                    max_episodes=1999, max_total_steps=19_000_000, max_episode_steps=190_000, patience=19)
+                    max_episodes=1999, max_total_steps=19_000_000, max_episode_steps=190_000, patience=19, quality=1.1, run_on=2.0)
     assert set(expected) == {f.name for f in fields(LearnerConfig) if f.metadata.get("cli")}
     for name, value in expected.items():
         assert getattr(LearnerConfig(), name) != value

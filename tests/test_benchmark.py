@@ -85,7 +85,7 @@ def test_report_names_each_methods_baseline(fast_runs):
         for base in bases:
             named += 1
             assert f"`{m}` against `{base}`" in report
-            assert f"{base}: " in row.split("|")[8]
+            assert f"{base}: " in row.split("|")[10] and f"{base}: " in row.split("|")[11]  # good path, settled
     assert named >= 3
     # two source seeds: the numbers, but no claim
     assert "too few pairs for a claim (2 < 10)" in report
@@ -230,7 +230,9 @@ def test_paired_factor_is_per_trial_and_ties_at_the_cap_are_counted_apart():
     assert pooled["baseline"] == "none" and pooled["first_exposure"]["seeds"] == 10
     assert benchmark_report.judgement(pooled["first_exposure"]).startswith("faster than its baseline")
     text = benchmark_report.sentence("pseudo", pooled, "s")
-    assert text.index("Whole cost") < text.index("First exposure") < text.index("Transfer ratio")
+    assert text.index("Good path") < text.index("Settled clock") < text.index("First exposure") \
+        < text.index("Transfer ratio")
+    assert "Good path: not measured" in text  # these records have no good-path clock
     assert "4.00x [4.00x, 4.00x] as fast" in text and "20 trial pairs capped in both are ties" in text
 
 
@@ -292,7 +294,7 @@ def test_baseline_comes_from_the_registry_when_it_names_one(monkeypatch):
     assert benchmark.baselines_of("guided") == ("pseudo", "dense") and benchmark.registered_baseline("guided")
     assert benchmark.baselines_of("dense") == ("none",) and not benchmark.registered_baseline("dense")
     ran, _ = benchmark.methods_to_run(("guided",))
-    assert ran == ["none", "pseudo", "dense", "guided"]  # and their own baselines
+    assert ran == ["none", "pseudo", "dense", "guided", "goal-dense"]  # and their own baselines: pseudo's goal-only
 
 
 def test_drawn_tasks_are_deterministic_and_long_enough():
@@ -352,3 +354,24 @@ def test_a_run_written_before_told_nothing_keeps_its_error():
 
     run = {"method": "pseudo", "trajectory": None, "source_failure": "robot 1 did not converge"}
     assert benchmark_runs.trial_result(run, None) == {"error": "no trajectory: robot 1 did not converge"}
+
+
+def test_every_record_carries_the_good_path_clock_and_the_report_leads_with_it(fast_runs):
+    """Every trial of every record has good_path_steps and settled_ratio; a trial with a
+    good_path_steps ended on a good path (its final greedy path within ceil(quality x shortest));
+    the claims state the good path first, with the settled quality beside it, and lazy's control."""
+    root, _ = fast_runs
+    data = json.loads((root / "one" / "results.json").read_text())
+    for rec in data["records"]:
+        n = len(rec["first_exposure"])
+        assert len(rec["good_path_steps"]) == len(rec["settled_ratio"]) == len(rec["final_ratio"]) == n
+        good_len = math.ceil(round(1.05 * rec["optimal"], 9))
+        for g, final, run in zip(rec["good_path_steps"], rec["final_ratio"], rec["steps_run"]):
+            if g is not None:
+                assert final is not None and round(final * rec["optimal"]) <= good_len and g <= run
+    assert {"lazy", "goal-dense"} <= set(data["methods"])
+    report = (root / "one" / "report.md").read_text()
+    claim = next(line for line in report.splitlines() if line.startswith("- fast: `corridor` against `plan`"))
+    assert claim.index("Good path:") < claim.index("Settled clock") and "settled at" in claim
+    assert "- fast: `corridor` against `goal-only`" in report and "- fast: `pseudo` against `goal-dense`" in report
+    assert "- fast, control: `lazy`" in report

@@ -94,15 +94,15 @@ def test_the_kept_standard_report_comes_back_from_its_records(tmp_path, capsys):
 
 
 def test_the_readme_shows_the_tables_of_the_kept_report():
-    """README's benchmark tables are research/readme_table.py's output on the kept results file,
+    """docs/benchmark.md's standard-suite tables are research/readme_table.py's output on the kept results file,
     character for character: no number in them is typed by hand."""
     import importlib.util
 
     spec = importlib.util.spec_from_file_location("readme_table", ROOT / "research" / "readme_table.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    readme = (ROOT / "README.md").read_text()
-    shown = readme.split("<!-- benchmark-tables -->\n", 1)[1].split("<!-- /benchmark-tables -->", 1)[0]
+    page = (ROOT / "docs" / "benchmark.md").read_text()
+    shown = page.split("<!-- benchmark-tables -->\n", 1)[1].split("<!-- /benchmark-tables -->", 1)[0]
     assert shown == module.tables(module.pooled(KEPT))
 
 
@@ -122,8 +122,8 @@ def test_the_readme_shows_the_learner_table_of_the_kept_small_report():
     """README's learner table (SARSA, DQN, PPO each against its own ``none``) is
     research/readme_table.py --learners on the kept small-suite results, character for character."""
     module = _readme_table_module()
-    readme = (ROOT / "README.md").read_text()
-    shown = readme.split("<!-- learner-table -->\n", 1)[1].split("<!-- /learner-table -->", 1)[0]
+    page = (ROOT / "docs" / "benchmark.md").read_text()
+    shown = page.split("<!-- learner-table -->\n", 1)[1].split("<!-- /learner-table -->", 1)[0]
     assert shown == module.learner_table(module.pooled(SMALL))
     assert [r.split(" | ")[0] for r in shown.splitlines()[2:]] == ["| sarsa", "| dqn", "| ppo"]
 
@@ -145,6 +145,37 @@ def test_the_learner_table_puts_each_learner_against_its_own_none():
                         "pseudo@ppo": {"none@ppo": {"first_exposure": ab(6.0)}}}}
     rows = module.learner_table(pooled).splitlines()
     assert [r.split(" | ")[0] for r in rows[2:]] == ["| sarsa", "| dqn", "| ppo"]
-    assert rows[3].split(" | ")[1].startswith("3×") and rows[3].split(" | ")[2].startswith("5×")
-    assert rows[4].split(" | ")[1] == "n/a" and rows[4].split(" | ")[3].startswith("6×")
+    # columns: good path (pseudo, dense), settled clock (pseudo, dense), first exposure (pseudo, dense)
+    assert rows[3].split(" | ")[1] == "not measured" and rows[3].split(" | ")[2] == "not measured"
+    assert rows[3].split(" | ")[3].startswith("3×") and rows[3].split(" | ")[4].startswith("5×")
+    assert rows[4].split(" | ")[1] == "not measured" and rows[4].split(" | ")[3] == "n/a"
+    assert rows[4].split(" | ")[5].startswith("6×")
     assert "n.s." in rows[2]
+
+
+PAPER = ROOT / "docs" / "benchmark-paper" / "results.json.gz"
+
+
+def test_the_readme_shows_the_good_path_tables_of_the_kept_paper_report():
+    """README's headline tables (the good-path clock first) are research/readme_table.py's output
+    on the kept paper-suite results, character for character; the control lazy is among them."""
+    module = _readme_table_module()
+    readme = (ROOT / "README.md").read_text()
+    shown = readme.split("<!-- paper-clock-tables -->\n", 1)[1].split("<!-- /paper-clock-tables -->", 1)[0]
+    assert shown == module.tables(module.pooled(PAPER), settled=False)
+    assert shown.startswith("**Good path") and "`lazy` vs `plan`" in shown.splitlines()[2]
+
+
+def test_the_readme_shows_the_calibrated_seeds_table():
+    """README's paper-calibrated table is research/calibrated_seeds.py's summary of the kept studies."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("calibrated_seeds", ROOT / "research" / "calibrated_seeds.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    kept = ROOT / "docs" / "reproduce-calibrated" / "seeds"
+    studies = {int(p.name.split("-")[1].split(".")[0]): module.load(p) for p in sorted(kept.glob("study-*.json.gz"))}
+    assert len(studies) >= 3
+    readme = (ROOT / "README.md").read_text()
+    shown = readme.split("<!-- calibrated-seeds -->\n", 1)[1].split("<!-- /calibrated-seeds -->", 1)[0]
+    assert shown == module.table(studies) and (kept / "seeds.md").read_text() == module.summary(studies)

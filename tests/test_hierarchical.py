@@ -18,32 +18,85 @@ def _coverage(make, datasets: int, seed: int) -> float:
     return hits / datasets
 
 
-@pytest.mark.parametrize("between, within", [(1.0, 0.5), (0.3, 1.0)])
-def test_coverage_at_ten_seeds_is_93_to_97_percent(between, within):
-    """Ten source seeds of two trials each, log factors normal around 0 with a seed effect and
-    trial noise: the interval holds 0 in 93-97% of 1000 simulated data sets (measured 94.5% and
-    94.9% on 1500 others; a percentile interval of the same resamples held it in about 92%, or
-    97.5% when the trials' noise dominates)."""
-    def make(rng):
-        return [(rng.normal(0.0, between, (10, 1)) + rng.normal(0.0, within, (10, 2))).tolist()]
+def _draw(kind, rng, shape):
+    """Centred draws: normal, heavy-tailed (t, 3 degrees of freedom) or skewed (gamma of shape 2,
+    skewness 1.4; log-normal of sigma 0.5, skewness 1.75)."""
+    if kind == "normal":
+        return rng.normal(0.0, 1.0, shape)
+    if kind == "t3":
+        return rng.standard_t(3, shape) / np.sqrt(3.0)
+    if kind == "gamma2":
+        return rng.gamma(2.0, 1.0, shape) - 2.0
+    return rng.lognormal(0.0, 0.5, shape) - np.exp(0.125)
 
-    assert 0.93 <= _coverage(make, 1000, 7) <= 0.97
+
+@pytest.mark.parametrize("kind", ["normal", "t3", "gamma2", "lognormal05"])
+@pytest.mark.parametrize("seeds", [6, 10])
+def test_coverage_on_normal_heavy_tailed_and_skewed_seeds_is_at_least_93_percent(kind, seeds):
+    """One case of 6 (the fewest units an interval is made from) or 10 source seeds (a case of the
+    benchmark) of two trials each, a seed effect and trial noise drawn from ``kind``: the interval
+    holds 0 in at least 93% of 600 simulated data sets, and is not wildly conservative (at most
+    99%). Measured (research/interval_coverage.py, 600 others): 94-98%; the equal-tailed bootstrap-t alone
+    held 0 in 91% on t3 at 10 seeds."""
+    def make(rng):
+        return [(_draw(kind, rng, (seeds, 1)) + 0.5 * _draw(kind, rng, (seeds, 2))).tolist()]
+
+    assert 0.93 <= _coverage(make, 600, 7) <= 0.99
+
+
+def test_the_equal_tailed_interval_alone_undercovers_heavy_tails():
+    """Why the interval is a union: on t3 seeds the equal-tailed bootstrap-t alone falls below 93%
+    (its quantiles of the studentized statistic, from resamples of few heavy-tailed units, are
+    too short on one side)."""
+    rng = np.random.default_rng(7)
+    hits = 0
+    for i in range(600):
+        data = (_draw("t3", rng, (10, 1)) + 0.5 * _draw("t3", rng, (10, 2))).tolist()
+        units = np.mean(data, axis=1)
+        est, se0 = units.mean(), units.std(ddof=1) / np.sqrt(10)
+        boot_rng = np.random.default_rng(i)
+        arr, cnt = hierarchical._pad(data)
+        stud = hierarchical._studentized([(arr, cnt)], float(est), 10, 999, boot_rng)
+        hi_q, lo_q = np.quantile(stud, [0.975, 0.025])
+        hits += est - hi_q * se0 <= 0.0 <= est - lo_q * se0
+    assert hits / 600 < 0.93
 
 
 @pytest.mark.slow
-def test_coverage_at_ten_cases_is_93_to_97_percent():
+@pytest.mark.parametrize("kind", ["normal", "t3", "gamma2", "lognormal05"])
+@pytest.mark.parametrize("cases", [8, 24])
+def test_coverage_over_cases_is_at_least_93_percent(kind, cases):
+    """Cases as the units (8: the paper section; 24: the arms), 5 seeds of two trials each."""
     def make(rng):
-        return [(rng.normal() + rng.normal(0.0, 0.5, (5, 2))).tolist() for _ in range(10)]
+        return [(_draw(kind, rng, 1)[0] + 0.5 * _draw(kind, rng, (5, 2))).tolist() for _ in range(cases)]
 
-    assert 0.93 <= _coverage(make, 400, 11) <= 0.97
+    assert 0.93 <= _coverage(make, 400, 11) <= 0.99
+
+
+def test_fewer_units_than_the_minimum_give_no_interval():
+    rng = np.random.default_rng(2)
+    few = hierarchical.bootstrap_t([rng.normal(1.0, 1.0, (hierarchical.MIN_UNITS - 1, 2)).tolist()])
+    assert few["ci95"] is None and few["p"] is None and few["too_few"]
+    assert few["estimate"] is not None
+    enough = hierarchical.bootstrap_t([rng.normal(1.0, 1.0, (hierarchical.MIN_UNITS, 2)).tolist()])
+    assert enough["ci95"] is not None and not enough["too_few"]
+
+
+def test_a_clear_effect_gets_a_p_fine_enough_for_holm_over_hundreds_of_verdicts():
+    """p-values below REFINE_BELOW come from FINE_RESAMPLES resamples: a clear effect's p is near
+    1e-5, so Holm over 300 verdicts still leaves it below 0.01."""
+    rng = np.random.default_rng(3)
+    out = hierarchical.bootstrap_t([rng.normal(2.0, 0.5, (10, 2)).tolist()])
+    assert out["p"] < 0.01 / 300
+    assert min(multiplicity.holm([out["p"]] + [0.5] * 299)) < 0.01
 
 
 def test_cases_weigh_equally_and_the_result_is_deterministic():
-    data = [[[1.0, 3.0], [5.0]], [[10.0], [10.0], [10.0]]]
+    data = [[[1.0, 3.0], [5.0]], [[10.0], [10.0], [10.0]]] + [[[float(k)], [float(k) + 1]] for k in range(4)]
     a, b = hierarchical.bootstrap_t(data), hierarchical.bootstrap_t(data)
     assert a == b
-    assert a["estimate"] == pytest.approx((np.mean([2.0, 5.0]) + 10.0) / 2)
-    assert a["cases"] == 2 and a["seeds"] == 5 and a["trials"] == 6 and a["df"] == 1
+    assert a["estimate"] == pytest.approx((np.mean([2.0, 5.0]) + 10.0 + sum(k + 0.5 for k in range(4))) / 6)
+    assert a["cases"] == 6 and a["seeds"] == 13 and a["trials"] == 14 and a["df"] == 5
     lo, hi = a["ci95"]
     assert lo < a["estimate"] < hi
 

@@ -168,13 +168,15 @@ def test_a_method_and_its_baseline_get_the_same_seeds_and_the_same_seed_the_same
     assert plan.labels() == ["none@oracle", "pseudo@oracle"]
     records, _ = benchmark.run_suite(SMALL_SUITE, 4, threads=1, learners=("oracle",))
     assert [(r["method"], r["learner"], r["baselines"]) for r in records] == [  # the suite's reward-term methods
-        ("none@oracle", "oracle", []), ("pseudo@oracle", "oracle", ["none@oracle"]),
-        ("dense@oracle", "oracle", ["none@oracle"])]
+        ("none@oracle", "oracle", []), ("pseudo@oracle", "oracle", ["none@oracle", "goal-dense@oracle"]),
+        ("dense@oracle", "oracle", ["none@oracle", "goal-dense@oracle"]),
+        ("goal-dense@oracle", "oracle", ["none@oracle"])]  # the goal-only baseline of the reward terms
     runs = plan.all_trial_runs(plan.pairs[0], {"trajectory": {"cells": [0], "actions": [0], "goal": 1,
                                                               "source": "x"}, "failure": None})
     assert [(r["method"], r["trial"]) for r in runs] == [("none", 0), ("none", 1), ("pseudo", 0), ("pseudo", 1)]
     # none's trial k and pseudo's trial k: the same model seed and the same environment stream
-    assert len(seen) == 6 and [s[1:] for s in seen[:2]] == [s[1:] for s in seen[2:4]] == [s[1:] for s in seen[4:]]
+    assert len(seen) == 8 and [s[1:] for s in seen[:2]] == [s[1:] for s in seen[2:4]] == [s[1:] for s in seen[4:6]] \
+        == [s[1:] for s in seen[6:]]  # none, pseudo, dense, goal-dense
     assert seen[0][1:] != seen[1][1:]
     assert seen[0][0] == "Monitor"
     again, _ = benchmark.run_suite(SMALL_SUITE, 4, threads=1, learners=("oracle",))
@@ -209,8 +211,9 @@ def test_the_training_env_carries_the_methods_reward_term_and_none_none(register
 def test_an_outside_learner_runs_only_none_and_the_reward_term_methods():
     ran, _ = benchmark.methods_to_run(("pseudo", "guided", "dense"))
     assert benchmark.learner_methods("sarsa", ran) == ran
-    assert benchmark.learner_methods("dqn", ran) == ["none", "pseudo", "dense"]
-    assert benchmark.baselines_of("pseudo@dqn") == ("none@dqn",) and benchmark.baselines_of("pseudo") == ("none",)
+    assert benchmark.learner_methods("dqn", ran) == ["none", "pseudo", "dense", "goal-dense"]
+    assert benchmark.baselines_of("pseudo@dqn") == ("none@dqn", "goal-dense@dqn")
+    assert benchmark.baselines_of("pseudo") == ("none", "goal-dense")
     from armtransfer.experiments.reports.benchmark_report import describe
 
     assert describe("none@dqn", benchmark.parse_label).startswith("no transfer; learned by dqn")
@@ -426,7 +429,7 @@ def test_a_suite_runs_on_a_small_world_with_its_tasks(registered):
     assert (pair.start, pair.goal) == ((0, 0), (-4, 4)) and pair.case.label.endswith(", in rooms11")
     assert pair.source_run()["world"] == "rooms11" and set(robots.resolved) == {"coarse in rooms11", "fine in rooms11"}
     records, _ = benchmark.run_suite(suite, 0, threads=1)
-    assert [r["method"] for r in records] == ["none@oracle", "pseudo@oracle", "dense@oracle"]
+    assert [r["method"] for r in records] == ["none@oracle", "pseudo@oracle", "dense@oracle", "goal-dense@oracle"]
     assert all(r["world"] == "rooms11" and r["optimal"] == pair.optimal for r in records)
     assert records[0]["converged"] == [True] and records[0]["source_failure"] is None
     # the built-in learner's trial of the same case runs on the same world's robot

@@ -241,7 +241,7 @@ def test_the_benchmark_runs_every_plugin_method_beside_the_suites(registered):
     registered(armtransfer.potential_method("mine", "one", index_potential))
     ran, missing = benchmark.methods_to_run()
     assert ran[-1] == "mine" and set(suites.METHODS) <= set(ran) and missing == []
-    assert benchmark.methods_to_run(("mine",)) == (["none", "mine"], [])
+    assert benchmark.methods_to_run(("mine",)) == (["none", "goal-dense", "mine"], [])  # with its goal-only baseline
 
 
 def test_benchmark_method_option_lists_the_valid_names_on_a_typo(tmp_path, capsys):

@@ -56,6 +56,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="the learners every method runs on, each method beside the baseline the same learner runs "
                         "(an outside learner runs none and the reward-term methods; docs/extending.md); default: the "
                         f"suite's own (sarsa). Learners: {learned}")
+    p.add_argument("--quality", type=float, default=None, metavar="Q",
+                   help="a good path is at most ceil(Q x the target's shortest path) steps; a trial ends only on a "
+                        "settled good path and the headline counts the steps until the greedy path is good and stays "
+                        "so (default: the preset's, 1.05)")
+    p.add_argument("--run-on", type=float, default=None, metavar="R",
+                   help="a trial that settles on a path that is not good runs on at most R times the steps it took "
+                        "to settle (default: the preset's, 1.0)")
     common.add_world_argument(p)
     add_executor_arguments(p)
     common.add_preset_argument(p)
@@ -98,7 +105,8 @@ def run(args: argparse.Namespace) -> int:
 
         learners = parse(args.learner)  # a typo lists the valid names
     robots = benchmark.Robots({})
-    plan = benchmark.plan(suite, args.seed, robots, ran, missing, preset=args.preset, learners=learners)
+    plan = benchmark.plan(suite, args.seed, robots, ran, missing, preset=args.preset, learners=learners,
+                          quality=args.quality, run_on=args.run_on)
     from armtransfer.learning.methods import probe_on, refuse_run_time
 
     # a plugin's fault stops the run here, in one line, before its store is opened
@@ -276,7 +284,8 @@ def plan_of(store: ResultStore) -> benchmark.Plan:
         raise StoreError(f"{str(store.root)!r} holds the seed {str(seed)[:40]}, which no benchmark takes (--seed is an "
                          f"integer 0..{MAX_COUNT}); it was not written by armtransfer")
     plan = benchmark.plan(suite, seed, ran=spec["methods"], missing=spec["not_in_registry"],
-                          preset=spec.get("preset", "default"), learners=spec.get("learners"))
+                          preset=spec.get("preset", "default"), learners=spec.get("learners"),
+                          quality=spec.get("quality"), run_on=spec.get("run_on"))
     if content_key(plan.spec()) != store.meta.get("key") or (suite.name in suites.SUITES and not suites.is_builtin(suite)):
         raise StoreError(f"{str(store.root)!r} holds a benchmark of suite {suite.name!r} as another build defined "
                          "it (its version, methods or learner settings differ); rebuild it with that build")

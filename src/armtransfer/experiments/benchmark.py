@@ -52,14 +52,27 @@ def baselines_of(name: str) -> tuple[str, ...]:
     """The methods ``name``'s gain is measured against, each sharing its learner and told less:
     the registry's ``Method.baselines`` (the no-transfer one first; empty for a method that is
     itself no transfer), or, from a registry without that field, ``none`` for every method but
-    ``none``. ``name`` may be a record's label ``METHOD@LEARNER``: its baselines are labelled so."""
+    ``none``; then, for a method that reads the trajectory, its goal-only baseline
+    (:data:`GOAL_ONLY`). ``name`` may be a record's label ``METHOD@LEARNER``: its baselines are
+    labelled so."""
     method, learner = parse_label(name)
     m = methods.get(method)
     if hasattr(m, "baselines"):
         named = tuple(b for b in m.baselines if b in methods.METHODS and b != method)
     else:
         named = () if method == "none" else ("none",)
+    goal = GOAL_ONLY.get(named[0]) if named else None
+    reads = getattr(m, "shaped", False) and getattr(m, "uses_trajectory", True)
+    if goal is not None and goal in methods.METHODS and goal not in named and goal != method and reads:
+        named += (goal,)
     return tuple(label(b, learner) for b in named)
+
+
+GOAL_ONLY = {"none": "goal-dense", "plan": "goal-only"}
+"""The goal-only baseline set beside every method that reads the trajectory, by the baseline told
+nothing that shares its learner: what the route adds beyond the goal (``goal-dense``: ``dense``'s
+potential from the goal alone, on Algorithm 1; ``goal-only``: ``plan``'s learner heading for the
+goal)."""
 
 
 def registered_baseline(name: str) -> bool:
@@ -83,11 +96,18 @@ def baseline_of(name: str) -> str | None:
     return named[0] if named else None
 
 
+CONTROLS_BESIDE = {"plan": ("lazy",)}
+"""Controls run beside a baseline wherever it runs: ``lazy`` (``plan`` exploring less, told
+nothing) beside ``plan``, so that every report shows whether its clock can be bought by exploring
+less (it must not rank ``lazy`` ahead of ``plan``)."""
+
+
 def methods_to_run(wanted: tuple[str, ...] | None = None) -> tuple[list[str], list[str]]:
     """(the methods to run, in registry order: those of ``wanted`` this build has and every
     baseline they name; those of ``wanted`` this build does not have). ``wanted`` defaults to
     ``suites.METHODS`` and every method of an installed plugin or registered in this process:
-    a researcher's method is put through the suite beside the built-in ones."""
+    a researcher's method is put through the suite beside the built-in ones; the controls of
+    :data:`CONTROLS_BESIDE` run beside their baseline."""
     if wanted is None:
         wanted = (*suites.METHODS, *(m for m in methods.METHODS if m not in methods.BUILTIN))
     chosen: set[str] = set()
@@ -97,6 +117,9 @@ def methods_to_run(wanted: tuple[str, ...] | None = None) -> tuple[list[str], li
             chosen.add(name)
             for b in baselines_of(name):
                 add(b)
+            for c in CONTROLS_BESIDE.get(name, ()):
+                if c in methods.METHODS:
+                    add(c)
 
     for m in wanted:
         if m in methods.METHODS:
@@ -264,10 +287,12 @@ class Pair:
                 **({} if self.case.state == "discrete" else {"state": self.case.state, "noise": self.case.noise})}
 
 
-def record(pair: Pair, name: str, source_result: dict, trials: list[dict]) -> dict:
+def record(pair: Pair, name: str, source_result: dict, trials: list[dict], ran: Sequence[str] | None = None) -> dict:
     """One record: method ``name``'s trials on ``pair`` (none when it could not run: then
-    ``error`` says why, the first trial's in trial order, and every trial counts as a failure)."""
-    rec = dict(pair.base(source_result), method=name, baselines=list(baselines_of(name)), error=None)
+    ``error`` says why, the first trial's in trial order, and every trial counts as a failure);
+    its baselines those of ``ran`` (None: all it names)."""
+    named = [b for b in baselines_of(name) if ran is None or b in ran]
+    rec = dict(pair.base(source_result), method=name, baselines=named, error=None)
     method, learner = parse_label(name)
     if source_result["trajectory"] is None and benchmark_runs.needs_trajectory(method):
         rec["told_nothing"] = benchmark_runs.told_nothing(method)
@@ -278,7 +303,8 @@ def record(pair: Pair, name: str, source_result: dict, trials: list[dict]) -> di
     if errors:
         rec["error"] = errors[0]
         rec.update(first_exposure=[None] * n, converged=[False] * n, convergence_steps=[None] * n,
-                   greedy_steps=[None] * n, episodes=[0] * n, area=[None] * n, curves=[])
+                   greedy_steps=[None] * n, episodes=[0] * n, area=[None] * n, curves=[],
+                   **{name: [None] * n for name in benchmark_runs.CLOCK_FIELDS})
         return rec
     said = list(dict.fromkeys(w for t in trials for w in t.get("warnings") or ()))
     if said:  # a potential of one's own that was squashed, constant or not 0 at the goal
@@ -286,6 +312,10 @@ def record(pair: Pair, name: str, source_result: dict, trials: list[dict]) -> di
     rec.update({key: [t[field] for t in trials] for key, field in (
         ("first_exposure", "first_exposure"), ("converged", "converged"), ("convergence_steps", "convergence_steps"),
         ("greedy_steps", "greedy_steps"), ("episodes", "episodes"), ("area", "area"), ("curves", "curve"))})
+    rec.update({name: [t.get(name) for t in trials] for name in benchmark_runs.CLOCK_FIELDS})
+    notes = sorted({t["clock_note"] for t in trials if t.get("clock_note")})
+    if notes:
+        rec["clock_note"] = notes[0]
     return rec
 
 
@@ -304,6 +334,10 @@ class Plan:
     """The learner preset robot 2 learns with (``learning.presets``)."""
     learners: tuple[str, ...] | None = None
     """The learners every method runs on; None: each section's own (``Section.learners``)."""
+    quality: float = SOURCE_CONFIG.quality
+    """The good path's threshold robot 2's trials run with (``LearnerConfig.quality``)."""
+    run_on: float = SOURCE_CONFIG.run_on
+    """The run-on budget robot 2's trials run with (``LearnerConfig.run_on``)."""
 
     @property
     def name(self) -> str:
@@ -319,6 +353,10 @@ class Plan:
         if pair.section.methods is not None:
             keep = methods_to_run(pair.section.methods)[0]
             ran = [m for m in ran if m in keep]
+        if pair.case.state != "discrete":  # a continuous target runs the methods paid on labels alone
+            from armtransfer.learning.cells import CELL_METHODS
+
+            ran = [m for m in ran if m == "none" or m in CELL_METHODS]
         return [(lr, learner_methods(lr, ran)) for lr in self.learners_of(pair)]
 
     def labels(self, pair: Pair | None = None) -> list[str]:
@@ -348,6 +386,10 @@ class Plan:
             spec["preset"] = self.preset
         if self.learners is not None:  # each section's own learners: the key it had before learners
             spec["learners"] = list(self.learners)
+        if self.quality != SOURCE_CONFIG.quality:  # the default's store keeps its key
+            spec["quality"] = self.quality
+        if self.run_on != SOURCE_CONFIG.run_on:
+            spec["run_on"] = self.run_on
         return {"benchmark": spec}
 
     def size(self) -> int:
@@ -393,10 +435,11 @@ class Plan:
                 continue
             trials = [(run, result(run)) for run in self.all_trial_runs(pair, source)]
             missing += sum(r is None and run["key"] not in failed for run, r in trials)
-            for name in self.labels(pair):
+            names = self.labels(pair)
+            for name in names:
                 mine = [(run, r) for run, r in trials if label(run["method"], run["learner"]) == name]
                 if all(r is not None for _, r in mine):
-                    out.append(record(pair, name, source, [r for _, r in mine if r is not None]))
+                    out.append(record(pair, name, source, [r for _, r in mine if r is not None], names))
                 elif keys := [run["key"] for run, r in mine if r is None and run["key"] in failed]:
                     lose(pair, name, keys)
         if missing:
@@ -423,13 +466,19 @@ class Plan:
 
 def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
          ran: Sequence[str] | None = None, missing: Sequence[str] = (), preset: str = "default",
-         learners: Sequence[str] | None = None) -> Plan:
+         learners: Sequence[str] | None = None, quality: float | None = None,
+         run_on: float | None = None) -> Plan:
     """Every pair of ``suite`` for ``seed``, its task's cells drawn and checked for both robots
     (an error names the case before anything runs); ``ran``: the methods (default
     :func:`methods_to_run`'s); robot 2 learns with the settings of ``preset`` (robot 1 always
     with the defaults); ``learners``: the learners every method runs on (None: each section's
-    own)."""
+    own); ``quality``: the good path's threshold (``LearnerConfig.quality``; None: the preset's);
+    ``run_on``: the run-on budget (``LearnerConfig.run_on``; None: the preset's)."""
     learner = presets.config(preset)
+    if quality is not None:
+        learner = replace(learner, quality=quality)  # checked by LearnerConfig: a one-line error
+    if run_on is not None:
+        learner = replace(learner, run_on=run_on)
     if ran is None:
         ran, missing = methods_to_run()
     robots = robots if robots is not None else Robots({})
@@ -470,7 +519,7 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
                 pairs.append(Pair(section, ci, case, j, run_seed(seed, section.name, ci, j), target.layout.xy(start),
                                   target.layout.xy(goal), len(path) - 1, learner))
     return Plan(suite, int(seed), tuple(ran), tuple(missing), tuple(pairs), preset,
-                None if learners is None else tuple(learners))
+                None if learners is None else tuple(learners), learner.quality, learner.run_on)
 
 
 def run_suite(suite: suites.Suite, seed: int = 0, tick: Callable[[], None] | None = None,

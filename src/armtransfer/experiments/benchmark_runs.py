@@ -38,6 +38,7 @@ from armtransfer.experiments.sweep import content_key
 from armtransfer.learning import methods
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.learner_names import SARSA
+from armtransfer.learning.sarsa import TrialResult
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.robot import DiscreteRobot
 
@@ -173,7 +174,21 @@ def _fields(res: experiment.MethodResult) -> dict:
     return {"error": None, "first_exposure": t.exploration_steps, "converged": bool(t.converged),
             "convergence_steps": t.total_steps if t.converged else None, "greedy_steps": t.greedy_steps,
             "episodes": int(t.episodes), "area": float(curve.sum()), "curve": [float(v) for v in curve],
-            "K": res.extra.get("K"), **({"warnings": res.extra["warnings"]} if res.extra.get("warnings") else {})}
+            "K": res.extra.get("K"), **clock_fields(t),
+            **({"warnings": res.extra["warnings"]} if res.extra.get("warnings") else {})}
+
+
+CLOCK_FIELDS = ("good_path_steps", "shortest_path_steps", "settled_ratio", "final_ratio", "steps_run")
+"""The good-path clock of a trial run's result (``sarsa.TrialResult``, ``learning.clock``)."""
+
+
+def clock_fields(t: TrialResult) -> dict:
+    """A trial's :data:`CLOCK_FIELDS`, and ``clock_note`` when its learner measures no good path."""
+    out = {name: getattr(t, name) for name in CLOCK_FIELDS}
+    note = t.clock_note
+    if note:
+        out["clock_note"] = note
+    return out
 
 
 def _continuous_trial(run: dict, target: DiscreteRobot) -> dict:
@@ -317,4 +332,10 @@ def trial_problem(result: dict) -> str | None:
     for name, ok in checks.items():
         if not ok(result.get(name)):
             return f"has no {name!r} of a trial"
+    clock = {"good_path_steps": _int_or_none, "shortest_path_steps": _int_or_none,
+             "settled_ratio": lambda v: v is None or _number(v), "final_ratio": lambda v: v is None or _number(v),
+             "steps_run": lambda v: v is None or _int_or_none(v)}
+    for name, ok in clock.items():  # a result written before the good-path clock has none of them
+        if name in result and not ok(result[name]):
+            return f"has a {name!r} that is not a trial's"
     return None

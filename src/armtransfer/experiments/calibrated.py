@@ -31,6 +31,7 @@ from dataclasses import replace
 from armtransfer.errors import InvalidParameterError
 from armtransfer.experiments import experiment
 from armtransfer.experiments.stats import metrics
+from armtransfer.experiments.stats.hierarchical import MIN_UNITS
 from armtransfer.learning import farming, methods, presets, sarsa
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.trajectory import Trajectory
@@ -47,8 +48,10 @@ EXPLORATION = ("alpha", "gamma", "lam", "epsilon")
 """The settings the exploration ablation takes from the default learner."""
 STUDY_CAP = 2_000_000
 """Steps of a first episode at most in the study."""
-SOURCE_SEEDS = 3
-"""Source seeds per cell: the source robot learns each task again per seed."""
+SOURCE_SEEDS = 10
+"""Source seeds per cell: the source robot learns each task again per seed. Trials from one seed
+share its trajectory, so the improvement's interval resamples seeds (``metrics.seed_improvement``),
+which needs at least ``hierarchical.MIN_UNITS`` of them: 3 seeds gave ten distinct resamples."""
 FARMING_TRIALS = 10
 FARMING_CAP = 1_000_000
 """Whole trials per task of the farming measurement, and their step cap."""
@@ -115,14 +118,18 @@ def run_study(config: LearnerConfig, trials: int, seed: int, tick: Callable[[], 
         for task in TASKS:
             start, goal = TABLE_I[task].cells()
             steps: dict[str, list] = {v: [] for v in VARIANTS}
+            by_seed: dict[str, list] = {v: [] for v in VARIANTS}
             ks: dict[str, list] = {v: [] for v in VARIANTS}
             farm: dict[str, list] = {v: [] for v in VARIANTS}
+            source_steps = []
             for j in range(SOURCE_SEEDS):
                 traj = experiment.source_trajectory("learned", src, start, goal, config, seed + j)
+                source_steps.append(len(traj.cells))  # its cells s_t0..s_tn, the goal after them: n + 1 steps
                 for name, (cfg, K) in variants.items():
                     cfg = replace(cfg, max_episodes=1, max_total_steps=STUDY_CAP)
                     r = _pseudo_trials(tgt, start, goal, traj, cfg, K, per_seed, seed + j, tick)
                     steps[name] += [t.exploration_steps for t in r["results"]]
+                    by_seed[name].append([t.exploration_steps for t in r["results"]])
                     ks[name].append(r["K"])
                     farm[name].append(r["farmable"])
             cell: dict = {}
@@ -130,9 +137,15 @@ def run_study(config: LearnerConfig, trials: int, seed: int, tick: Callable[[], 
                 entry = metrics.exploration_stats(steps[name], STUDY_CAP)
                 entry.update(exploration_steps=steps[name], K=ks[name], farmable=farm[name])
                 if name != "none":
-                    imp = metrics.paired_improvement(steps["none"], steps[name], STUDY_CAP)
-                    entry.update(improvement_percent=imp["percent"], improvement_ci95=imp["ci95"])
+                    imp = metrics.seed_improvement(by_seed["none"], by_seed[name], STUDY_CAP, MIN_UNITS)
+                    entry.update(improvement_percent=imp["percent"], improvement_ci95=imp["ci95"],
+                                 improvement_design=imp["design"], improvement_too_few=imp["too_few"],
+                                 exploration_steps_by_seed=by_seed[name])
+                else:
+                    entry.update(exploration_steps_by_seed=by_seed[name])
                 cell[name] = entry
+            src_path = src.shortest_path(src.start_state(start), goal)
+            cell["source"] = {"steps": source_steps, "shortest": None if src_path is None else len(src_path) - 1}
             table[task] = cell
         out[key] = table
     out["farming"] = farming_runs(config, seed, tick)

@@ -27,6 +27,12 @@ if TYPE_CHECKING:
     import pandas as pd
 
 
+CLOCK_NOTE = ("no good-path clock on a continuous target: its shortest path is not known (the table robot's "
+              "shortest path counts moves between cell centres, which an arm placed off them by IK and moved with "
+              "actuation noise is not held to), so good_path_steps and settled_ratio are null and its trials stop "
+              "on any settled greedy path")
+"""Why a continuous target's trials record no good-path clock (``learning.clock``)."""
+
 SPATIAL_TABLE_BITS = 18
 """The hashed table (2**18 features per action) ``armtransfer.transfer`` gives a spatial arm's
 tiles: its three moved joints' box at 2-step tiles has ~4 million dense tiles over 8 tilings."""
@@ -96,7 +102,10 @@ def run_method(method: str, arm, goal_cell: int, trajs: Sequence[Trajectory] | N
         out.trials.append(linear.learn(arm, goal_cell, coding, config, trial_rng(seed, trial), shaping, lin, steps_by))
         if on_trial is not None:
             on_trial()
+    for t in out.trials:
+        t.clock_note = CLOCK_NOTE
     out.extra["state"] = "continuous"
+    out.extra["clock_note"] = CLOCK_NOTE
     out.extra["approximation"] = {**approx.to_json(), "features": coding.size}
     if noise > 0.0:
         out.extra["noise"] = noise

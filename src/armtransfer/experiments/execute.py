@@ -62,6 +62,7 @@ def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
         "total_steps": res.column("total_steps"),
         "greedy_steps": res.column("greedy_steps"),
         "converged": res.column("converged"),
+        **experiment.clock_columns(res),
         "episodes": res.column("episodes"),
         "K": res.extra.get("K"),
         "trajectory_length": None if traj is None else len(traj),

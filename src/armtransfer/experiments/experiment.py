@@ -157,6 +157,14 @@ def method_shaping(
     return sh
 
 
+def shortest_steps(target: DiscreteRobot, start_state: int, goal_cell: int) -> int | None:
+    """The target's shortest path from ``start_state`` to the goal, in its own steps (None: it
+    cannot reach it): the harness's measure of a good path (``learning.clock``), read from the
+    robot's table by the harness alone and handed to the stopping rule, never to the learner."""
+    path = target.shortest_path(start_state, goal_cell)
+    return None if path is None else len(path) - 1
+
+
 def run_method(
     method: str,
     target: DiscreteRobot,
@@ -195,6 +203,8 @@ def run_method(
     def shaping_for(trajs):
         return method_shaping(method, target, start_state, goal_cell, trajs, K, config, wind, beta)
 
+    optimal = shortest_steps(target, start_state, goal_cell)
+
     out = MethodResult(method, control=control)
     if callable(traj):  # each trial its own trajectories (the controls: one draw per trial)
         shapings: list = [None] * trials
@@ -202,7 +212,7 @@ def run_method(
         def one(trial: int):
             shapings[trial] = sh = shaping_for(traj(first_trial + trial))
             return sarsa.learn(target, start_state, goal_cell, config, trial_rng(seed, first_trial + trial),
-                               shaping=sh, wind=wind, macros=macros)
+                               shaping=sh, wind=wind, macros=macros, optimal=optimal)
 
         out.trials = map_trials(one, trials, threads, on_trial)
         if m.shaped:
@@ -213,7 +223,8 @@ def run_method(
     made = shaping
     out.trials = map_trials(lambda trial: sarsa.learn(target, start_state, goal_cell, config,
                                                       trial_rng(seed, first_trial + trial),
-                                                      shaping=made, wind=wind, macros=macros),
+                                                      shaping=made, wind=wind, macros=macros,
+                                                      optimal=optimal),
                             trials, threads, on_trial)
     if made is not None:
         out.extra["K"] = made.K
@@ -383,6 +394,7 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int 
             "total_mean": t_mean,
             "total_ci95": t_ci,
             "converged": r.column("converged"),
+            **clock_columns(r),
             "episodes": r.column("episodes"),
             "episode_steps": [t.episode_steps.tolist() for t in r.trials],
             "greedy_path_states": [[int(s) for s, _ in t.greedy_path] for t in r.trials],
@@ -390,6 +402,19 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int 
         entry.update(r.extra)
         out[r.label] = entry
     return out
+
+
+CLOCK = ("good_path_steps", "shortest_path_steps", "settled_ratio", "final_ratio", "optimal", "good_len",
+         "steps_run")
+"""The good-path clock's per-trial lists (``sarsa.TrialResult``, ``learning.clock``): steps until the
+greedy path was good (at most ``good_len`` = ceil(quality x optimal) steps) and stayed so, the same
+at quality 1.0, the first settled path's and the final path's length over the shortest, and the
+steps each trial ran (where a trial that never got there is censored)."""
+
+
+def clock_columns(r: MethodResult) -> dict:
+    """A method's :data:`CLOCK` lists (None where a learner does not measure one)."""
+    return {name: [getattr(t, name, None) for t in r.trials] for name in CLOCK}
 
 
 BULKY = ("episode_steps", "greedy_path_states")

@@ -43,7 +43,11 @@ def trial_result(result: dict, stream: list[int]) -> TrialResult:
     return TrialResult(exploration_steps=result["first_exposure"], converged=converged,
                        total_steps=result["convergence_steps"] if converged else int(trained),
                        greedy_steps=result["greedy_steps"], episodes=int(result["episodes"]),
-                       episode_steps=np.asarray(stream, dtype=np.int64), greedy_lengths=EMPTY, macro_steps=EMPTY)
+                       episode_steps=np.asarray(stream, dtype=np.int64), greedy_lengths=EMPTY, macro_steps=EMPTY,
+                       good_path_steps=result.get("good_path_steps"),
+                       shortest_path_steps=result.get("shortest_path_steps"),
+                       settled_ratio=result.get("settled_ratio"), final_ratio=result.get("final_ratio"),
+                       steps_run=int(result.get("steps_run") or 0))
 
 
 def run_method(learner: Learner, method: str, target: DiscreteRobot, start: list[int], goal: list[int],

@@ -13,7 +13,10 @@ step budget (the section's ``max_total_steps``). After each chunk one greedy epi
 the reward term (its own wind stream), capped at :data:`EVAL_CAP` x the target's shortest path.
 **Convergence**: :data:`EVALS` consecutive greedy episodes reach the goal in at most (1 +
 :data:`TOLERANCE`) x the shortest path; the steps to convergence are the training steps at the
-first of them; a trial that does not get there within the budget is censored at it.
+first of them; a trial that does not get there within the budget is censored at it. The trial
+goes on until :data:`EVALS` consecutive greedy episodes are good, at most ``ceil(quality x
+shortest)`` steps (``learning.clock``), or the budget; the good-path clock is the training steps at
+the first of the last run of good evaluations, None when the last evaluation is not good.
 From the monitored stream: the first exposure (training steps until the goal was first
 reached; None, censored, if never within the budget), the episodes' steps (an unfinished
 episode negative, as the kernel's) and the learning curve and its area
@@ -37,6 +40,7 @@ import numpy as np
 
 from armtransfer.errors import ArmTransferError, PluginError
 from armtransfer.experiments.stats import learning_metrics
+from armtransfer.learning import clock
 from armtransfer.learning import learners as registry
 from armtransfer.learning import methods, plugin_calls
 from armtransfer.learning.config import LearnerConfig
@@ -238,6 +242,7 @@ def trial(learner: Learner, run: dict, target: DiscreteRobot,
         raise ArmTransferError(f"{target.name} cannot reach the goal")
     optimal = max(len(path) - 1, 1)
     cap, good = EVAL_CAP * optimal, (1 + TOLERANCE) * optimal
+    good_len = clock.good_length(config.quality, optimal)
     model = _call(said, "make", learner.make, env, model_seed, *handed(learner, run["method"], target, trajectory, term))
     chunk = max(budget // CHUNKS, 1)
     evals: list[list[int | None]] = []
@@ -256,9 +261,11 @@ def trial(learner: Learner, run: dict, target: DiscreteRobot,
         steps = greedy_episode(model, ev, cap, said)
         evals.append([env.total, steps])
         last = evals[-EVALS:]
-        if len(last) == EVALS and all(s is not None and s <= good for _, s in last):
+        if converged_at is None and len(last) == EVALS and all(s is not None and s <= good for _, s in last):
             converged_at, greedy = last[0][0], last[-1][1]
-            break
+        if converged_at is not None and len(last) == EVALS \
+                and all(s is not None and s <= good_len for _, s in last):
+            break  # converged on a good path; converged on a worse one, it goes on to the budget
     converged = converged_at is not None and converged_at <= budget
     first = env.first_exposure if env.first_exposure is not None and env.first_exposure <= budget else None
     stream = env.stream()
@@ -266,7 +273,27 @@ def trial(learner: Learner, run: dict, target: DiscreteRobot,
     return {"error": None, "first_exposure": first, "converged": converged,
             "convergence_steps": converged_at if converged else None, "greedy_steps": greedy if converged else None,
             "episodes": len(stream), "area": float(curve.sum()), "curve": [float(v) for v in curve],
-            "K": None if term is None else float(term.K), "evaluations": evals}, stream
+            "K": None if term is None else float(term.K), "evaluations": evals,
+            **eval_clock(evals, optimal, good_len, greedy if converged else None, env.total)}, stream
+
+
+def eval_clock(evals: list[list], optimal: int, good_len: int, settled: int | None, total: int) -> dict:
+    """The good-path clock from the greedy evaluations (``[training steps, greedy steps or None]``):
+    the training steps at the first evaluation of the last run of evaluations at most ``good_len``
+    (and at most ``optimal``) steps that lasts to the end of the trial (None: the last one is not),
+    the converged greedy episode's steps and the last one's over the shortest, the steps trained."""
+    def held(limit: int) -> int | None:
+        at = None
+        for trained, steps in reversed(evals):
+            if steps is None or steps > limit:
+                break
+            at = int(trained)
+        return at
+
+    last = evals[-1][1] if evals else None
+    return {"good_path_steps": held(good_len), "shortest_path_steps": held(optimal),
+            "settled_ratio": clock.ratio(settled, optimal), "final_ratio": clock.ratio(last, optimal),
+            "steps_run": int(total)}
 
 
 def _say(line: str) -> None:

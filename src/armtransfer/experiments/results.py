@@ -154,7 +154,8 @@ class TransferResult:
 
 
 PER_TRIAL = ("exploration_steps", "converged", "total_steps", "greedy_steps", "episodes", "mapped_fraction",
-             "macro_steps_first_episode")
+             "macro_steps_first_episode", "good_path_steps", "shortest_path_steps", "settled_ratio", "final_ratio",
+             "optimal", "good_len", "steps_run")
 """The per-trial lists of a summary entry that a frame takes as columns."""
 
 

@@ -49,6 +49,18 @@ class LearnerConfig:
                             1_000_000)
     """The greedy path has converged when it reaches the goal and stays the same for this
     many consecutive episodes."""
+    quality: float = _param(1.05, "a target's trial ends only on a settled greedy path at most ceil(quality x "
+                            "shortest) steps long (else at a cap); good_path_steps counts the steps until the "
+                            "greedy path is that good and stays so", 1.0, 1000.0)
+    """The harness's threshold of a good path (``learning.clock``); the learner never reads it.
+    Robot 1's learning, handed no shortest path, stops on any settled path."""
+    run_on: float = _param(1.0, "a trial that settles on a path that is not good runs on at most this many times the "
+                           "steps it took to settle (then its good path, if none yet, is censored)", 0.0, 1000.0)
+    """The budget of the good-path clock's run-on: a trial that first settled after S steps on a path
+    longer than the good length stops at (1 + run_on) x S steps at most (or at its caps). It bounds
+    what the clock costs (docs/benchmark.md: the standard suite in 90 minutes on 2 cores); a trial
+    not good by then counts at the step cap in the benchmark's statistics, so a smaller budget never
+    favours a method that settles on a worse path."""
 
     def __post_init__(self) -> None:
         for f in fields(self):

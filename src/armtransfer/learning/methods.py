@@ -14,7 +14,10 @@ Baselines. A method's gain is measured against a method that shares its learner 
 only in what it is told: ``none`` for the reward terms on Algorithm 1 (``pseudo``, ``dense``,
 ...); ``plan`` for the methods on ``guided``'s learner (its model of its own moves and its
 planner, with no trajectory at all); and ``goal-only`` (``guided`` told the goal and no route)
-for what ``guided``'s route adds beyond knowing the goal. ``Method.baselines`` names them, the
+for what ``guided``'s route adds beyond knowing the goal. ``goal-dense`` (``dense`` told the goal
+and no route) and ``goal-only`` are the goal-only baselines the benchmark sets beside every method
+that reads the trajectory (``experiments.benchmark.GOAL_ONLY``); ``lazy`` is a control beside
+``plan``: told nothing and exploring less. ``Method.baselines`` names them, the
 no-transfer one first, and :func:`with_baselines` adds them to a list of methods to run.
 """
 
@@ -105,6 +108,29 @@ def _plan(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) 
                    np.zeros(robot.n_states), k, guide=planner_guide(robot))
 
 
+LAZY_UNTRIED = -100.0
+"""``lazy``'s planned Q of an untried move, in units of Q (``plan``'s is just above 0): the lowest
+return there is at the default step reward and discount (-1 / (1 - 0.99)), so the planner never
+leads to an untried move while it knows a way to the goal; only epsilon-greedy tries new moves.
+A control, not a method: told nothing, it explores less, so the settled clock ranked it ahead of
+``plan`` (2.3-3.8x on Table I tasks 1-4, fine robot) while the good-path clock must not
+(0.11-0.85x there; ``learning.clock``). A milder penalty (-10 or -30) is no such control: it
+reached a good path sooner than ``plan`` (1.2-2.5x, settling within 5% of the shortest), a
+finding about ``plan``, not about the clock (docs/research-log.md)."""
+
+
+def _lazy(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
+    g = planner_guide(robot)._replace(untried=np.full(robot.n_states, LAZY_UNTRIED))
+    return replace(_plan(robot, trajs, k, beta), guide=g)
+
+
+def _goal_dense(robot: DiscreteRobot, trajs: list[Trajectory], k: float, beta: float) -> Shaping:
+    # dense's potential from a trajectory that is its goal alone: it falls with the straight-line distance to the goal
+    goal = trajs[0].goal
+    only = Trajectory((goal,), (0,), goal, source="goal-only")
+    return _dense(robot, [only], k, beta)
+
+
 GOAL_WINDOW = 1e6
 """``goal-only``'s window: past any trajectory, so its score is the straight-line distance to the goal."""
 GOAL_FILL = 1.0
@@ -170,6 +196,12 @@ _BUILTIN: dict[str, Method] = {
         Method("pseudo-plan", "the paper's pseudo reward on guided's learner told nothing (plan): the paper's reward "
                "and guided on equal footing", paper=False, build=_pseudo_plan, farmable=True, chooses=True,
                baselines=("plan",), is_baseline=True),
+        Method("goal-dense", "dense told only the goal: a potential falling with the straight-line distance to the "
+               "goal, on Algorithm 1; what the reward-term methods' route adds beyond the goal", paper=False,
+               build=_goal_dense, auto_k=potentials.DENSE_K, baselines=("none",), is_baseline=True),
+        Method("lazy", "a control: plan with every untried move valued lower (LAZY_UNTRIED), so it explores less and "
+               "is told nothing; the benchmark's clock must not rank it ahead of plan", paper=False, build=_lazy,
+               auto_k=0.0, chooses=True, is_baseline=True, uses_trajectory=False, baselines=("plan",)),
     )
 }
 """The built-in methods, ``none`` first."""

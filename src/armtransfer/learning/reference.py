@@ -460,6 +460,7 @@ def learn(
     macros=None,
     guide=None,
     trace: list | None = None,
+    paths: list | None = None,
 ) -> tuple[np.ndarray, list[int]]:
     """Run ``episodes`` episodes; returns (Q, steps per episode).
 
@@ -471,6 +472,7 @@ def learn(
 
     ``guide`` (a ``learning.guide.Guide``, method ``guided``): its model breaks the ties of
     epsilon-greedy (:class:`GuideModel`). ``trace``, when given, gets every state visited.
+    ``paths``, when given, gets the greedy path after every episode (:func:`greedy_path`).
     """
     model = None if guide is None else GuideModel(guide, robot.n_states, robot.n_actions)
     seq_at: dict[int, list[int]] = {}
@@ -539,4 +541,21 @@ def learn(
         if model is not None and model.plans:  # robot 2 plans over the moves it has tried
             model.plan(Q, robot.label, goal_cell, config)
         steps_per_episode.append(steps)
+        if paths is not None:
+            paths.append(greedy_path(robot, Q, start_state, goal_cell))
     return Q, steps_per_episode
+
+
+def greedy_path(robot: DiscreteRobot, Q: np.ndarray, start_state: int, goal_cell: int) -> tuple[int, ...] | None:
+    """The states of the greedy path from the start (argmax Q, the lowest index on ties, no
+    wind) to the goal; None when it comes back to a state before reaching it."""
+    seen: set[int] = set()
+    s = start_state
+    path = [s]
+    while robot.label[s] != goal_cell:
+        if s in seen:
+            return None
+        seen.add(s)
+        s = int(robot.next_state[s, int(np.argmax(Q[s]))])
+        path.append(s)
+    return tuple(path)

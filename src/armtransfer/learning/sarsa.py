@@ -1,7 +1,9 @@
 """SARSA(lambda) with knowledge-based pseudo rewards: the paper's Algorithm 1, compiled.
 
 One call to :func:`learn` is one trial: episodes from the start state until the greedy
-path has converged (or a limit is hit). The inner loop is a numba kernel over the robot's
+path has converged (or a limit is hit); when the harness hands the target's shortest path over
+(``optimal``), until it has converged on a good path, at most ``ceil(quality x shortest)`` steps
+long (``learning.clock``), so that a trial settled on a worse path goes on and pays for it. The inner loop is a numba kernel over the robot's
 plain arrays, so it runs the same on grid robots and compiled arms.
 
 Faithful to Algorithm 1:
@@ -55,6 +57,7 @@ import numpy as np
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.learning.config import LearnerConfig
 
+from armtransfer.learning import clock as _clock
 from armtransfer.learning import guide as _guide
 from armtransfer.learning import jitcache as _jitcache
 from armtransfer.learning import traces as _traces
@@ -86,6 +89,10 @@ class World(NamedTuple):
     """The goal cell (a label)."""
     wind: float
     """The probability of a gust after a move."""
+    good_len: int
+    """The harness's measuring instrument, read only by the stopping rule: a settled greedy path
+    ends the trial only when it is at most this long (-1: any settled path does). No choice of
+    the learner reads it."""
 
 
 class Rewards(NamedTuple):
@@ -121,13 +128,15 @@ class Learning(NamedTuple):
     max_total_steps: int
     max_episode_steps: int
     patience: int
+    run_on: float
+    """A trial settled on a path that is not good runs on to (1 + run_on) x its steps then, at most."""
 
     @staticmethod
     def of(config: LearnerConfig) -> "Learning":
         return Learning(float(config.alpha), float(config.gamma), float(config.lam), float(config.epsilon),
                         float(config.step_reward), float(config.goal_reward), float(config.trace_cutoff),
                         int(config.max_episodes), int(config.max_total_steps), int(config.max_episode_steps),
-                        int(config.patience))
+                        int(config.patience), float(config.run_on))
 
 
 class Outputs(NamedTuple):
@@ -149,6 +158,13 @@ class Outputs(NamedTuple):
     """int64 [S + 1]: the first episode's path, its loops erased."""
     fp_actions: np.ndarray
     """int64 [S + 1]: the action taken at each of its states."""
+    settled_path: np.ndarray
+    """int64 [S + 1]: the greedy path the first time it settled (``patience`` episodes unchanged)."""
+    settled_actions: np.ndarray
+    """int64 [S + 1]: the greedy action at each of its states then (lowest index on ties)."""
+    settled: np.ndarray
+    """int64 [2]: the episode of the first settled path's last change (-1: never settled) and
+    the number of its states."""
 
 
 @numba.njit(cache=True, inline="always")
@@ -279,7 +295,10 @@ def _make_run_trial(with_guide: bool):
     Arguments: ``world`` (:class:`World`), ``rewards`` (:class:`Rewards`), ``macros``
     (:class:`Macros`), ``learning`` (:class:`Learning`), the generator ``rng``, the guide ``g``
     and what robot 2 learns, ``m`` (``guide.Guide``, ``guide.Model``; None without the guide),
-    and ``out`` (:class:`Outputs`). Returns (episodes, the converged episode or -1, the length
+    and ``out`` (:class:`Outputs`; ``out.settled`` gets the first settled path). A settled greedy
+    path ends the trial only when it is at most ``world.good_len`` long (-1: any); otherwise the
+    trial goes on to a cap or until it has run ``learning.run_on`` times the steps it took to settle
+    more. Returns (episodes, the converged episode or -1, the length
     of ``out.prev_path``, the length of ``out.fp_states``)."""
 
     @numba.njit(cache=True, nogil=True)  # nogil: trials run on threads (experiment.trial_threads)
@@ -293,6 +312,7 @@ def _make_run_trial(with_guide: bool):
         patience = learning.patience
         Q, episode_steps, greedy_len, macro_steps_out = out.Q, out.episode_steps, out.greedy_len, out.macro_steps
         path_buf, prev_path, fp_states, fp_actions = out.path_buf, out.prev_path, out.fp_states, out.fp_actions
+        settled_path = out.settled_path
         n_states, n_actions = next_state.shape
         q_flat = Q.reshape(n_states * n_actions)  # a view: the trace loop indexes pairs s * n_actions + a
         # the first episode's path with its loops erased (for the online action sequence mapping):
@@ -309,6 +329,7 @@ def _make_run_trial(with_guide: bool):
         pos = np.full(cap, -1, np.int64)
         n_tr = 0
         decay = gamma * learning.lam
+        run_on_until = max_total_steps  # the run-on budget, set when the greedy path first settles
         total = 0
         prev_n = 0
         stable = 0
@@ -430,8 +451,21 @@ def _make_run_trial(with_guide: bool):
                 for i in range(abs(n)):
                     prev_path[i] = path_buf[i]
             if n > 0 and stable >= patience:
-                break
-            if total >= max_total_steps:
+                if out.settled[0] < 0:  # the first settled path: what the settled clock stops at
+                    out.settled[0] = converged_episode
+                    out.settled[1] = n
+                    run_on_until = total + int(learning.run_on * total)
+                    for i in range(n):
+                        settled_path[i] = path_buf[i]
+                        x = path_buf[i]
+                        ba = 0
+                        for a3 in range(1, n_actions):
+                            if Q[x, a3] > Q[x, ba]:
+                                ba = a3
+                        out.settled_actions[i] = ba
+                if world.good_len < 0 or n - 1 <= world.good_len:  # settled on a good path: the trial ends
+                    break
+            if total >= max_total_steps or total >= run_on_until:  # a cap, or the run-on budget spent
                 break
         if stable < patience:
             converged_episode = -1
@@ -473,6 +507,26 @@ class TrialResult:
     (state, action) pairs ending with (goal state, -1); empty when the goal was not reached.
     What the online action sequence mapping learns from (``mapping.ActionMapping.learn_from``)."""
     Q: np.ndarray | None = None
+    optimal: int | None = None
+    """The target's shortest path from the start (steps), as the harness measured it; None: not
+    measured (robot 1's learning, or a learner run alone)."""
+    good_len: int | None = None
+    """The longest good path, ``clock.good_length(quality, optimal)``; the trial ended only on a
+    settled path at most this long, or at a cap (None: on any settled path)."""
+    good_path_steps: int | None = None
+    """Steps until the greedy path was at most ``good_len`` long and stayed so to the end of the
+    trial (``clock.good_path_steps``); None: never, censored at ``steps_run``."""
+    shortest_path_steps: int | None = None
+    """The same clock at quality 1.0: steps until the greedy path was a shortest one and stayed so."""
+    settled_ratio: float | None = None
+    """The first settled greedy path's length over the shortest (``greedy_steps / optimal``)."""
+    final_ratio: float | None = None
+    """The greedy path's length at the end of the trial over the shortest (None: it misses the goal)."""
+    steps_run: int = 0
+    """Every step the trial took."""
+    clock_note: str | None = None
+    """Why the good-path clock is not measured, where a learner cannot measure it (None: it is, or
+    no shortest path was handed over)."""
 
 
 def learn(
@@ -487,6 +541,7 @@ def learn(
     q_init: np.ndarray | None = None,
     keep_q: bool = False,
     guide_model: _guide.Model | None = None,
+    optimal: int | None = None,
 ) -> TrialResult:
     """Run one trial of SARSA(lambda) on ``robot`` from ``start_state`` to ``goal_cell``.
 
@@ -494,7 +549,10 @@ def learn(
     :class:`armtransfer.learning.mapping.MacroTable` (None: no action sequence mapping); its attribute
     ``episodes`` (None: all) says in how many first episodes macros are offered. ``rng`` is
     the only source of randomness. ``guide_model``: what robot 2 learns with the guide, to learn
-    into (``guide.new_model``) and read afterwards; None: a new one.
+    into (``guide.new_model``) and read afterwards; None: a new one. ``optimal``: the target's
+    shortest path from the start, measured by the harness (None: not measured): the trial then
+    ends only on a settled greedy path at most ``clock.good_length(config.quality, optimal)``
+    steps long (or at a cap), and the good-path clock is recorded; the learner never reads it.
     """
     n = robot.n_states
     sh = shaping if shaping is not None else Shaping.none(n)
@@ -517,45 +575,56 @@ def learn(
                   episode_steps=np.zeros(E, np.int64), greedy_len=np.zeros(E, np.int64),
                   macro_steps=np.zeros(E, np.int64), path_buf=np.zeros(n + 1, np.int64),
                   prev_path=np.zeros(n + 1, np.int64), fp_states=np.zeros(n + 1, np.int64),
-                  fp_actions=np.zeros(n + 1, np.int64))
-    world = World(robot.next_state, robot.wind_state, robot.label, int(start_state), int(goal_cell), float(wind))
+                  fp_actions=np.zeros(n + 1, np.int64), settled_path=np.zeros(n + 1, np.int64),
+                  settled_actions=np.zeros(n + 1, np.int64),
+                  settled=np.full(2, -1, np.int64))
+    good_len = None if optimal is None else _clock.good_length(config.quality, optimal)
+    world = World(robot.next_state, robot.wind_state, robot.label, int(start_state), int(goal_cell), float(wind),
+                  -1 if good_len is None else int(good_len))
     rewards = Rewards(int(sh.mode), sh.bonus, sh.traj_index, sh.phi)
-    episodes, conv_ep, path_n, fp_n = kernel(world, rewards, table, Learning.of(config), rng, g, m, out)
-    Q, prev_path, fp_states, fp_actions = out.Q, out.prev_path, out.fp_states, out.fp_actions
+    episodes, _, _, fp_n = kernel(world, rewards, table, Learning.of(config), rng, g, m, out)
+    Q, fp_states, fp_actions = out.Q, out.fp_states, out.fp_actions
     episode_steps, greedy_len, macro_steps = out.episode_steps, out.greedy_len, out.macro_steps
     episode_steps = episode_steps[:episodes].copy()
+    lengths = greedy_len[:episodes].copy()
     first = int(episode_steps[0]) if episodes and episode_steps[0] > 0 else None
+    # the settled clock: the first settled path (with no good length, where the trial stopped)
+    conv_ep, path_n = int(out.settled[0]), int(out.settled[1])
     converged = conv_ep >= 0
     path: list[tuple[int, int]] = []
     if converged:
-        states = prev_path[:path_n]
+        states = out.settled_path[:path_n]
         for i in range(path_n - 1):
             s, t = int(states[i]), int(states[i + 1])
-            a = _greedy_action(Q, s)
+            a = int(out.settled_actions[i])
             assert robot.next_state[s, a] == t
             path.append((s, a))
         path.append((int(states[-1]), -1))
     first_path = [(int(fp_states[i]), int(fp_actions[i])) for i in range(fp_n - 1)]
     if fp_n:
         first_path.append((int(fp_states[fp_n - 1]), -1))
+    greedy_steps = path_n - 1 if converged else None
+    final = int(lengths[-1]) if episodes and lengths[-1] >= 0 else None
     return TrialResult(
         exploration_steps=first,
         converged=converged,
         total_steps=int(np.abs(episode_steps[: conv_ep + 1]).sum()) if converged else None,
-        greedy_steps=path_n - 1 if converged else None,
+        greedy_steps=greedy_steps,
         episodes=int(episodes),
         episode_steps=episode_steps,
-        greedy_lengths=greedy_len[:episodes].copy(),
+        greedy_lengths=lengths,
         macro_steps=macro_steps[:episodes].copy(),
         greedy_path=path,
         first_path=first_path,
         Q=Q if keep_q else None,
+        optimal=None if optimal is None else int(optimal),
+        good_len=good_len,
+        good_path_steps=None if good_len is None else _clock.good_path_steps(lengths, episode_steps, good_len),
+        shortest_path_steps=None if optimal is None else _clock.good_path_steps(lengths, episode_steps, int(optimal)),
+        settled_ratio=_clock.ratio(greedy_steps, optimal),
+        final_ratio=_clock.ratio(final, optimal),
+        steps_run=int(np.abs(episode_steps).sum()),
     )
-
-
-def _greedy_action(Q: np.ndarray, s: int) -> int:
-    """argmax with the lowest index on ties, as the kernel's greedy path uses."""
-    return int(np.argmax(Q[s]))
 
 
 DEPENDENCIES = [*_guide.FILES, Path(_traces.__file__)]

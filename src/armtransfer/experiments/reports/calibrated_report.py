@@ -175,7 +175,9 @@ def section_markdown(res: dict) -> list[str]:
         f"transfer run), over {study['trials']} trials per cell from source seeds "
         f"{', '.join(map(str, study['source_seeds']))} (the source robot learns each task again per seed), "
         f"first episodes capped at {study['cap']:,} steps. Intervals are 95%; improvements are paired on the "
-        "trial streams.",
+        "trial streams, and their intervals resample whole source seeds (the trials of one seed share its "
+        "trajectory, so they are not independent)" + ("" if "improvement_design" in study["table_ii"][1]["pseudo, safe K"]
+                                                       else " (this run's: over trials, as if independent)") + ".",
         "",
         pred,
         "",

@@ -23,10 +23,11 @@ if TYPE_CHECKING:
     import pandas as pd
 
 EXTRA = "frames"
-COUNTS = ("exploration_steps", "total_steps", "greedy_steps", "episodes", "step_cap")
+COUNTS = ("exploration_steps", "total_steps", "greedy_steps", "episodes", "step_cap", "good_path_steps",
+          "shortest_path_steps", "optimal", "good_len", "steps_run")
 """Whole-number columns that may be missing (pandas' nullable ``Int64``)."""
-LEAD = ("method", "control", "trial", "reached", "exploration_steps", "converged", "total_steps", "greedy_steps",
-        "episodes")
+LEAD = ("method", "control", "trial", "reached", "good_path_steps", "settled_ratio", "exploration_steps", "converged",
+        "total_steps", "greedy_steps", "episodes")
 """The columns a frame starts with, in this order; the other metrics and the settings follow."""
 NO_CONTROL = "none"
 """The ``control`` of a run on the trajectory it was given (not a control's): a label, not a

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable
 
 
@@ -137,15 +138,63 @@ def transfer_order(out: dict) -> list[tuple[str, dict]]:
     return rows
 
 
+def _good_median(e: dict) -> str:
+    """The median steps to a good path (a trial never good counts as beyond its steps run) and
+    how many trials ended on one."""
+    good = e.get("good_path_steps") or []
+    if not good or all(v is None and r is None for v, r in zip(good, e.get("steps_run") or [None] * len(good))):
+        return "n/a"
+    runs = e.get("steps_run") or [None] * len(good)
+    vals = sorted((float("inf") if v is None else float(v)) for v in good)
+    mid = vals[(len(vals) - 1) // 2] if len(vals) % 2 else (vals[len(vals) // 2 - 1] + vals[len(vals) // 2]) / 2
+    ended = sum(v is not None for v in good)
+    shown = f"> {max((r for r in runs if r is not None), default=0):,}" if mid == float("inf") else f"{mid:,.0f}"
+    return f"{shown} ({ended}/{len(good)} good)"
+
+
+def _good_factor(e: dict, base: dict | None, cap: int) -> str:
+    """The geometric mean over paired trials of baseline / method steps to a good path (a trial not
+    good at its end counts at the step cap, marked †: a bound), and the worst trial."""
+    if base is None:
+        return "n/a"
+    mine, theirs = e.get("good_path_steps") or [], base.get("good_path_steps") or []
+    if not mine or len(mine) != len(theirs) or all(v is None for v in (*mine, *theirs)):
+        return "n/a"
+    logs = [math.log(max(cap if b is None else b, 1) / max(cap if m is None else m, 1)) for m, b in zip(mine, theirs)]
+    mark = "†" if any(v is None for v in (*mine, *theirs)) else ""
+    return f"{math.exp(sum(logs) / len(logs)):.2f}x{mark} (worst {math.exp(min(logs)):.2f}x)"
+
+
+def _settled(e: dict) -> str:
+    ratios = [r for r in e.get("settled_ratio") or [] if r is not None]
+    if not ratios:
+        return "n/a"
+    ratios.sort()
+    mid = ratios[(len(ratios) - 1) // 2] if len(ratios) % 2 else (ratios[len(ratios) // 2 - 1] + ratios[len(ratios) // 2]) / 2
+    return f"{mid:.2f} ({ratios[-1]:.2f})"
+
+
+GOOD_NOTE = ("Good path: steps until the greedy path is within ceil(quality x shortest) steps and stays so (a trial "
+             "ends only on a settled good path, so one that settles on a longer path runs on to a cap); the factor "
+             "is the baseline's steps over the method's, a geometric mean over paired trials (†: some trial never "
+             "reached a good path and counts at the step cap, so the factor is a bound, not an estimate). Settled "
+             "ratio: the first settled greedy path over the shortest. Settled clock: steps until the greedy path "
+             "first stopped changing, however long.")
+
+
 def transfer_table(out: dict) -> str:
-    """A transfer as one table, the whole cost first: each method beside the baseline that
-    shares its learner, and under it its control runs. Columns: steps to convergence (the
-    whole cost), then the first exposure (exploration steps, mean and median), then the
-    improvement of the first exposure over the row's baseline; ``out`` is
+    """A transfer as one table, the good-path clock first: each method beside the baseline that
+    shares its learner, and under it its control runs. Columns: steps to a good path (median, and
+    the factor against the row's baseline) with the settled quality beside it, then steps to
+    convergence (the settled clock), then the first exposure (exploration steps, mean and median),
+    then the improvement of the first exposure over the row's baseline; ``out`` is
     ``TransferResult.to_json()``."""
     rows_in = transfer_order(out)
+    by_label = dict(rows_in)
+    cap = int(out.get("config", {}).get("max_total_steps") or 0)
     median_header, median_cell = median_column(e for _, e in rows_in)
-    header = ["method", "baseline", "mean steps to converge", "converged", "reached goal",
+    header = ["method", "baseline", "good path: median steps", "good path vs baseline", "settled ratio: median (worst)",
+              "settled clock: mean steps", "converged", "reached goal",
               "mean exploration steps [95% CI]", median_header, "improvement over baseline % [95% CI]",
               "mean greedy steps"]
     rows, designs, capped = [], set(), False
@@ -160,11 +209,13 @@ def transfer_table(out: dict) -> str:
             improvement += " " + fmt_ci(against.get("ci95"))
             designs.add(against.get("design"))
             capped |= bool(against.get("cap_dominated"))
-        rows.append([label, base or "(baseline)", fmt_num(e.get("total_mean"), 0),
+        rows.append([label, base or "(baseline)", _good_median(e),
+                     _good_factor(e, by_label.get(base) if base else None, cap), _settled(e),
+                     fmt_num(e.get("total_mean"), 0),
                      f"{sum(bool(c) for c in conv)}/{len(conv)}", fmt_reached(e),
                      f"{fmt_mean(e)} {fmt_ci(e.get('ci95'))}", median_cell(e), improvement,
                      fmt_num(e.get("greedy_mean"))])
-    table = markdown_table(header, rows)
+    table = markdown_table(header, rows) + "\n\n" + GOOD_NOTE
     if any(e.get("mean_is_lower_bound") for _, e in rows_in):
         table += ("\n\n≥: some trials never reached the goal; they count at the step cap, so the mean "
                   "is a lower bound.")

@@ -1,11 +1,16 @@
 """The statistics of a benchmark run, from its records alone.
 
-Three step counts are measured per trial, each a time until an event, restricted to the
+Four step counts are measured per trial, each a time until an event, restricted to the
 trial's step cap and *censored* there when the event did not happen (survival data, never
 padded with a made-up value):
 
-  convergence        steps until the greedy path settled: the whole cost of learning, and
-                     every claim's headline
+  good path          steps until the greedy path was good, at most ceil(quality x shortest)
+                     steps, and stayed so to the end of the trial (``learning.clock``): every
+                     claim's headline. A trial whose path was not good at its end (it settled
+                     on a worse path and ran on to its episode or step cap) counts at the cap.
+  convergence        steps until the greedy path first settled (unchanged for ``patience``
+                     episodes, however long): the settled clock, which a learner that explores
+                     less can buy with a worse path
   first exposure     steps until the goal was first reached
   cost of HORIZON    steps of the first ``learning_metrics.HORIZON`` episodes (a converged trial
   episodes           goes on at its greedy length); a trial the cap stopped before that is
@@ -39,13 +44,28 @@ import numpy as np
 
 from armtransfer.experiments.stats import hierarchical, learning_metrics, multiplicity, survival
 
-METRICS = ("convergence", "first_exposure", "cost")
-"""The paired metrics in the order every claim states them: the whole cost first."""
+METRICS = ("good_path", "convergence", "first_exposure", "cost")
+"""The paired metrics in the order every claim states them: the good-path clock first."""
+
+DESCRIBED = ("shortest_path",)
+"""Paired metrics reported beside the claims without a verdict (outside Holm's correction): the
+good-path clock at quality 1.0, the shortest path itself."""
+
+CLOCKS = {"good_path": "good_path_steps", "shortest_path": "shortest_path_steps"}
+"""The good-path clocks and the record field each reads."""
+
+
+def measured(rec: dict, metric: str) -> bool:
+    """Whether ``rec``'s trials measured ``metric``: a good-path clock is missing from records
+    written before it and from a continuous target's (``clock_note`` says why)."""
+    return metric not in CLOCKS or (CLOCKS[metric] in rec and not rec.get("clock_note"))
 
 
 def _restricted(rec: dict, metric: str) -> list[float | None]:
     """One record's trials' times for ``metric`` (None: censored at the cap)."""
     cap = rec["cap"]
+    if metric in CLOCKS:
+        return [None if v is None else min(float(v), cap) for v in rec[CLOCKS[metric]]]
     if metric == "first_exposure":
         return [None if v is None else min(float(v), cap) for v in rec["first_exposure"]]
     if metric == "convergence":
@@ -97,6 +117,10 @@ def cell_stats(recs: list[dict]) -> dict:
     km = fe_block.pop("km")
     conv = _km_block([_restricted(r, "convergence") for r in recs], cap)
     conv.pop("km")
+    clocked = [r for r in recs if measured(r, "good_path")]
+    good = _km_block([_restricted(r, "good_path") for r in clocked], cap) if clocked else None
+    if good is not None:
+        good.pop("km")
     cost = _km_block([_restricted(r, "cost") for r in recs], cap)
     cost.pop("km")
     within = [v is not None and v <= r["budget"] for r in recs for v in r["first_exposure"]]
@@ -110,20 +134,35 @@ def cell_stats(recs: list[dict]) -> dict:
         "seed_share": seed_share(fe_seeds, cap),
         "first_exposure": fe_block,
         "survival": {k: km[k] for k in ("times", "survival", "low", "high")},
+        "good_path": good,
+        "settled_quality": settled_quality(recs),
         "convergence": dict(conv, converged=conv["events"]),
         "cost": cost,
         "curve_mean": [float(v) for v in np.mean(curves, axis=0)] if curves else [],
     }
 
 
+def settled_quality(recs: list[dict]) -> dict:
+    """How good the settled paths were: the median and worst (largest) ``settled_ratio`` (the first
+    settled greedy path over the shortest) over the trials that settled, how many did, and how
+    many trials' paths were good at the end (``good_path_steps`` not None)."""
+    ratios = [v for r in recs for v in r.get("settled_ratio") or [] if v is not None]
+    clocked = [r for r in recs if measured(r, "good_path")]
+    trials = sum(len(r["first_exposure"]) for r in clocked)
+    return {"median": float(np.median(ratios)) if ratios else None, "worst": max(ratios) if ratios else None,
+            "settled": len(ratios), "good_at_end": sum(v is not None for r in clocked for v in r["good_path_steps"]),
+            "trials": trials}
+
+
 def _pairs(method: list[dict], base: list[dict], metric: str) -> tuple[list[list[float]], int, int]:
     """Per source seed, the trial-paired log factors log(baseline / method) of ``metric`` (ties
-    left out), the number of ties (both censored) and of bounds (one censored)."""
+    left out), the number of ties (both censored) and of bounds (one censored). A pair whose
+    either record did not measure ``metric`` (:func:`measured`) is left out."""
     by_seed = {b["source_seed"]: b for b in base}
     seeds, ties, bounds = [], 0, 0
     for m in method:
         b = by_seed.get(m["source_seed"])
-        if b is None:
+        if b is None or not (measured(m, metric) and measured(b, metric)):
             continue
         logs = []
         cap = m["cap"]
@@ -137,17 +176,18 @@ def _pairs(method: list[dict], base: list[dict], metric: str) -> tuple[list[list
     return seeds, ties, bounds
 
 
-def compare(cases: list[tuple[list[dict], list[dict]]], metric: str) -> dict:
+def compare(cases: list[tuple[list[dict], list[dict]]], metric: str, refine: bool = True) -> dict:
     """(method records, baseline records) per case: the paired factor of ``metric`` over cases,
     source seeds and trials, with its hierarchical bootstrap-t interval, p-value, detectable
-    factors, worst and best seed (geometric mean of its trials), ties and bounds."""
+    factors, worst and best seed (geometric mean of its trials), ties and bounds. ``refine``: a
+    small p from more resamples (``hierarchical.FINE_RESAMPLES``), for a verdict Holm corrects."""
     nested, ties, bounds = [], 0, 0
     for method, base in cases:
         seeds, t, b = _pairs(method, base, metric)
         nested.append(seeds)
         ties += t
         bounds += b
-    out = hierarchical.as_factor(hierarchical.bootstrap_t(nested))
+    out = hierarchical.as_factor(hierarchical.bootstrap_t(nested, refine=refine))
     seed_factors = [math.exp(float(np.mean(s))) for c in nested for s in c if s]
     out.update(metric=metric, ties=ties, bounds=bounds, pairs=sum(len(s) for c in nested for s in c) + ties,
                worst=min(seed_factors) if seed_factors else None, best=max(seed_factors) if seed_factors else None)
@@ -159,8 +199,19 @@ def compare(cases: list[tuple[list[dict], list[dict]]], metric: str) -> dict:
 
 
 def paired(method: list[dict], base: list[dict]) -> dict:
-    """The method against one baseline on one case, every metric (``METRICS``)."""
-    return {k: compare([(method, base)], k) for k in METRICS}
+    """The method against one baseline on one case, every metric (``METRICS``, ``DESCRIBED``)."""
+    return {k: compare([(method, base)], k, refine=False) for k in (*METRICS, *DESCRIBED)}
+
+
+def _pooled(cases: list[tuple[list[dict], list[dict]]], base: str, refine: bool = True) -> dict:
+    """Every metric over ``cases``, the described ones without a verdict, and the settled quality
+    of the method's and the baseline's trials beside them."""
+    out = dict({k: compare(cases, k, refine) for k in METRICS}, baseline=base)
+    for k in DESCRIBED:
+        out[k] = dict(compare(cases, k, refine=False), p_holm=None, verdicts=0)
+    out["settled"] = {"method": settled_quality([r for m, _ in cases for r in m]),
+                      "baseline": settled_quality([r for _, b in cases for r in b])}
+    return out
 
 
 def summarize(records: list[dict]) -> dict:
@@ -196,7 +247,7 @@ def summarize(records: list[dict]) -> dict:
         for name in names:
             pooled: dict = {}
             for base, cases in _pairings(section, name, by_cell):
-                pooled[base] = dict({k: compare(cases, k) for k in METRICS}, baseline=base)
+                pooled[base] = _pooled(cases, base)
                 verdicts += [pooled[base][k] for k in METRICS]
             if pooled:
                 sec["pooled"][name] = pooled
@@ -248,8 +299,10 @@ def with_trajectory(section: str, by_cell: dict) -> dict:
     pooled: dict = {}
     for name in names:
         for base, cases in _pairings(section, name, by_cell, kept):
-            pooled.setdefault(name, {})[base] = dict(
-                {k: dict(compare(cases, k), p_holm=None, verdicts=0) for k in METRICS}, baseline=base)
+            block = _pooled(cases, base, refine=False)
+            for k in METRICS:
+                block[k] = dict(block[k], p_holm=None, verdicts=0)
+            pooled.setdefault(name, {})[base] = block
     pairs = {(c, r["source_seed"]): r["source_failure"] is None for (s, c, _), recs in by_cell.items()
              if s == section for r in recs}
     told = any(r.get("told_nothing") for (s, _, _), recs in by_cell.items() if s == section for r in recs)
