@@ -85,6 +85,7 @@ def load(path: str | Path, builtin: dict[str, suites.Suite] | None = None) -> su
     if len(raw) > MAX_BYTES:
         raise SuiteFileError(f"{where}: larger than {MAX_BYTES:,} bytes")
     try:  # the shared readers: UTF-8, syntax, digits and magnitudes of numbers, as every user file
+        data: object
         if p.suffix.lower() == ".toml":
             data = parse_toml_bytes(raw)
         else:
