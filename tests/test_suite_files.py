@@ -99,7 +99,8 @@ def test_a_suite_file_runs_resumes_and_is_summarized_byte_for_byte(tmp_path, cap
     report, results = (out / "report.md").read_bytes(), (out / "results.json").read_bytes()
     assert b"--suite FILE" in report and b"`zigzag`" in report and b"(6,6) -> (-6,-6)" in report
     data = json.loads(results)
-    assert {r["method"] for r in data["records"]} == {"none", "pseudo"} and len(data["records"]) == 4
+    # pseudo beside its goal-only baseline (goal-dense) and none, on 2 cases
+    assert {r["method"] for r in data["records"]} == {"none", "pseudo", "goal-dense"} and len(data["records"]) == 6
     # a run lost (as a kill loses the runs under way) is run again by the same command
     store = ResultStore.open_existing(out)
     lost = sorted(store.runs_dir.glob("*.json"))[-1]
@@ -145,7 +146,8 @@ def test_a_failed_run_keeps_its_traceback_and_the_report_lists_it(tmp_path):
     write_report(store, plan)
     data = json.loads((tmp_path / "s" / "results.json").read_text())
     assert [(f["method"], f["source_seed"]) for f in data["failed"]] == [("pseudo", 1)]
-    assert [(r["method"], r["source_seed"]) for r in data["records"]] == [("none", 0), ("pseudo", 0), ("none", 1)]
+    assert [(r["method"], r["source_seed"]) for r in data["records"]] == [
+        ("none", 0), ("pseudo", 0), ("goal-dense", 0), ("none", 1), ("goal-dense", 1)]
     report = (tmp_path / "s" / "report.md").read_text()
     assert "## Runs that failed" in report and "KeyError" in report
 
@@ -273,7 +275,7 @@ def test_a_learner_receives_the_transfer_and_its_options_key_its_runs(seen_learn
     runs = plan.all_trial_runs(plan.pairs[0], None)  # those that wait for no trajectory: none's
     assert [r["method"] for r in runs] == ["none"] and runs[0]["learner_options"] == {"alpha": 0.5}
     records, _ = benchmark.run_suite(suite, 0, learners=["seen"])
-    assert {r["method"] for r in records} == {"none@seen", "pseudo@seen"}
+    assert {r["method"] for r in records} == {"none@seen", "pseudo@seen", "goal-dense@seen"}
     shaped = [t for t in _Seen.seen if t.method == "pseudo"]
     assert shaped and all(len(t.trajectories) == 1 and t.trajectories[0].shape[1] == 2 for t in shaped)
     assert all(t.shaping is not None and len(t.shaping.bonus) > 0 for t in shaped)
