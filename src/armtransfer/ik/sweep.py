@@ -163,6 +163,14 @@ class SweepChecker:
                                                        model.geom_aabb[fixed, :3])
             self._boxes[g] = (fixed, centre, np.einsum("nij,nj->ni", rot, model.geom_aabb[fixed, 3:]))
         self._arm_partners = {g: hs[~env[hs]] for g, hs in partners.items()}
+        # the same pairs as rows, so that one pass of numpy finds the near ones of every geom:
+        # (geom, scenery partner) with the partner's fixed box, and (geom, arm partner)
+        self._fg = np.array([g for g in self._gjk for _ in self._boxes[g][0]], dtype=np.int64)
+        self._fh = np.concatenate([self._boxes[g][0] for g in self._gjk] or [np.zeros(0, np.int64)]).astype(np.int64)
+        self._fc = np.concatenate([self._boxes[g][1] for g in self._gjk] or [np.zeros((0, 3))])
+        self._fhalf = np.concatenate([self._boxes[g][2] for g in self._gjk] or [np.zeros((0, 3))])
+        self._ag = np.array([g for g in self._gjk for _ in self._arm_partners[g]], dtype=np.int64)
+        self._ah = np.concatenate([self._arm_partners[g] for g in self._gjk] or [np.zeros(0, np.int64)]).astype(np.int64)
 
     def clear(self, qa: np.ndarray, qb: np.ndarray) -> bool:
         """No counted contact deeper than ``TOLERANCE`` anywhere on the move ``qa -> qb``."""
@@ -206,11 +214,11 @@ class SweepChecker:
                         inside = np.all(np.abs(d.geom_xpos[arm_g, :2]) + self._rb[arm_g, None] < self._half, axis=1)
                         r = np.where(table & level & inside, rate_z[arm_g], r)
                     step = min(step, float(np.min(np.maximum(dist, TOLERANCE) / np.maximum(r, 1e-12))))
-            for g in self._gjk:
-                near = self._apart(g)
+            if self._gjk:
+                near = self._apart_all()
                 if near is None:
                     return False
-                for h, dist_h, level in near:
+                for g, h, dist_h, level in near:
                     r_h = rate[g] + rate[h] if not self._env[h] else (rate_z[g] if level else rate[g])
                     step = min(step, max(dist_h, TOLERANCE) / max(r_h, 1e-12))
             if t >= 1.0:
@@ -219,29 +227,37 @@ class SweepChecker:
             d.qpos[:] = qa + t * dq
             mujoco.mj_kinematics(m, d)
 
-    def _apart(self, g: int) -> list[tuple[int, float, bool]] | None:
-        """(partner, distance, against the tabletop from above) of geom ``g``'s counted partners
-        within ``QUERY`` (by their bounding boxes, then ``mj_geomDistance``); None when one is
-        in contact."""
+    def _apart_all(self) -> list[tuple[int, int, float, bool]] | None:
+        """(geom, partner, distance, against the tabletop from above) of every geom whose distances
+        are asked of ``mj_geomDistance`` and each of its counted partners within ``QUERY`` (by
+        their bounding boxes, all pairs in one pass, then ``mj_geomDistance``); None when a pair
+        is in contact."""
         m, d = self.model, self.data
+        xpos, rb = d.geom_xpos, self._rb
+        pairs = []
+        if self._fg.size:
+            diff = np.abs(xpos[self._fg] - self._fc) - self._fhalf
+            np.maximum(diff, 0.0, out=diff)
+            gap = np.sqrt(np.einsum("ij,ij->i", diff, diff)) - rb[self._fg]
+            sel = np.flatnonzero(gap < QUERY)
+            pairs += zip(self._fg[sel].tolist(), self._fh[sel].tolist())
+        if self._ag.size:
+            diff = np.abs(xpos[self._ag] - xpos[self._ah]) - rb[self._ah, None]
+            np.maximum(diff, 0.0, out=diff)
+            gap = np.sqrt(np.einsum("ij,ij->i", diff, diff)) - rb[self._ag]
+            sel = np.flatnonzero(gap < QUERY)
+            pairs += zip(self._ag[sel].tolist(), self._ah[sel].tolist())
         out = []
-        centre, radius = d.geom_xpos[g], self._rb[g]
-        hs, box_c, box_h = self._boxes[g]
-        if self._arm_partners[g].size:  # boxes of the arm's own geoms move: take them now
-            a = self._arm_partners[g]
-            hs = np.concatenate([hs, a])
-            box_c = np.concatenate([box_c, d.geom_xpos[a]])
-            box_h = np.concatenate([box_h, np.repeat(self._rb[a, None], 3, axis=1)])
-        gap = np.linalg.norm(np.maximum(np.abs(centre - box_c) - box_h, 0.0), axis=1) - radius
-        for h in hs[gap < QUERY]:
-            dist = mujoco.mj_geomDistance(m, d, g, int(h), QUERY, self._fromto)
+        for g, h in pairs:
+            dist = mujoco.mj_geomDistance(m, d, g, h, QUERY, self._fromto)
             if dist < 0.0:
                 return None
             if dist < QUERY:
+                centre, radius = xpos[g], rb[g]
                 way = self._fromto[3:] - self._fromto[:3]
                 level = bool(self._table[h] and dist > 0 and abs(way[2]) > (1.0 - 1e-9) * np.linalg.norm(way)
                              and np.all(np.abs(centre[:2]) + radius < self._half))
-                out.append((int(h), float(dist), level))
+                out.append((g, h, float(dist), level))
         return out
 
     def _turn_rate(self, j: int) -> np.ndarray:
