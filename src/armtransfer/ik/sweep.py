@@ -234,7 +234,7 @@ class SweepChecker:
         is in contact."""
         m, d = self.model, self.data
         xpos, rb = d.geom_xpos, self._rb
-        pairs = []
+        pairs: list[tuple[int, int]] = []
         if self._fg.size:
             diff = np.abs(xpos[self._fg] - self._fc) - self._fhalf
             np.maximum(diff, 0.0, out=diff)
