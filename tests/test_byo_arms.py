@@ -91,6 +91,7 @@ def test_so100_style_by_fixed_jaw_and_offset(so100):
     assert _solved(so100) >= 3
 
 
+@pytest.mark.slow  # 7 s; the Panda-style file is compiled by default with its hand (test_panda_with_hand_by_body_and_offset)
 def test_panda_without_hand_by_flange_site(files):
     r = arm_robot(None, "cartesian", xml_path=files["panda_nohand"], tip_site="attachment_site",
                    tip_offset=(0.0, 0.0, 0.1))
@@ -99,6 +100,7 @@ def test_panda_without_hand_by_flange_site(files):
     assert r.arm.reach >= 0.8 and _solved(r) == 4
 
 
+@pytest.mark.slow  # 6 s: a second 5-joint file compiled; tests/test_tool_tilt.py and the walls tests compile others
 def test_planar5_straight_cartesian_from_its_singular_qpos0(files):
     # no keyframe: home is qpos0, the straight arm, where IK's Jacobian loses a rank
     r = arm_robot(None, "cartesian", xml_path=files["planar5"], tip_body="stylus")

@@ -47,6 +47,7 @@ def test_states_are_free_cells_and_mink_agrees_with_their_labels(spec, robots):
     assert np.array_equal(np.sort(robot.label[can]), np.unique(robot.label))
 
 
+@pytest.mark.slow  # 6 s; test_walls_hold.py checks door crossings of cartesian moves against the walls by default
 def test_walls_block_cartesian_moves(robots):
     robot = robots["planar2:cartesian"]
     F, B, R, L = range(4)

@@ -65,6 +65,7 @@ def test_the_held_pen_lets_the_gripper_reach_every_task(files):
     assert robot.arm.tool.held == Stylus() and "holding a 50 mm stylus 3 mm wide" in robot.arm.tool.describe()
 
 
+@pytest.mark.slow  # 5 s: the remedy of a second cell size, compiled again; the held pen reaches by default
 def test_wider_cells_let_the_pen_reach_every_task(files):
     robot = arm_robot(None, "cartesian", xml_path=files["planar5_wide_pen"], cell_size=0.016, **PEN)
     assert robot.arm.reach >= 0.8 and tasks_solvable(robot) == len(TABLE_I)

@@ -54,6 +54,7 @@ def test_the_cone_changes_nothing_where_straight_down_works_and_reaches_more(so1
     assert only_cone > 0  # beyond the ring straight down allows, the tilted tool still reaches
 
 
+@pytest.mark.slow  # 10 s: a 5-joint lattice compiled with its swept checks; the cone itself is tested above
 def test_a_compiled_five_joint_arm_keeps_its_tool_within_the_cone(files):
     s = ml.SUGGESTED["so100"]
     robot = arm_robot(None, "cartesian", xml_path=files["so100"], base_pos=s["base_pos"], base_yaw=s["base_yaw"],
