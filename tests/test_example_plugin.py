@@ -90,8 +90,9 @@ def test_sweep_and_matrix_run_it_in_worker_processes(site, tmp_path):
 def test_benchmark_runs_it_against_none(site, tmp_path):
     cli(site, tmp_path, "benchmark", "--suite", "fast", "--method", NAME, "--out", "bench")
     results = json.loads((tmp_path / "bench" / "results.json").read_text())
-    assert results["methods"] == ["none", NAME] and results["baselines"][NAME] == ["none"]
-    assert {r["method"] for r in results["records"]} == {"none", NAME}
+    # beside its baseline, the goal-only one of a reward term: dense's potential from the goal alone
+    assert results["methods"] == ["none", "goal-dense", NAME] and results["baselines"][NAME] == ["none", "goal-dense"]
+    assert {r["method"] for r in results["records"]} == {"none", "goal-dense", NAME}
     assert f"`{NAME}`" in (tmp_path / "bench" / "report.md").read_text()
 
 
@@ -123,11 +124,11 @@ def test_benchmark_runs_its_method_and_its_learner(site, tmp_path):
     cli(site, tmp_path, "benchmark", "--suite", "fast", "--method", NAME, "--learner", f"sarsa,{LEARNER}",
         "--out", "bench", "--workers", "2")
     results = json.loads((tmp_path / "bench" / "results.json").read_text())
-    labels = [f"none@{LEARNER}", f"{NAME}@{LEARNER}"]
-    assert results["methods"] == ["none", NAME, *labels]
-    assert results["baselines"][labels[1]] == [labels[0]]
+    labels = [f"none@{LEARNER}", f"goal-dense@{LEARNER}", f"{NAME}@{LEARNER}"]
+    assert results["methods"] == ["none", "goal-dense", NAME, *labels]
+    assert results["baselines"][labels[2]] == labels[:2]
     mine = [r for r in results["records"] if r.get("learner") == LEARNER]
-    assert {r["method"] for r in mine} == set(labels) and len(mine) == 2 * 2  # 2 source seeds
+    assert {r["method"] for r in mine} == set(labels) and len(mine) == 3 * 2  # 2 source seeds
     assert all(r["error"] is None and len(r["first_exposure"]) == 2 for r in mine)
     assert all(n is None or 0 < n <= r["cap"] for r in mine for n in r["convergence_steps"])
     report = (tmp_path / "bench" / "report.md").read_text()
