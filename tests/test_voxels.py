@@ -187,7 +187,7 @@ def test_a_spatial_arms_voxel_path_transfers_to_another_spatial_arm(ur5e_joint):
 @pytest.mark.slow
 def test_the_voxels_suite_runs_on_one_source_seed():
     """A smoke test of the held-out 3D suite: one source seed, one trial per method; both
-    cases, only none and pseudo (the section's methods)."""
+    cases, only none and pseudo (the section's methods), and pseudo's goal-only baseline goal-dense."""
     from dataclasses import replace
 
     from armtransfer.experiments import benchmark, suites
@@ -196,8 +196,8 @@ def test_the_voxels_suite_runs_on_one_source_seed():
     assert suite.held_out and suite.sections[0].source_seeds >= 10
     section = replace(suite.sections[0], source_seeds=1, trials=1)
     records, _ = benchmark.run_suite(suites.Suite("t", 1, True, "", (section,)), threads=1)
-    assert sorted((r["case"], r["method"]) for r in records) == [(0, "none"), (0, "pseudo"), (1, "none"),
-                                                                 (1, "pseudo")]
+    assert sorted((r["case"], r["method"]) for r in records) == [(0, "goal-dense"), (0, "none"), (0, "pseudo"),
+                                                                 (1, "goal-dense"), (1, "none"), (1, "pseudo")]
     for r in records:
         assert r["error"] is None and r["first_exposure"][0] is not None, r
 
