@@ -317,6 +317,16 @@ def parse_toml_bytes(raw: bytes) -> dict:
     return data
 
 
+def parse_user_file_bytes(raw: bytes, suffix: str) -> object:
+    """A user's TOML (``suffix`` ``.toml``) or JSON file from its bytes, by the readers above,
+    its numbers checked (:func:`check_user_numbers`); ValueError with the reason."""
+    if suffix.lower() == ".toml":
+        return parse_toml_bytes(raw)
+    data = parse_json_bytes(raw)
+    check_user_numbers(data)
+    return data
+
+
 def check_user_numbers(data: object) -> None:
     """ValueError naming the first number of a user's parsed file that no value of the project
     can be: an integer of magnitude above :data:`MAX_FILE_INT` or more than :data:`MAX_DIGITS`

@@ -39,7 +39,7 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
-from armtransfer.io import check_user_numbers, parse_json_bytes, parse_toml_bytes
+from armtransfer.io import parse_user_file_bytes
 from armtransfer.errors import InvalidParameterError
 from armtransfer.experiments import suite_model as suites
 
@@ -85,12 +85,7 @@ def load(path: str | Path, builtin: dict[str, suites.Suite] | None = None) -> su
     if len(raw) > MAX_BYTES:
         raise SuiteFileError(f"{where}: larger than {MAX_BYTES:,} bytes")
     try:  # the shared readers: UTF-8, syntax, digits and magnitudes of numbers, as every user file
-        data: object
-        if p.suffix.lower() == ".toml":
-            data = parse_toml_bytes(raw)
-        else:
-            data = parse_json_bytes(raw)
-            check_user_numbers(data)
+        data = parse_user_file_bytes(raw, p.suffix)
     except ValueError as err:
         raise SuiteFileError(f"{where}: {err}") from None
     return parse(data, where, p.parent, builtin=builtin)

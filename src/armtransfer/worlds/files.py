@@ -52,15 +52,10 @@ def load_layout(path: str | os.PathLike) -> Layout:
         raw = p.read_bytes()
     except (OSError, ValueError) as err:  # ValueError: a path with a NUL byte
         raise InvalidWorldError(f"{where}: cannot be read: {getattr(err, 'strerror', None) or err}") from None
-    from armtransfer.io import check_user_numbers, parse_json_bytes, parse_toml_bytes
+    from armtransfer.io import parse_user_file_bytes
 
-    data: object
     try:
-        if p.suffix.lower() == ".toml":
-            data = parse_toml_bytes(raw)
-        else:
-            data = parse_json_bytes(raw)
-            check_user_numbers(data)
+        data = parse_user_file_bytes(raw, p.suffix)
     except ValueError as err:
         raise InvalidWorldError(f"{where} {err}") from None
     return parse_layout(data, p.stem, where)
