@@ -11,7 +11,6 @@ their range) and the wall seconds (medians). CPU time is the figure to read on a
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import statistics
@@ -19,6 +18,8 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+from armtransfer import script
 
 CHILD = ("import json, time\nfrom armtransfer.tasks import arms\nt0, w0 = time.process_time(), time.time()\n"
          "robot = arms.robot({spec!r})\n"
@@ -35,11 +36,15 @@ def compile_once(src: str, spec: str) -> tuple[float, float, int]:
 
 
 def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = script.parser(__doc__)
     p.add_argument("--base", required=True, help="the src folder of the tree to compare against")
     p.add_argument("--robots", default="planar3:joint,planar4:joint,ur5e_like:cartesian,panda_like:cartesian")
     p.add_argument("--rounds", type=int, default=3)
     a = p.parse_args()
+    if not (Path(a.base) / "armtransfer").is_dir():
+        p.error(f"--base {a.base!r} holds no armtransfer package (give the src folder of an exported tree)")
+    if a.rounds < 1:
+        p.error("--rounds must be >= 1")
     trees = [("base", a.base), ("this", str(Path(__file__).resolve().parents[1] / "src"))]
     specs = a.robots.split(",")
     res: dict[tuple[str, str], list[tuple[float, float, int]]] = {}
@@ -59,4 +64,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    script.exit_with(main)
