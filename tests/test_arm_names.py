@@ -120,6 +120,7 @@ def test_bad_matrix_arm_input_is_one_line(tmp_path, scara_xml, capsys, argv, mes
     assert not (tmp_path / "m").exists()
 
 
+@pytest.mark.slow
 def test_a_matrix_runs_with_an_arm_file(tmp_path, scara_xml):
     out = tmp_path / "m"
     assert main(["matrix", "--robots", "planar2:joint,custom:joint", "--tasks", "2", "--methods", "pseudo",

@@ -71,6 +71,7 @@ def test_ur5e_style_by_flange_site_and_tool_offset(ur5e):
     assert _solved(ur5e) == 4
 
 
+@pytest.mark.slow
 def test_panda_with_hand_by_body_and_offset(panda):
     assert panda.name == "panda:cartesian"
     assert panda.arm.dof == 7  # the fingers are not the arm's
@@ -137,6 +138,7 @@ def test_arm_name_overrides_the_model_attribute(files, ur5e):
     assert r.n_states == ur5e.n_states and np.array_equal(r.label, ur5e.label)
 
 
+@pytest.mark.slow
 def test_the_tip_is_the_offset_from_the_named_frame(ur5e, panda):
     import mujoco
 
@@ -165,6 +167,7 @@ def test_the_tip_is_the_offset_from_the_named_frame(ur5e, panda):
 # --------------------------------------------------------------------------- using them
 
 
+@pytest.mark.slow
 def test_transfer_both_ways_between_menagerie_style_arms(ur5e, panda):
     for source, target in ((ur5e, panda), (panda, ur5e)):
         r = armtransfer.transfer(source=source, target=target, task=1, methods=["none", "pseudo"], trials=2,

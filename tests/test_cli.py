@@ -139,6 +139,7 @@ def test_bench_fast_mode_writes_its_figures(tmp_path):
         data["median_steps_per_second"] / data["baseline_median_steps_per_second"])
 
 
+@pytest.mark.slow  # the reproduce fixture: 17 s
 def test_reproduce_fast_mode_writes_report_figures_and_results(reproduce_fast):
     code, out = reproduce_fast
     assert code == 0
@@ -155,6 +156,7 @@ def test_reproduce_fast_mode_writes_report_figures_and_results(reproduce_fast):
         assert (out / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+@pytest.mark.slow  # the reproduce fixture: 17 s
 def test_reproduce_follows_the_papers_protocol_by_default_and_reports_both(reproduce_fast):
     code, out = reproduce_fast
     assert code == 0

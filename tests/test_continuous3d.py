@@ -79,6 +79,7 @@ def test_with_noise_a_move_turns_its_joint_by_a_noisy_step_and_the_same_seed_giv
         assert all(isinstance(k, int) for k in noisy.key())
 
 
+@pytest.mark.slow
 def test_it_learns_rooms11_task_2_from_planar2s_path_under_actuation_noise():
     """planar2:joint's learned path -> ur5e_like:joint in its continuous joint space, noise 0.1,
     hashed tiles, via the API: every trial of none and pseudo reaches the goal within the
@@ -101,6 +102,7 @@ def test_it_learns_rooms11_task_2_from_planar2s_path_under_actuation_noise():
     assert r.methods["pseudo"].extra["K"] > 0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("env_id", ["armtransfer/ContinuousArmRooms-v0", "armtransfer/ContinuousArmRoomsBox-v0"])
 def test_the_environments_with_a_spatial_arm_pass_check_env(env_id):
     import gymnasium as gym

@@ -253,7 +253,7 @@ def test_the_guide_reads_only_configurations_labels_and_the_trajectory():
     ("coarse", "fine", {}),
     ("fine", "coarse", {}),
     ("planar2:joint", "ur5e_like:cartesian", {}),
-    ("coarse", "fine", {"wind": 0.05}),
+    pytest.param("coarse", "fine", {"wind": 0.05}, marks=pytest.mark.slow),  # 5 s
     pytest.param("coarse", "fine", {"trajectory": ["optimal", "learned"]}, marks=pytest.mark.slow),  # 6 s
 ])
 def test_it_runs_on_every_kind_of_robot_pair(source, target, options):

@@ -331,6 +331,7 @@ def test_rooms_mapping_bad_input(tmp_path, capsys):
                      capsys, "cannot write")
 
 
+@pytest.mark.slow
 def test_reproduce_reports_the_mapping_columns_beside_the_papers(reproduce_fast):
     code, out = reproduce_fast
     assert code == 0

@@ -341,12 +341,15 @@ ROUTE = armtransfer.potential_method("route", "minus the distance to the nearest
      "named 'numpyy')"),
     ("import armtransfer\nM = armtransfer.potential_method('bad', 'raises', lambda c, t: c[10**9])\n",
      "bad = badplug:M", r"plugin bad-plugin 0.1 .*: method 'bad': its potential raised IndexError", ""),
-    ("import armtransfer, numpy as np\nM = armtransfer.potential_method('bad', 'short', lambda c, t: np.ones(3))\n",
-     "bad = badplug:M", r"plugin bad-plugin 0.1 .*: method 'bad': its potential returned shape \(3,\)", ""),
-    ("import armtransfer, numpy as np\n"
-     "M = armtransfer.potential_method('bad', 'nan', lambda c, t: np.where(c[:, 0] > 0, np.nan, 0.0))\n",
-     "bad = badplug:M", r"plugin bad-plugin 0.1 .*: method 'bad': its potential returned nan", ""),
-    ("M = 3\n", "bad = badplug:M", r"plugin bad-plugin 0.1 .* is int, not a method", "left out (is int, not a method;"),
+    pytest.param("import armtransfer, numpy as np\nM = armtransfer.potential_method('bad', 'short', lambda c, t: np.ones(3))\n",
+                 "bad = badplug:M", r"plugin bad-plugin 0.1 .*: method 'bad': its potential returned shape \(3,\)", "",
+                 marks=pytest.mark.slow),  # 3-4 s each; two others run by default
+    pytest.param("import armtransfer, numpy as np\n"
+                 "M = armtransfer.potential_method('bad', 'nan', lambda c, t: np.where(c[:, 0] > 0, np.nan, 0.0))\n",
+                 "bad = badplug:M", r"plugin bad-plugin 0.1 .*: method 'bad': its potential returned nan", "",
+                 marks=pytest.mark.slow),
+    pytest.param("M = 3\n", "bad = badplug:M", r"plugin bad-plugin 0.1 .* is int, not a method",
+                 "left out (is int, not a method;", marks=pytest.mark.slow),
 ])
 def test_a_bad_installed_plugin_breaks_only_itself(tmp_path, code, ep, fault, at_import):
     """A command that does not use the plugin runs, with one warning line naming it and how to

@@ -65,6 +65,7 @@ def test_a_fold_into_itself_is_a_contact_and_the_home_overlap_is_not(folder):
     assert not checker.touches(np.array([0.0, 1.2, 1.2]))
 
 
+@pytest.mark.slow
 def test_no_compiled_state_of_an_arm_touches_itself(folder, monkeypatch, arm_cache):
     options = dict(xml_path=folder, tip_site="tip", base_pos=MOUNT, base_yaw=0.0, joint_step=0.25,
                    cache=False)

@@ -78,6 +78,7 @@ def _lowest_point(scene, q) -> float:
     return float(data.site_xpos[tip][2] - reach)
 
 
+@pytest.mark.slow
 def test_fingers_past_a_tcp_ride_clear_and_the_cell_is_read_at_the_tcp(files):
     mount = {k: v for k, v in ml.SUGGESTED["panda"].items() if k.startswith("base")}
     robot = arm_robot(None, "cartesian", xml_path=files["panda_tcp"], tip_site="tcp", **mount)
