@@ -147,14 +147,6 @@ def cells(records: list[dict], cap: int = LearnerConfig().max_total_steps) -> li
     return out
 
 
-def robots_of(records: list[dict]) -> list[str]:
-    seen: dict[str, None] = {}
-    for rec in records:
-        seen.setdefault(rec["config"]["source"], None)
-        seen.setdefault(rec["config"]["target"], None)
-    return list(seen)
-
-
 def _fmt(c: Cell | None) -> str:
     if c is None or c.improvement is None or c.ci95 is None:
         return "—"

@@ -14,7 +14,6 @@ from dataclasses import dataclass
 
 from armtransfer.errors import UnknownArmError
 
-CARTESIAN_DIRECTIONS = ((0, 1), (0, -1), (1, 0), (-1, 0))
 CARTESIAN_NAMES = ("F", "B", "R", "L")
 
 

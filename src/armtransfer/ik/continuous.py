@@ -40,7 +40,6 @@ import math
 from typing import Any
 
 import mujoco
-import numba
 import numpy as np
 
 from armtransfer.errors import ArmModelError, InvalidCellError, UnreachableTableError

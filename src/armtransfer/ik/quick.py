@@ -66,7 +66,6 @@ class QuickIK:
         self._forward(q)
         height = TIP_HEIGHT + self.scene.clearance if not self.scene.planar else float(self.tip()[2])
         target = np.array([xy[0], xy[1], height])
-        down = np.array([0.0, 0.0, -1.0])
         rows = 2 if self.scene.planar else 3
         stop_tilt = math.cos(self.tilt_limit * 0.5) if self.tip_down else -1.0  # as -z[2]: half the limit
         spatial = self.tip_down

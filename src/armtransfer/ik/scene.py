@@ -294,11 +294,6 @@ def _home_qpos(model: mujoco.MjModel) -> np.ndarray:
     return q
 
 
-def arm_home(xml_path: Path) -> np.ndarray:
-    """The arm file's ``home`` keyframe qpos (every joint), else its qpos0, clipped."""
-    return _home_qpos(_load_arm(Path(xml_path))[1])
-
-
 def _tip_body(model: mujoco.MjModel, tool: Tool, where: str) -> int:
     if tool.site is not None:
         sid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, tool.site)

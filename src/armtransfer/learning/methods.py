@@ -33,7 +33,7 @@ from armtransfer.learning import guide, plugins, potentials
 from armtransfer.learning import shaping as modes
 from armtransfer.learning.lazy_registry import Names, Registry
 from armtransfer.learning.plugin_calls import PROBE_SECONDS, probe_seconds
-from armtransfer.learning.method import DEFAULT_GAMMA, HALF_BOUND, Builder, Method
+from armtransfer.learning.method import DEFAULT_GAMMA, HALF_BOUND, Method
 from armtransfer.learning.rewards import as_list, farming_bound, longest_n, union_index
 from armtransfer.learning.shaping import Shaping
 from armtransfer.learning.trajectory import Trajectory

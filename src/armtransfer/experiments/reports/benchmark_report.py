@@ -9,7 +9,7 @@ import numpy as np
 from armtransfer.experiments.reports import figures
 
 from armtransfer.experiments import suites
-from armtransfer.experiments.reports.report import fmt_num, markdown_table
+from armtransfer.experiments.reports.report import markdown_table
 from armtransfer.experiments.stats.hierarchical import MIN_UNITS
 from armtransfer.experiments.stats.learning_metrics import HORIZON
 from armtransfer.experiments.stats.multiplicity import ALPHA
@@ -49,13 +49,6 @@ def _factor_ci(ab: dict | None) -> str:
 
 def _pct(x: float | None) -> str:
     return "n/a" if x is None else f"{100 * x:.0f}%"
-
-
-WHAT = {"good_path": "good path (steps until its greedy path was within the quality threshold of the shortest "
-                     "and stayed so)",
-        "convergence": "settled clock (steps until its greedy path first settled, however long)",
-        "first_exposure": "first exposure (steps until it first reached the goal)",
-        "cost": "transfer ratio"}
 
 
 def judgement(ab: dict) -> str:

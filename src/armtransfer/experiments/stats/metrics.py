@@ -167,19 +167,6 @@ def paired_improvement(base: Sequence[float | None], other: Sequence[float | Non
     return out
 
 
-def improvement_ci(
-    baseline: Sequence[float | None], values: Sequence[float | None], cap: int | None = None
-) -> list[float] | None:
-    """95% interval of the improvement in percent. With ``cap``: censored at it and paired
-    when the lengths agree (see :func:`paired_improvement`); without: the trials that
-    reached the goal, independent samples (kept for old callers)."""
-    if cap is not None:
-        return paired_improvement(baseline, values, cap, paired=len(baseline) == len(values))["ci95"]
-    b = [v for v in baseline if v is not None]
-    x = [v for v in values if v is not None]
-    return paired_improvement(b, x, 0, paired=False)["ci95"]
-
-
 SEED_DESIGN = "paired trial by trial; the interval resamples whole source seeds (their trials with them)"
 SEED_RESAMPLES = 9999
 
