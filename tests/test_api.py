@@ -14,7 +14,7 @@ from armtransfer.errors import ArmTransferError, InvalidParameterError
 from armtransfer.learning import methods as registry
 from armtransfer.learning import shaping as modes
 from armtransfer.experiments.experiment import MethodResult
-from armtransfer.learning.sarsa import TrialResult
+from armtransfer.learning.trial_result import TrialResult
 from armtransfer.learning.shaping import Shaping
 
 

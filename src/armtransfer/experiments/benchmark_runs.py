@@ -38,7 +38,7 @@ from armtransfer.experiments.sweep import content_key
 from armtransfer.learning import methods
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.learner_names import SARSA
-from armtransfer.learning.sarsa import TrialResult
+from armtransfer.learning.trial_result import TrialResult
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.robot import DiscreteRobot
 
@@ -179,7 +179,7 @@ def _fields(res: experiment.MethodResult) -> dict:
 
 
 CLOCK_FIELDS = ("good_path_steps", "shortest_path_steps", "settled_ratio", "final_ratio", "steps_run")
-"""The good-path clock of a trial run's result (``sarsa.TrialResult``, ``learning.clock``)."""
+"""The good-path clock of a trial run's result (``trial_result.TrialResult``, ``learning.clock``)."""
 
 
 def clock_fields(t: TrialResult) -> dict:

@@ -4,7 +4,7 @@ The arm is any ``Mover`` placed at the task's start (``ik.continuous.ContinuousA
 the methods are those paid on labels alone (``learning.cells.CELL_METHODS``). Trial k of every
 method draws from ``experiment.trial_rng(seed, k)``, as the tabular trials do, so the methods
 meet the same random streams trial by trial and the results are the tabular ones' kind
-(``sarsa.TrialResult`` in a ``MethodResult``): ``experiment.summarize``, the metrics and the
+(``trial_result.TrialResult`` in a ``MethodResult``): ``experiment.summarize``, the metrics and the
 survival statistics apply unchanged. Trials run one after the other (one MuJoCo data per arm).
 """
 

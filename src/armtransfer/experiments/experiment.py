@@ -18,6 +18,7 @@ from armtransfer.cpus import cpus as _cpus
 from armtransfer.errors import InvalidParameterError
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.learning import controls, farming, methods, potentials, sarsa
+from armtransfer.learning.trial_result import TrialResult
 from armtransfer.experiments.stats import metrics
 from armtransfer.learning.controls import CONTROLS
 from armtransfer.learning import trajectory as trajectories
@@ -106,7 +107,7 @@ class MethodResult:
     method was given instead of the real one (None: the real trajectory)."""
 
     method: str
-    trials: list[sarsa.TrialResult] = field(default_factory=list)
+    trials: list[TrialResult] = field(default_factory=list)
     extra: dict = field(default_factory=dict)
     control: str | None = None
 
@@ -313,7 +314,7 @@ def online_mapping(
 ) -> ActionMapping:
     """The action sequence mapping learned *during* a task: ``mapping`` (default: empty) plus
     what each trial's first exposure teaches, in trial order. A trial's first-episode path,
-    its loops erased (``sarsa.TrialResult.first_path``), is set beside ``traj`` as a converged
+    its loops erased (``trial_result.TrialResult.first_path``), is set beside ``traj`` as a converged
     greedy path would be (``mapping.observe``: matched cells, the shorter target sequence wins),
     so the mapping exists as soon as the goal is first reached, before any trial converges,
     and the method ``mapping`` can use it on the next task at once."""
@@ -406,7 +407,7 @@ def summarize(results: Sequence[MethodResult], baseline: str = "none", cap: int 
 
 CLOCK = ("good_path_steps", "shortest_path_steps", "settled_ratio", "final_ratio", "optimal", "good_len",
          "steps_run")
-"""The good-path clock's per-trial lists (``sarsa.TrialResult``, ``learning.clock``): steps until the
+"""The good-path clock's per-trial lists (``trial_result.TrialResult``, ``learning.clock``): steps until the
 greedy path was good (at most ``good_len`` = ceil(quality x optimal) steps) and stayed so, the same
 at quality 1.0, the first settled path's and the final path's length over the shortest, and the
 steps each trial ran (where a trial that never got there is censored)."""

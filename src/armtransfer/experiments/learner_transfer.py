@@ -6,7 +6,7 @@ environment, the method's reward term over it, ``none`` with none: trial ``k`` o
 starts from the seeds of trial ``k`` of the kernel (``SeedSequence([seed, 0, k])``), so a method
 and its baseline meet the same streams, and the same seed gives the same bytes when the
 learner draws only from the seed it is handed. Each trial becomes a
-:class:`~armtransfer.learning.sarsa.TrialResult` as the kernel's are, so the tables, JSON and
+:class:`~armtransfer.learning.trial_result.TrialResult` as the kernel's are, so the tables, JSON and
 frames read alike:
 
 - ``exploration_steps``: training steps until the goal was first reached (None: never, within
@@ -29,7 +29,7 @@ from armtransfer.experiments.experiment import MethodResult
 from armtransfer.learning import methods
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.learners import Learner
-from armtransfer.learning.sarsa import TrialResult
+from armtransfer.learning.trial_result import TrialResult
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.robot import DiscreteRobot
 

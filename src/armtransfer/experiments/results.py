@@ -2,7 +2,7 @@
 
 A :class:`TransferResult` holds the task, the robots, the transferred trajectories, the
 learner's settings and, per method, a :class:`~armtransfer.experiments.experiment.MethodResult`
-with every trial (:class:`~armtransfer.learning.sarsa.TrialResult`). Control runs (a method
+with every trial (:class:`~armtransfer.learning.trial_result.TrialResult`). Control runs (a method
 given a shuffled or random trajectory) are kept apart, under ``controls[kind][method]``.
 
 ``to_json()`` is exactly what ``armtransfer rooms --json`` and ``armtransfer arms`` write;

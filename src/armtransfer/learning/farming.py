@@ -43,7 +43,7 @@ import numpy as np
 from armtransfer.errors import InvalidParameterError
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.learning import methods, rewards
-from armtransfer.learning.sarsa import _shaping as kernel_shaping
+from armtransfer.learning.sarsa import shaping_term as kernel_shaping
 from armtransfer.learning.shaping import Shaping
 from armtransfer.learning.trajectory import Trajectory
 
@@ -334,7 +334,7 @@ def self_loops(robot: DiscreteRobot, goal_cell: int, wind: float = 0.0) -> np.nd
 
 
 def self_loop_shaping(shaping: Shaping, states: np.ndarray, gamma: float) -> np.ndarray:
-    """The shaping term the kernel (``sarsa._shaping``) pays for repeating a self-loop at each of
+    """The shaping term the kernel (``sarsa.shaping_term``) pays for repeating a self-loop at each of
     ``states``, after the learner arrived there: a once-per-episode bonus already paid, the best
     bonus of the episode at least the state's own."""
     sh = shaping

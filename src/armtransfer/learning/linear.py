@@ -9,7 +9,7 @@ the same steps, bit for bit:
   * epsilon-greedy on the Q values of the active features (``sarsa._egreedy``: the same
     draws, ties broken the same way).
   * delta = r + r'(s') + gamma Q(s', a') - Q(s, a), Q(terminal, .) = 0; the shaping term r'
-    is ``sarsa._shaping``'s, paid on the *label* (the cell under the tool point): the
+    is ``sarsa.shaping_term``'s, paid on the *label* (the cell under the tool point): the
     paper's pseudo reward i*K on reaching the i-th trajectory cell, or another method's.
   * traces on (feature, action) pairs: accumulating (e += 1 for each active feature) or
     replacing (e = 1); then for every pair with a trace: w += alpha / tilings * delta * e
@@ -48,7 +48,8 @@ from armtransfer.learning import sarsa as _sarsa
 from armtransfer.learning import tiles as _tiles
 from armtransfer.learning import traces as _traces
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.learning.sarsa import TrialResult, _best_and_ties, _nth_best, _shaping
+from armtransfer.learning.trial_result import TrialResult
+from armtransfer.learning.sarsa import best_and_ties, nth_best, shaping_term
 from armtransfer.learning.shaping import MODE_NONE, Shaping
 from armtransfer.learning.tiles import TileCoding
 
@@ -94,8 +95,8 @@ def _egreedy(qrow, n_actions, eps, u, c):
     draws in the same order, the same choice (the one-hot test checks it)."""
     if _draw(u, c) < eps:
         return int(_draw(u, c) * n_actions)
-    best, ties = _best_and_ties(qrow, 0, n_actions)
-    return _nth_best(qrow, 0, n_actions, best, 0 if ties == 1 else int(_draw(u, c) * ties))
+    best, ties = best_and_ties(qrow, 0, n_actions)
+    return nth_best(qrow, 0, n_actions, best, 0 if ties == 1 else int(_draw(u, c) * ties))
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -151,7 +152,7 @@ def _update(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats
     if terminal:
         r += p[P_GOAL]
     if mode != MODE_NONE:
-        term, best = _shaping(mode, label, label2, terminal, bonus, traj_index, phi, gamma, paid_stamp,
+        term, best = shaping_term(mode, label, label2, terminal, bonus, traj_index, phi, gamma, paid_stamp,
                               c[I_EPISODE], best)
         r += term
     feat, feat2 = feats[0], feats[1]
@@ -244,7 +245,7 @@ def learn(mover: Mover, goal: int, coding: TileCoding, config: LearnerConfig, rn
     """One trial of linear SARSA(lambda) on ``mover`` towards the goal cell ``goal``.
 
     ``shaping`` holds per-*cell* arrays (``cells.cell_shaping``; None: no transfer). ``rng``
-    is the only source of randomness. The result is ``sarsa.TrialResult``'s, with the paths
+    is the only source of randomness. The result is ``trial_result.TrialResult``'s, with the paths
     empty (a continuous robot has no state numbers to name them by). ``steps_by``: what runs
     each episode's steps (the same steps, faster; None: the loop here)."""
     sh = shaping if shaping is not None else Shaping.none(1)

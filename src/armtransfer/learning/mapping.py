@@ -90,7 +90,7 @@ MACRO_EPISODES: int | None = 1
 is the exploration phase: until the goal is first reached. See the module docstring."""
 
 Path_ = list[tuple[int, int]]
-"""A robot's path: [(state, action), ..., (goal state, -1)], as ``sarsa.TrialResult.greedy_path``."""
+"""A robot's path: [(state, action), ..., (goal state, -1)], as ``trial_result.TrialResult.greedy_path``."""
 
 
 @dataclass

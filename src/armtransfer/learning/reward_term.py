@@ -3,7 +3,7 @@
 :class:`TransferTerm` holds the shaping arrays the method registry builds for a robot and its
 transferred trajectories, and the state the learner kernel keeps (which trajectory cells
 ``first-visit`` has paid in the trial, how far ``progress`` got in the episode); each move's term is computed by the
-kernel's own shaping function (``armtransfer.learning.sarsa._shaping``), so a learner that adds
+kernel's own shaping function (``armtransfer.learning.sarsa.shaping_term``), so a learner that adds
 it sees exactly the rewards the project's SARSA(lambda) sees. The Gymnasium wrapper
 (``armtransfer.wrappers.TransferReward``) and the dm_control one (``armtransfer.dmc``) add it.
 """
@@ -20,7 +20,7 @@ from armtransfer.errors import InvalidParameterError, InvalidTrajectoryError
 from armtransfer.learning import methods as registry
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.learning.sarsa import _shaping
+from armtransfer.learning.sarsa import shaping_term
 from armtransfer.learning.shaping import MODE_NONE
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.grid_robots import GRID_ROBOTS
@@ -95,7 +95,7 @@ class TransferTerm:
         sh = self.shaping
         if sh.mode == MODE_NONE:
             return 0.0
-        value, self._best = _shaping(sh.mode, int(s), int(s2), bool(terminated), sh.bonus, sh.traj_index, sh.phi,
+        value, self._best = shaping_term(sh.mode, int(s), int(s2), bool(terminated), sh.bonus, sh.traj_index, sh.phi,
                                      self.gamma, self._paid, self._episode, self._best)
         return float(value)
 

@@ -47,7 +47,6 @@ The random stream, in the order it is drawn (the dense reference draws the same)
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
 
@@ -56,6 +55,7 @@ import numpy as np
 
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.trial_result import TrialResult
 
 from armtransfer.learning import clock as _clock
 from armtransfer.learning import guide as _guide
@@ -168,7 +168,7 @@ class Outputs(NamedTuple):
 
 
 @numba.njit(cache=True, inline="always")
-def _best_and_ties(Q, s, n_actions):
+def best_and_ties(Q, s, n_actions):
     """(the largest Q[s, .], how many actions have it)."""
     best = Q[s, 0]
     ties = 1
@@ -183,7 +183,7 @@ def _best_and_ties(Q, s, n_actions):
 
 
 @numba.njit(cache=True, inline="always")
-def _nth_best(Q, s, n_actions, best, k):
+def nth_best(Q, s, n_actions, best, k):
     """The k-th (from 0, in index order) action whose Q[s, .] is ``best``."""
     for a in range(n_actions):
         if Q[s, a] == best:
@@ -197,8 +197,8 @@ def _nth_best(Q, s, n_actions, best, k):
 def _egreedy(Q, s, n_actions, eps, rng):
     if rng.random() < eps:
         return int(rng.random() * n_actions)
-    best, ties = _best_and_ties(Q, s, n_actions)
-    return _nth_best(Q, s, n_actions, best, 0 if ties == 1 else int(rng.random() * ties))
+    best, ties = best_and_ties(Q, s, n_actions)
+    return nth_best(Q, s, n_actions, best, 0 if ties == 1 else int(rng.random() * ties))
 
 
 @numba.njit(cache=True, inline="always")
@@ -262,7 +262,7 @@ def _greedy_path(Q, next_state, label, start, goal, stamp, stamp_id, path_out):
 
 
 @numba.njit(cache=True)
-def _shaping(mode, s, s2, terminal, bonus, traj_index, phi, gamma, paid_stamp, episode, best):
+def shaping_term(mode, s, s2, terminal, bonus, traj_index, phi, gamma, paid_stamp, episode, best):
     """The shaping term for the move s -> s2; returns (term, the best bonus so far)."""
     if mode == MODE_PSEUDO:
         return bonus[s2], best
@@ -396,7 +396,7 @@ def _make_run_trial(with_guide: bool):
                 if terminal:
                     r += r_goal
                 if mode != MODE_NONE:
-                    term, best = _shaping(
+                    term, best = shaping_term(
                         mode, s, s2, terminal, bonus, traj_index, phi, gamma, paid_stamp, ep, best
                     )
                     r += term
@@ -480,53 +480,6 @@ _run_trial = _make_run_trial(False)
 """The kernel for a run without a guide."""
 _run_trial_guided = _make_run_trial(True)
 """The kernel for method ``guided``."""
-
-
-@dataclass
-class TrialResult:
-    """What one trial of :func:`learn` measured."""
-
-    exploration_steps: int | None
-    """Steps of the first episode, i.e. until the goal is first reached (None: never)."""
-    converged: bool
-    total_steps: int | None
-    """Steps until the greedy path stopped changing (through its first episode)."""
-    greedy_steps: int | None
-    """Length of the converged greedy path (None when not converged)."""
-    episodes: int
-    episode_steps: np.ndarray
-    """Steps per episode (negative: the episode hit a cap before the goal)."""
-    greedy_lengths: np.ndarray
-    """Greedy path length after each episode (-1: the greedy path misses the goal)."""
-    macro_steps: np.ndarray
-    """Primitive steps taken inside mapped macros, per episode."""
-    greedy_path: list[tuple[int, int]] = field(default_factory=list)
-    """The converged greedy path as (state, action) pairs ending with (goal state, -1)."""
-    first_path: list[tuple[int, int]] = field(default_factory=list)
-    """The first episode's path (until the goal was first reached) with its loops erased, as
-    (state, action) pairs ending with (goal state, -1); empty when the goal was not reached.
-    What the online action sequence mapping learns from (``mapping.ActionMapping.learn_from``)."""
-    Q: np.ndarray | None = None
-    optimal: int | None = None
-    """The target's shortest path from the start (steps), as the harness measured it; None: not
-    measured (robot 1's learning, or a learner run alone)."""
-    good_len: int | None = None
-    """The longest good path, ``clock.good_length(quality, optimal)``; the trial ended only on a
-    settled path at most this long, or at a cap (None: on any settled path)."""
-    good_path_steps: int | None = None
-    """Steps until the greedy path was at most ``good_len`` long and stayed so to the end of the
-    trial (``clock.good_path_steps``); None: never, censored at ``steps_run``."""
-    shortest_path_steps: int | None = None
-    """The same clock at quality 1.0: steps until the greedy path was a shortest one and stayed so."""
-    settled_ratio: float | None = None
-    """The first settled greedy path's length over the shortest (``greedy_steps / optimal``)."""
-    final_ratio: float | None = None
-    """The greedy path's length at the end of the trial over the shortest (None: it misses the goal)."""
-    steps_run: int = 0
-    """Every step the trial took."""
-    clock_note: str | None = None
-    """Why the good-path clock is not measured, where a learner cannot measure it (None: it is, or
-    no shortest path was handed over)."""
 
 
 def learn(
@@ -632,4 +585,4 @@ DEPENDENCIES = [*_guide.FILES, Path(_traces.__file__)]
 
 # numba's cache does not notice an edit to those files alone (``jitcache``), so the kernels'
 # cache is emptied when one of them changes.
-_jitcache.invalidate_stale(__name__, [_best_and_ties, _nth_best, _egreedy, _macro_step, _choose, _choose_guided, _greedy_path, _shaping, _run_trial, _run_trial_guided], DEPENDENCIES)
+_jitcache.invalidate_stale(__name__, [best_and_ties, nth_best, _egreedy, _macro_step, _choose, _choose_guided, _greedy_path, shaping_term, _run_trial, _run_trial_guided], DEPENDENCIES)

@@ -10,7 +10,7 @@
 
 Every step's reward is the environment's plus the chosen method's shaping term for the move
 just made, computed by the learner kernel's own shaping function
-(``armtransfer.learning.sarsa._shaping``) on arrays built by the method registry, so an
+(``armtransfer.learning.sarsa.shaping_term``) on arrays built by the method registry, so an
 agent learning on the wrapped env sees exactly the rewards the project's SARSA(lambda) sees.
 The term is also in ``info["shaping"]``. How far ``progress`` got starts afresh at every
 ``reset``; the cells ``first-visit`` has paid stay paid for the wrapper's life (one trial).
