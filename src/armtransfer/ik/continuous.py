@@ -92,6 +92,7 @@ class NoisyJointMoves:
     _rng: np.random.Generator
     _eps: list[float]
     _k: int
+    dof: int
 
     def seed_noise(self, rng: np.random.Generator) -> None:
         """Draw the actuation noise from ``rng`` from now on (nothing is drawn when sigma is 0)."""
@@ -106,6 +107,22 @@ class NoisyJointMoves:
             k = 0
         self._k = k + 1
         return self._eps[k]
+
+    def move_by(self, dq: np.ndarray) -> int:
+        """Turn every moved joint at once, joint j by ``dq[j]`` radians (times 1 + eps_j with
+        actuation noise, one draw per joint), along the straight line in joint space: the cell
+        (or voxel) under the tool point after the move, or ``BLOCKED`` (the arm has not moved).
+        It leaves the lattice: :meth:`key` then names the angles; :meth:`reset` goes back to the
+        start. How the line is checked is the arm's ``_move_by``."""
+        turn = np.asarray(dq, dtype=np.float64).reshape(-1)
+        if turn.shape != (self.dof,) or not np.all(np.isfinite(turn)):
+            raise ArmModelError(f"a joint move of this arm is {self.dof} finite angles, got {dq!r}")
+        if self._noisy:
+            turn = turn * (1.0 + np.array([self._next_eps() for _ in range(self.dof)]))
+        return self._move_by(turn)
+
+    def _move_by(self, turn: np.ndarray) -> int:
+        raise NotImplementedError
 
     def noiseless(self) -> "_Noiseless":
         """A context in which the moves have no noise (a greedy path's roll-out: reset first,
@@ -424,26 +441,6 @@ class ContinuousArm(NoisyJointMoves):
         (an unlimited joint: pi either side of it)."""
         return np.array(self._box[0]), np.array(self._box[1])
 
-    def move_by(self, dq: np.ndarray) -> int:
-        """Turn every joint at once, joint j by ``dq[j]`` radians (times 1 + eps_j with actuation
-        noise, one draw per joint): the cell under the tool point after the move, or
-        ``BLOCKED`` (the arm has not moved) when it leaves the joint box, MuJoCo reports a
-        contact at its end, or the tool point at its end or at points along the straight line in
-        joint space (spaced so that the tip moves at most half a cell between them, by
-        ``sum_j |dq_j| * reach_j``) is over a wall or off the table, or a geom would touch the
-        table or a wall anywhere along the line (``ik.fastline``, compiled; an arm that can touch
-        itself is also asked for contacts at up to 3 of the tool points). It leaves the lattice:
-        :meth:`key` names such a configuration only with noise; :meth:`reset` goes back to the
-        lattice's start. A move whose contacts the compiled code cannot read (more than
-        ``ik.fastmove.CONTACTS``) is checked here in Python, by the tool points and MuJoCo at up
-        to 3 of them near a wall."""
-        turn = np.asarray(dq, dtype=np.float64).reshape(-1)
-        if turn.shape != (self.dof,) or not np.all(np.isfinite(turn)):
-            raise ArmModelError(f"a joint move of this arm is {self.dof} finite angles, got {dq!r}")
-        if self._noisy:
-            turn = turn * (1.0 + np.array([self._next_eps() for _ in range(self.dof)]))
-        return self._move_by(turn)
-
     def _line(self) -> np.ndarray | None:
         """The table ``ik.fastline.line_move`` reads, or None (no compiled move)."""
         if self._line_table is not None:
@@ -480,7 +477,14 @@ class ContinuousArm(NoisyJointMoves):
         return self._line_table
 
     def _move_by(self, turn: np.ndarray) -> int:
-        """:meth:`move_by` of a checked turn (noise applied)."""
+        """:meth:`move_by` of a checked turn (noise applied): ``BLOCKED`` when it leaves the joint
+        box, MuJoCo reports a contact at its end, or the tool point at its end or at points along
+        the straight line in joint space (spaced so that the tip moves at most half a cell between
+        them, by ``sum_j |dq_j| * reach_j``) is over a wall or off the table, or a geom would touch
+        the table or a wall anywhere along the line (``ik.fastline``, compiled; an arm that can
+        touch itself is also asked for contacts at up to 3 of the tool points). A move whose
+        contacts the compiled code cannot read (more than ``ik.fastmove.CONTACTS``) is checked
+        here in Python, by the tool points and MuJoCo at up to 3 of them near a wall."""
         self._fresh = False
         self.moves += 1
         line = self._line_table if self._line_table is not None else self._line()

@@ -345,17 +345,6 @@ class SpatialContinuousArm(NoisyJointMoves):
         swept.capture(d.geom_xpos, d.geom_xmat, self._geoms, self._offset, d.xanchor, d.xaxis, self._joints,
                       self._frames, self._anchors, self._axes)
 
-    def move_by(self, dq: np.ndarray) -> int:
-        """Turn every moved joint at once, joint i by ``dq[i]`` radians (times 1 + eps_i with
-        noise), along the straight line in joint space: the voxel after the move, or ``BLOCKED``.
-        It leaves the lattice (:meth:`key` is then q; :meth:`reset` goes back to the start)."""
-        turn = np.asarray(dq, dtype=np.float64).reshape(-1)
-        if turn.shape != (self.dof,) or not np.all(np.isfinite(turn)):
-            raise ArmModelError(f"a joint move of this arm is {self.dof} finite angles, got {dq!r}")
-        if self._noisy:
-            turn = turn * (1.0 + np.array([self._next_eps() for _ in range(self.dof)]))
-        return self._move_by(turn)
-
     def _move_by(self, turn: np.ndarray) -> int:
         """:meth:`move_by` of a checked turn (noise applied): by ``ik.fastline.line_move`` when
         the arm has it (the same rule as :meth:`_go`, compiled)."""
