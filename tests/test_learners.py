@@ -216,8 +216,8 @@ def test_an_outside_learner_runs_only_none_and_the_reward_term_methods():
     assert benchmark.baselines_of("pseudo") == ("none", "goal-dense")
     from armtransfer.experiments.reports.benchmark_report import describe
 
-    assert describe("none@dqn", benchmark.parse_label).startswith("no transfer; learned by dqn")
-    assert describe("none", benchmark.parse_label) == "Algorithm 1 without transfer"
+    assert describe("none@dqn").startswith("no transfer; learned by dqn")
+    assert describe("none") == "Algorithm 1 without transfer"
 
 
 def test_the_default_learners_keep_the_suites_key_and_bytes():

@@ -51,19 +51,7 @@ from armtransfer.registration import MAX_EPISODE_STEPS
 from armtransfer.tasks.catalog import custom_task
 from armtransfer.tasks.envs import RobotRoomsEnv
 from armtransfer.tasks.robot import DiscreteRobot
-
-CHUNKS = 200
-"""Greedy evaluations per trial budget: a chunk is ``max_total_steps // CHUNKS`` training steps."""
-
-EVALS = 3
-"""Consecutive greedy episodes at (1 + TOLERANCE) x the shortest path that make a trial converged."""
-
-TOLERANCE = 0.25
-"""A greedy episode counts towards convergence when its steps are at most (1 + TOLERANCE) x the
-target's shortest path."""
-
-EVAL_CAP = 4
-"""A greedy episode stops after EVAL_CAP x the target's shortest path steps (failed)."""
+from armtransfer.experiments.harness_terms import CHUNKS, EVAL_CAP, EVALS, TOLERANCE
 
 HEARTBEAT_SECONDS = 30.0
 """A trial running longer says how far it has got on stderr every this many seconds (when asked

@@ -6,14 +6,17 @@ from pathlib import Path
 
 import numpy as np
 
-from armtransfer.experiments.reports import figures
-
+from armtransfer.experiments import harness_terms as lt
 from armtransfer.experiments import suites
+from armtransfer.experiments.comparisons import baselines_of, registered_baseline
+from armtransfer.experiments.reports import figures
 from armtransfer.experiments.reports.report import markdown_table
 from armtransfer.experiments.stats.hierarchical import MIN_UNITS
 from armtransfer.experiments.stats.learning_metrics import HORIZON
 from armtransfer.experiments.stats.multiplicity import ALPHA
 from armtransfer.learning import methods
+from armtransfer.learning.learner_names import parse_label
+from armtransfer.learning.learners import LEARNERS
 
 
 def survival_name(section: str) -> str:
@@ -122,7 +125,6 @@ def sentence(name: str, ab: dict, where: str) -> str:
     """One claim about ``name`` against one of its baselines, from the pooled comparison ``ab``
     (one block per metric): the whole cost first, then the first exposure, then the transfer
     ratio, and whether a first-episode win is lost back."""
-    from armtransfer.experiments.benchmark import baselines_of, registered_baseline
 
     base = ab["baseline"]
     if not registered_baseline(name):
@@ -249,10 +251,21 @@ def record_warnings(records: list[dict]) -> list[str]:
 
 def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str], missing: list[str],
                     failures: list[dict] | None = None, warnings: list[str] | None = None) -> str:
-    from armtransfer.experiments.benchmark import baselines_of, registered_baseline
+    out = _preamble(suite, seed, ran)
+    if missing:
+        out += ["", f"Not in this build's method registry, so not run: {', '.join(missing)}."]
+    if warnings:
+        out += ["", "## Warnings", "", *(f"- {w}" for w in warnings)]
+    if failures:
+        out += _failures(failures)
+    out += _claims(suite, summary)
+    out += _sections(suite, summary)
+    out += READING
+    return "\n".join(out)
 
-    from armtransfer.experiments.benchmark import parse_label
 
+def _preamble(suite: suites.Suite, seed: int, ran: list[str]) -> list[str]:
+    """The title, how the report was made, and every method with its baselines."""
     kind = ("held out: no parameter of any method was chosen on it" if suite.held_out
             else "not held out: parameters may be chosen on it")
     worlds = list(dict.fromkeys(c.world.partition("#")[0] for sec in suite.sections for c in sec.cases))
@@ -268,30 +281,35 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
     out.append(markdown_table(["method", "baselines (the first: told nothing)", "what it is"],
                               [[m, (", ".join(baselines_of(m)) or "-") + ("" if m == "none" or registered_baseline(m)
                                                                           else " (default: the registry names none)"),
-                                describe(m, parse_label)] for m in ran]))
+                                describe(m)] for m in ran]))
     outside = sorted({parse_label(m)[1] for m in ran} - {"sarsa"})
     if outside:
-        from armtransfer.experiments import learner_trial as lt
-
         out += ["", f"`METHOD@LEARNER`: the method run by the outside learner {', '.join(outside)} "
                 "(docs/extending.md), on the case's Gymnasium environment with the method's reward term "
                 "(`TransferReward`). The harness counts the steps; it learns in chunks of the step cap / "
                 f"{lt.CHUNKS}, each followed by one greedy episode (capped at {lt.EVAL_CAP}x the shortest "
                 f"path); converged: {lt.EVALS} greedy episodes in a row at most {1 + lt.TOLERANCE:g}x the "
                 "shortest path, its steps those at the first of them; otherwise censored at the cap."]
-    if missing:
-        out += ["", f"Not in this build's method registry, so not run: {', '.join(missing)}."]
-    if warnings:
-        out += ["", "## Warnings", "", *(f"- {w}" for w in warnings)]
-    if failures:
-        out += ["", "## Runs that failed", "",
-                f"{sum(f['failed_runs'] for f in failures)} runs failed, so the records below are left out of "
-                "everything that follows (method `source`: robot 1's run failed, so every method of that case and "
-                "source seed); each method is paired with its baseline over the source seeds both have. The store's "
-                "`failed/` keeps each run's traceback, and running the same command again retries them.", ""]
-        out.append(markdown_table(["section", "case", "source seed", "method", "runs failed", "first error"],
-                                  [[f["section"], f["label"], str(f["source_seed"]), f["method"],
-                                    str(f["failed_runs"]), f["error"].replace("|", "\\|")] for f in failures]))
+    return out
+
+
+def _failures(failures: list[dict]) -> list[str]:
+    """The runs that failed, and what that leaves out."""
+    out: list[str] = []
+    out += ["", "## Runs that failed", "",
+            f"{sum(f['failed_runs'] for f in failures)} runs failed, so the records below are left out of "
+            "everything that follows (method `source`: robot 1's run failed, so every method of that case and "
+            "source seed); each method is paired with its baseline over the source seeds both have. The store's "
+            "`failed/` keeps each run's traceback, and running the same command again retries them.", ""]
+    out.append(markdown_table(["section", "case", "source seed", "method", "runs failed", "first error"],
+                              [[f["section"], f["label"], str(f["source_seed"]), f["method"],
+                                str(f["failed_runs"]), f["error"].replace("|", "\\|")] for f in failures]))
+    return out
+
+
+def _claims(suite: suites.Suite, summary: dict) -> list[str]:
+    """Every comparison's claim, the controls', the strata's and the source seeds' effect."""
+    out: list[str] = []
     out += ["", "## Claims", ""]
     for section in suite.sections:
         for name, against in summary[section.name]["pooled"].items():
@@ -306,6 +324,12 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
         if stratum:
             out.append("- " + stratum_text(section.name, stratum))
     out += ["", seed_effect_text(suite, summary)]
+    return out
+
+
+def _sections(suite: suites.Suite, summary: dict) -> list[str]:
+    """Each section: its protocol, figures and each case's table."""
+    out: list[str] = []
     for section in suite.sections:
         sec = summary[section.name]
         out += ["", f"## Section `{section.name}`", "",
@@ -328,7 +352,10 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
                 out.append(f"\nRobot 1 did not converge on {case['source_failures']} of "
                            f"{len(case['optimal_per_seed'])} source seeds: there every method that needs a "
                            "trajectory learned as its baseline told nothing.")
-    out += ["", "## How to read this report", "",
+    return out
+
+
+READING = ["", "## How to read this report", "",
             "- Every claim states, in this order: the good path (steps until the greedy path was at most "
             "ceil(quality x the target's shortest path) steps long and stayed so to the end of the trial; a trial "
             "ends only on a settled good path, so one that settles on a worse path runs on to its episode or step "
@@ -360,16 +387,14 @@ def report_markdown(suite: suites.Suite, seed: int, summary: dict, ran: list[str
             "the cap. Success in budget: trials that reached it within the budget. Seed share: the share of the "
             "variance of log first exposure that lies between source seeds.",
             ""]
-    return "\n".join(out)
+"""How to read the report: the closing section, the same for every suite."""
 
 
-def describe(name: str, parse_label) -> str:
+def describe(name: str) -> str:
     """What a record's method is: the method's description, and its learner's when not the built-in."""
     method, learner = parse_label(name)
     if learner == "sarsa":
         return methods.get(method).description
-    from armtransfer.learning.learners import LEARNERS
-
     found = LEARNERS.get(learner)
     text = "no transfer" if method == "none" else methods.get(method).description  # none's is Algorithm 1's
     return text + f"; learned by {learner}" + (f" ({found.description})" if found is not None else "")
