@@ -48,9 +48,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from armtransfer.ik.actions import ACTION_MODELS
-    from armtransfer.errors import ArmModelError
-
     if args.action == "generate":
         common.refuse_other_options(args, GENERATE_OPTIONS, "'arms generate'")
         return generate(args)
@@ -62,10 +59,15 @@ def run(args: argparse.Namespace) -> int:
         return arm_transfer.run(args)
     common.refuse_other_options(args, LIST_OPTIONS, "'arms list'")
     common.check_arm_flags(args)
-    from armtransfer.tasks.arms import arm_robot, is_spatial_joint, robot_specs, spatial_joint_specs
-    from armtransfer.worlds.resolve import is_default
+    return _list(args)
 
-    layout = common.world_of(args)
+
+def _jobs(args: argparse.Namespace, layout) -> list[dict[str, Any]]:
+    """The robots ``arms list`` reports: the built-in ones --arm and --actions pick, in the
+    registry's order, then the arm file's (checked first, so a bad file fails fast)."""
+    from armtransfer.ik.actions import ACTION_MODELS
+    from armtransfer.errors import ArmModelError
+    from armtransfer.tasks.arms import robot_specs, spatial_joint_specs
 
     wanted = None
     if args.actions:
@@ -98,7 +100,17 @@ def run(args: argparse.Namespace) -> int:
                   **{k: v for k, v in options.items() if k != "arm_name"})
         for a in custom:
             jobs.append(dict(arm=None, actions=a, xml_path=args.arm_xml, **options))
-    from armtransfer.tasks.arms import NotCached, tasks_solvable, walls_cause
+    return jobs
+
+
+def _list(args: argparse.Namespace) -> int:
+    """``arms list``: a row per robot, compiled where asked, from the cache otherwise."""
+    from armtransfer.models import ARMS
+    from armtransfer.tasks.arms import NotCached, arm_robot, is_spatial_joint, tasks_solvable, walls_cause
+    from armtransfer.worlds.resolve import is_default
+
+    layout = common.world_of(args)
+    jobs = _jobs(args, layout)
 
     # compiled: the robots asked for by name (--arm, --actions), the arm file's, every one with --compile;
     # the others are listed at once, with their figures when the cache has them
