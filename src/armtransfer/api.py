@@ -15,10 +15,17 @@ from __future__ import annotations
 
 import numbers
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import armtransfer.checks as checks
 from armtransfer.errors import InvalidCellError, InvalidParameterError, InvalidTaskError
+from armtransfer.experiments.learner_trial import refuse_methods
+from armtransfer.io import check_writable
+from armtransfer.learning.cells import CELL_METHODS, check_method
+from armtransfer.learning.method import check_k
+from armtransfer.learning.plugin_calls import probe_seconds
 from armtransfer.learning import potentials, presets
 from armtransfer.experiments import experiment
 from armtransfer.learning import methods as registry
@@ -85,9 +92,8 @@ def transfer(
     :data:`TRAJECTORY_KINDS`, trajectory JSON files or :class:`Trajectory` objects (default
     ``learned``). ``controls`` also runs every reward-only method with a shuffled and a
     random trajectory, each trial with its own draw (``experiment.run_control``). ``baselines``
-    also runs, before the methods that need them, the baselines sharing their learners
-    (``Method.baselines``, see :func:`armtransfer.learning.methods.with_baselines`). ``mapping`` (for method ``mapping``) is a mapping or its JSON file;
-    with ``save_mapping`` the file is updated from this run's converged trials.
+    also runs the baselines sharing their learners (``learning.methods.with_baselines``).
+    ``mapping`` (method ``mapping``) is a mapping or its JSON file, updated with ``save_mapping``.
     ``learner_options`` are :class:`LearnerConfig` fields (``alpha``, ``epsilon``, ...), over
     the settings of ``preset`` (``learning.presets``: ``default`` or ``paper-calibrated``).
     ``progress`` is called after every trial.
@@ -111,9 +117,8 @@ def transfer(
     method through the benchmark's harness (``experiments.learner_transfer``) on the same case
     and seeds, ``none`` (run by it too) its baseline, within ``max_total_steps`` steps a trial;
     it runs ``none`` and the reward-term methods (another is refused in one line listing them)
-    and no controls (a control trajectory ends elsewhere than the task's goal, which the harness's
-    reward term refuses), and is made, learns a few steps and predicts once before anything else is learned, so a
-    learner that raises is refused in one line naming it.
+    and no controls (a control trajectory ends elsewhere than the task's goal), and is probed
+    before anything else is learned, so a learner that raises is refused in one line naming it.
 
     ``probe_timeout``: the time limit in seconds of the probe of each plugin (a method's potential
     or bonus built once on the target, an outside learner made, learning a few steps and
@@ -121,59 +126,92 @@ def transfer(
     that overruns it is named in one line with the call that overran. With ``progress`` given, an
     outside learner's trial that runs longer than 30 s says how far it has got on stderr every 30 s.
     """
+    req = _checked(dict(locals()))
+    if req.state == "continuous":  # the engine: the linear learner on the arm's configuration
+        return _transfer_continuous(req)
+    src, tgt, distance = _discrete_pair(req)
+    if req.outside is not None:  # the engine: an outside learner through the benchmark's harness
+        return _transfer_outside(req, src, tgt, distance)
+    return _transfer_tabular(req, src, tgt, distance)  # the engine: the compiled kernel
+
+
+@dataclass(frozen=True)
+class _Request:
+    """A transfer's inputs, each checked once, in :func:`transfer`'s terms."""
+
+    source: str | DiscreteRobot
+    target: str | DiscreteRobot
+    task: Task
+    methods: list[str]
+    trials: int
+    seed: int
+    wind: float
+    K: float | str
+    beta: float | None
+    specs: list
+    controls: bool
+    mapping: str | Path | ActionMapping | None
+    save_mapping: bool
+    uses_mapping: bool
+    max_span: int
+    arm_xml: str | None
+    options: dict
+    progress: Callable[[], None] | None
+    state: str
+    config: LearnerConfig
+    noise: float
+    outside: Any
+    probe_timeout: float
+
+
+def _checked(a: dict[str, Any]) -> _Request:
+    """:func:`transfer`'s arguments ``a`` checked, each once and in this order (the first fault
+    is the one line raised), before anything is built or learned."""
+    state = a["state"]
     if not isinstance(state, str) or state not in STATES:
         raise InvalidParameterError(f"unknown state {state!r}; valid states: {', '.join(STATES)}")
-    config = presets.config(preset, learner_options)
-    method_names = [registry.get(m).name for m in _as_sequence(methods, "methods")]
+    config = presets.config(a["preset"], a["learner_options"])
+    method_names = [registry.get(m).name for m in _as_sequence(a["methods"], "methods")]
     if not method_names:
         raise InvalidParameterError(f"give at least one method; valid methods: {', '.join(registry.METHODS)}")
-    outside = _outside_learner(learner)
+    outside = _outside_learner(a["learner"])
     if outside is not None:
-        from armtransfer.experiments.learner_trial import refuse_methods
-
         if state != "discrete":
             raise InvalidParameterError(f"learner {outside.name!r} learns on a discrete target; valid learners for a "
                                         "continuous one: sarsa")
         refuse_methods(outside, method_names)
     if state == "continuous":  # the methods asked for, before their baselines join them
-        from armtransfer.learning.cells import check_method
-
         for m in method_names:
             check_method(m)
-    baselines = checks.flag(baselines, "baselines")
-    if baselines:
+    if checks.flag(a["baselines"], "baselines"):
         method_names = registry.with_baselines(method_names)
-    trials = checks.whole(trials, "trials", 1, checks.MAX_TRIALS)
-    seed = checks.whole(seed, "seed", 0)
-    wind = checks.probability(wind, "wind")
-    max_span = checks.whole(max_span, "max_span", 1)
-    controls = checks.flag(controls, "controls")
-    save_mapping = checks.flag(save_mapping, "save_mapping")
+    trials = checks.whole(a["trials"], "trials", 1, checks.MAX_TRIALS)
+    seed = checks.whole(a["seed"], "seed", 0)
+    wind = checks.probability(a["wind"], "wind")
+    max_span = checks.whole(a["max_span"], "max_span", 1)
+    controls = checks.flag(a["controls"], "controls")
+    save_mapping = checks.flag(a["save_mapping"], "save_mapping")
+    progress = a["progress"]
     if progress is not None and not callable(progress):
         raise InvalidParameterError(f"progress must be a function called after every trial, got {progress!r}")
-    from armtransfer.learning.method import check_k
-    from armtransfer.learning.plugin_calls import probe_seconds
-
-    K = check_k(K)
-    probe_timeout = probe_seconds(probe_timeout)
-    if beta is not None:
-        beta = checks.real(beta, "beta", 0.0)
-    if arm_xml is not None:
-        arm_xml = checks.path(arm_xml, "arm_xml")
-    options = _arm_options(arm_options)
-    layout = _world(world, source, target)
-    specs = list(_as_sequence(trajectory, "trajectory")) if trajectory is not None else ["learned"]
+    K = check_k(a["K"])
+    probe_timeout = probe_seconds(a["probe_timeout"])
+    beta = None if a["beta"] is None else checks.real(a["beta"], "beta", 0.0)
+    arm_xml = None if a["arm_xml"] is None else checks.path(a["arm_xml"], "arm_xml")
+    options = _arm_options(a["arm_options"])
+    layout = _world(a["world"], a["source"], a["target"])
+    specs = list(_as_sequence(a["trajectory"], "trajectory")) if a["trajectory"] is not None else ["learned"]
     uses_mapping = any(registry.get(m).macros for m in method_names)
+    mapping = a["mapping"]
     if mapping is not None and not uses_mapping:
         raise InvalidParameterError("a mapping goes with method 'mapping'")
     if mapping is not None and not isinstance(mapping, ActionMapping):
         mapping = checks.path(mapping, "mapping")
     if save_mapping and not isinstance(mapping, (str, Path)):
         raise InvalidParameterError("save_mapping needs the mapping's file path")
-
-    the_task = _task(task, start, goal, specs, layout)
-    start_cell, goal_cell = the_task.cells()
-    noise = checks.real(noise, "noise (the actuation noise sigma)", 0.0, 0.5)
+    the_task = _task(a["task"], a["start"], a["goal"], specs, layout)
+    the_task.cells()
+    noise = checks.real(a["noise"], "noise (the actuation noise sigma)", 0.0, 0.5)
     if noise and state != "continuous":
         raise InvalidParameterError("noise (actuation noise) applies to a continuous target; a discrete one has "
                                     "wind; valid noise: 0")
@@ -182,11 +220,20 @@ def transfer(
             raise InvalidParameterError("a continuous target has no wind; valid wind: 0")
         if mapping is not None or uses_mapping:
             raise InvalidParameterError("the action sequence mapping needs a discrete target; valid methods for a "
-                                        "continuous one: " + ", ".join(_cell_methods()))
-        return _transfer_continuous(source, target, the_task, method_names, specs, trials, seed, K, config,
-                                    arm_xml, options, progress, noise)
-    src = resolve(source, xml_path=arm_xml, layout=layout, **options)
-    tgt = resolve(target, xml_path=arm_xml, layout=layout, **options)
+                                        "continuous one: " + ", ".join(CELL_METHODS))
+    return _Request(a["source"], a["target"], the_task, method_names, trials, seed, wind, K, beta, specs, controls,
+                    mapping, save_mapping, uses_mapping, max_span, arm_xml, options, progress, state, config, noise,
+                    outside, probe_timeout)
+
+
+def _discrete_pair(req: _Request) -> tuple[DiscreteRobot, DiscreteRobot, int]:
+    """(source, target, the target's shortest path in steps): both robots built in the task's world,
+    the task's start and goal checked for both, both able to reach the goal (the source must solve
+    the task too, to hand over its path), and every plugin the methods use probed on the target."""
+    layout = req.task.layout
+    src = resolve(req.source, xml_path=req.arm_xml, layout=layout, **req.options)
+    tgt = resolve(req.target, xml_path=req.arm_xml, layout=layout, **req.options)
+    start_cell, goal_cell = req.task.cells()
     for robot in (src, tgt):
         try:
             robot.start_state(start_cell)
@@ -194,69 +241,74 @@ def transfer(
         except InvalidCellError as err:
             raise InvalidCellError(_with_walls_cause(str(err), robot)) from None
     paths: dict[str, list[tuple[int, int]]] = {}
-    for robot in (tgt, src):  # the source must solve the task too, to hand over its path
+    for robot in (tgt, src):
         found = robot.shortest_path(robot.start_state(start_cell), goal_cell)
         if found is None:
             raise InvalidTaskError(_with_walls_cause(
-                f"robot {robot.name} cannot reach the goal {the_task.goal} from {the_task.start}", robot))
+                f"robot {robot.name} cannot reach the goal {req.task.goal} from {req.task.start}", robot))
         paths[robot.name] = found
-    path = paths[tgt.name]
-    registry.probe_on(method_names, [tgt], probe_timeout)  # a plugin's fault or overrun: one line, now
-    if outside is not None:
-        return _transfer_outside(outside, src, tgt, the_task, method_names, specs, trials, seed, wind, K, beta,
-                                 config, controls, progress, len(path) - 1, probe_timeout)
+    registry.probe_on(req.methods, [tgt], req.probe_timeout)  # a plugin's fault or overrun: one line, now
+    return src, tgt, len(paths[tgt.name]) - 1
 
+
+def _transfer_tabular(req: _Request, src: DiscreteRobot, tgt: DiscreteRobot, distance: int) -> TransferResult:
+    """``transfer`` by the compiled SARSA(lambda) kernel: every method, its controls and the
+    action sequence mapping."""
+    start_cell, goal_cell = req.task.cells()
     mapping_obj, mapping_path = None, None
-    if uses_mapping:
-        if isinstance(mapping, ActionMapping):
-            mapping_obj = mapping
-        elif mapping is not None:
-            mapping_path = str(mapping)
-            if save_mapping:
-                from armtransfer.io import check_writable
-
+    if req.uses_mapping:
+        if isinstance(req.mapping, ActionMapping):
+            mapping_obj = req.mapping
+        elif req.mapping is not None:
+            mapping_path = str(req.mapping)
+            if req.save_mapping:
                 check_writable(mapping_path)
             mapping_obj = load_mapping(mapping_path, src, tgt)
         if mapping_obj is not None:
             mapping_obj.check_new_task(start_cell, goal_cell, tgt.layout)
-    shaped = any(registry.get(m).shaped and registry.get(m).uses_trajectory for m in method_names)
-    trajs = resolve_trajectories(specs, src, the_task, config, seed) if shaped else []
+    shaped = any(registry.get(m).shaped and registry.get(m).uses_trajectory for m in req.methods)
+    trajs = resolve_trajectories(req.specs, src, req.task, req.config, req.seed) if shaped else []
     # every method's shaping, made before any learning and used by its run: a farmable method's
     # K checked by value iteration over the shaped task (refused in one line naming the largest
     # safe K; 'auto' is verified), the controls given the same K
-    beta = potentials.DENSE_BETA if beta is None else beta
+    beta = potentials.DENSE_BETA if req.beta is None else req.beta
     shapings = {}
-    for m in method_names:
-        made = experiment.method_shaping(m, tgt, tgt.start_state(start_cell), goal_cell, trajs, K, config, wind,
-                                         beta)
+    for m in req.methods:
+        made = experiment.method_shaping(m, tgt, tgt.start_state(start_cell), goal_cell, trajs, req.K, req.config,
+                                         req.wind, beta)
         if made is not None:
             shapings[m] = made
-
     entries_before = 0 if mapping_obj is None else len(mapping_obj)
     runs, learned = experiment.run_all(
-        src, tgt, start_cell, goal_cell, method_names, trajs, trials, seed, config,
-        wind=wind, K={m: sh.K for m, sh in shapings.items()}, beta=beta,
-        mapping=mapping_obj, max_span=max_span, controls=controls, tick=progress, shapings=shapings,
+        src, tgt, start_cell, goal_cell, req.methods, trajs, req.trials, req.seed, req.config,
+        wind=req.wind, K={m: sh.K for m, sh in shapings.items()}, beta=beta,
+        mapping=mapping_obj, max_span=req.max_span, controls=req.controls, tick=req.progress, shapings=shapings,
     )
+    by_method, by_control = _by_method_and_control(runs)
+    info = None
+    if req.uses_mapping:
+        assert learned is not None  # run_all returns the learned mapping whenever a method uses one
+        info = MappingInfo(path=mapping_path, entries_before=entries_before, entries_after=len(learned),
+                           macro_states=int(by_method["mapping"].extra["macro_states"]),
+                           saved=bool(req.save_mapping))
+        if req.save_mapping:
+            assert mapping_path is not None  # save_mapping was refused without the mapping's file path
+            learned.save(mapping_path)
+    return TransferResult(
+        task=req.task, source=src, target=tgt, distance=distance, trajectories=trajs, seed=req.seed,
+        trials=req.trials, wind=req.wind, config=req.config, methods=by_method, controls=by_control,
+        mapping=info, learned_mapping=learned,
+    )
+
+
+def _by_method_and_control(runs) -> tuple[dict, dict]:
+    """The runs of a transfer by method, and the control runs by control and method."""
     by_method = {r.method: r for r in runs if r.control is None}
     by_control: dict[str, dict] = {}
     for r in runs:
         if r.control is not None:
             by_control.setdefault(r.control, {})[r.method] = r
-    info = None
-    if uses_mapping:
-        assert learned is not None  # run_all returns the learned mapping whenever a method uses one
-        info = MappingInfo(path=mapping_path, entries_before=entries_before, entries_after=len(learned),
-                           macro_states=int(by_method["mapping"].extra["macro_states"]),
-                           saved=bool(save_mapping))
-        if save_mapping:
-            assert mapping_path is not None  # save_mapping was refused above without the mapping's file path
-            learned.save(mapping_path)
-    return TransferResult(
-        task=the_task, source=src, target=tgt, distance=len(path) - 1, trajectories=trajs, seed=seed,
-        trials=trials, wind=wind, config=config, methods=by_method, controls=by_control,
-        mapping=info, learned_mapping=learned,
-    )
+    return by_method, by_control
 
 
 def _outside_learner(learner: object):
@@ -270,47 +322,37 @@ def _outside_learner(learner: object):
     return None if found.name == learners.SARSA else found
 
 
-def _transfer_outside(learner, src: DiscreteRobot, tgt: DiscreteRobot, the_task: Task, method_names: list[str],
-                      specs, trials: int, seed: int, wind: float, K, beta, config: LearnerConfig, controls: bool,
-                      progress, distance: int, probe_timeout: float = 60.0) -> TransferResult:
+def _transfer_outside(req: _Request, src: DiscreteRobot, tgt: DiscreteRobot, distance: int) -> TransferResult:
     """``transfer`` by an outside learner (see its docstring): probed first, then every method
     through the harness; no controls (``controls`` is not read)."""
     from armtransfer.experiments import learner_trial, learner_transfer
 
+    learner, the_task = req.outside, req.task
     start, goal = list(the_task.start), list(the_task.goal)
-    learner_trial.probe(learner, tgt, start, goal, probe_timeout)  # a learner that raises: one line, before anything is learned
-    shaped = any(registry.get(m).shaped and registry.get(m).uses_trajectory for m in method_names)
-    trajs = resolve_trajectories(specs, src, the_task, config, seed) if shaped else []
+    learner_trial.probe(learner, tgt, start, goal, req.probe_timeout)  # a learner that raises: one line, before anything is learned
+    shaped = any(registry.get(m).shaped and registry.get(m).uses_trajectory for m in req.methods)
+    trajs = resolve_trajectories(req.specs, src, the_task, req.config, req.seed) if shaped else []
     start_cell, goal_cell = the_task.cells()
     verified: dict[str, float] = {}
-    for m in method_names:  # a K that can be farmed is refused in one line, and 'auto' verified, as for the kernel
-        made = experiment.method_shaping(m, tgt, tgt.start_state(start_cell), goal_cell, trajs, K, config, wind,
-                                         potentials.DENSE_BETA if beta is None else beta)
+    for m in req.methods:  # a K that can be farmed is refused in one line, and 'auto' verified, as for the kernel
+        made = experiment.method_shaping(m, tgt, tgt.start_state(start_cell), goal_cell, trajs, req.K, req.config,
+                                         req.wind, potentials.DENSE_BETA if req.beta is None else req.beta)
         if made is not None:
             verified[m] = made.K
-    runs = learner_transfer.run_all(learner, src, tgt, start, goal, method_names, trajs, trials, seed, config,
-                                    wind=wind, K=verified, beta=beta, tick=progress,
-                                    heartbeat=progress is not None)  # a long trial says how far it has got
-    by_method = {r.method: r for r in runs if r.control is None}
-    by_control: dict[str, dict] = {}
-    for r in runs:
-        if r.control is not None:
-            by_control.setdefault(r.control, {})[r.method] = r
-    return TransferResult(task=the_task, source=src, target=tgt, distance=distance, trajectories=trajs, seed=seed,
-                          trials=trials, wind=wind, config=config, methods=by_method, controls=by_control,
+    runs = learner_transfer.run_all(learner, src, tgt, start, goal, req.methods, trajs, req.trials, req.seed,
+                                    req.config, wind=req.wind, K=verified, beta=req.beta, tick=req.progress,
+                                    heartbeat=req.progress is not None)  # a long trial says how far it has got
+    by_method, by_control = _by_method_and_control(runs)
+    return TransferResult(task=the_task, source=src, target=tgt, distance=distance, trajectories=trajs, seed=req.seed,
+                          trials=req.trials, wind=req.wind, config=req.config, methods=by_method, controls=by_control,
                           learner=learner.name)
 
 
-def _cell_methods() -> tuple[str, ...]:
-    from armtransfer.learning.cells import CELL_METHODS
-
-    return tuple(CELL_METHODS)
-
-
-def _transfer_continuous(source, target, the_task: Task, method_names: list[str], specs, trials: int, seed: int,
-                         K, config: LearnerConfig, arm_xml, options: dict, progress,
-                         noise: float = 0.0) -> ContinuousResult:
+def _transfer_continuous(req: _Request) -> ContinuousResult:
     """``transfer`` with a continuous-state target (see its docstring)."""
+    source, target, the_task, method_names, specs = req.source, req.target, req.task, req.methods, req.specs
+    trials, seed, K, config, arm_xml, options = req.trials, req.seed, req.K, req.config, req.arm_xml, req.options
+    progress, noise = req.progress, req.noise
     from armtransfer.experiments import continuous as runs
     from armtransfer.tasks.continuous import ARM_KEYWORDS, continuous_arm
 
