@@ -18,6 +18,7 @@ import os
 import re
 import sys
 import time
+from dataclasses import dataclass
 from typing import cast
 from pathlib import Path
 
@@ -195,8 +196,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
     pen in the hand, ``"stylus[:LENGTH[:RADIUS]]"`` (metres; see ``ik.tool.Stylus``), for any arm
     whose tool is kept pointing down; the cell is read at the pen's end. The cell size is the
     world's (``ik.workspace.world_cell``: 1 cm on the rooms) unless given. ``only_cached``: load
-    it from the cache or raise :class:`NotCached`, never compile (``arms list``'s listing).
-    """
+    it from the cache or raise :class:`NotCached`, never compile (``arms list``'s listing)."""
     model = action_model(actions)
     stylus = parse_held(tool) if tool is not None else None
     cell_size, base_pos, base_yaw = _checked_pose(cell_size, base_pos, base_yaw, layout)
@@ -266,7 +266,6 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
                               "steps": list(SPATIAL_STEPS), "step_cells": STEP_CELLS, "version": 1}
     key = _cache.cache_key(parts)
     robot_name = f"{name}:{model.name}"
-    status = "off"
     start = time.perf_counter()
 
     def build() -> dict[str, np.ndarray]:
@@ -274,29 +273,59 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
             print(f"compiling {robot_name} ...", file=sys.stderr, flush=True)
         return _compile(_scene(path, tool, mount, yaw, cell_size, layout), model, tip_down, step, progress, spatial)
 
+    arrays, status = _load_or_build(robot_name, key, _arrays_check(layout, _levels(spatial)), build, cache,
+                                    only_cached)
+    return _robot_of(arrays, layout, model, DescriptionFacts(
+        name=name, kind=kind, status=status, key=key, seconds=time.perf_counter() - start, cell_size=cell_size,
+        mount=mount, yaw=yaw, path=path, tool=tool, step=step, source=source))
+
+
+@dataclass(frozen=True)
+class DescriptionFacts:
+    """What :func:`arm_robot` knows of a robot besides its compiled arrays."""
+
+    name: str
+    kind: str
+    status: str
+    key: str
+    seconds: float
+    cell_size: float
+    mount: tuple[float, float, float]
+    yaw: float
+    path: Path
+    tool: Tool
+    step: float | None
+    source: str
+
+
+def _load_or_build(robot_name: str, key: str, check, build, cache: bool,
+                   only_cached: bool) -> tuple[dict[str, np.ndarray], str]:
+    """(arrays, cache status): from the arm cache, else built and saved (under the cache's build
+    lock, so each arm compiles once however many processes ask); ``only_cached`` never builds."""
     if only_cached:
-        loaded = _cache.load(robot_name, key, _arrays_check(layout, _levels(spatial)))[0] if cache else None
+        loaded = _cache.load(robot_name, key, check)[0] if cache else None
         if loaded is None:
             raise NotCached(f"robot {robot_name} is not in the arm cache")
-        arrays, status = loaded, "hit"
-    elif not cache:
-        arrays = build()
-    else:
-        _check_cache_dir()
-        check = _arrays_check(layout, _levels(spatial))
-        loaded, status = _cache.load(robot_name, key, check)
-        if loaded is not None:
-            arrays = loaded
-        else:
-            with _cache.building(_cache.entry_path(robot_name, key)):
-                meanwhile, again = _cache.load(robot_name, key, check)  # built by another process while we waited
-                if meanwhile is None:
-                    arrays = build()
-                    _cache.save(robot_name, key, arrays)
-                else:
-                    arrays, status = meanwhile, again
-    seconds = time.perf_counter() - start
+        return loaded, "hit"
+    if not cache:
+        return build(), "off"
+    _check_cache_dir()
+    loaded, status = _cache.load(robot_name, key, check)
+    if loaded is not None:
+        return loaded, status
+    with _cache.building(_cache.entry_path(robot_name, key)):
+        meanwhile, again = _cache.load(robot_name, key, check)  # built by another process while we waited
+        if meanwhile is None:
+            arrays = build()
+            _cache.save(robot_name, key, arrays)
+            return arrays, status
+        return meanwhile, again
+
+
+def _robot_of(arrays: dict[str, np.ndarray], layout: Layout, model, facts: DescriptionFacts) -> DiscreteRobot:
+    """The discrete robot of an arm's compiled arrays, with its description."""
     dof = int(arrays["qpos"].shape[1])
+    step = facts.step
     if "joint_step" in arrays:
         step = float(arrays["joint_step"])
     label = arrays["label"]
@@ -304,25 +333,25 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
     if levels:
         from armtransfer.ik.voxels import workspace_voxels
 
-        reach = float(len(np.unique(label)) / workspace_voxels(layout, cell_size).free.sum())
+        reach = float(len(np.unique(label)) / workspace_voxels(layout, facts.cell_size).free.sum())
     else:
         reach = float(len(np.unique(label)) / layout.free.sum())
     chain, held = _chain_of(arrays)
     clearance = float(arrays.get("clearance", 0.0))
     clearance_geom = str(arrays.get("clearance_geom", ""))
     description = ArmDescription(
-        name=name, actions=model.name, dof=dof, kind=kind, qpos=arrays["qpos"], tip=arrays["tip"],
-        reach=reach, cache=status, key=key, seconds=seconds, cell_size=cell_size,
-        mount=mount, yaw=yaw, xml_path=str(path), tool=tool,
+        name=facts.name, actions=model.name, dof=dof, kind=facts.kind, qpos=arrays["qpos"], tip=arrays["tip"],
+        reach=reach, cache=facts.status, key=facts.key, seconds=facts.seconds, cell_size=facts.cell_size,
+        mount=facts.mount, yaw=facts.yaw, xml_path=str(facts.path), tool=facts.tool,
         joint_step=step if model.kind == "joint" else None, layout=layout,
-        lattice=arrays.get("lattice"), mount_source=source, chain=chain, held=held,
+        lattice=arrays.get("lattice"), mount_source=facts.source, chain=chain, held=held,
         clearance=clearance, clearance_geom=clearance_geom, levels=levels,
         moved=tuple(int(j) for j in arrays["moved"]) if "moved" in arrays else (),
     )
     names = (tuple(f"q{j + 1}{sign}" for j in description.moved for sign in ("+", "-")) if levels
              else model.action_names(dof))
     return DiscreteRobot(
-        name=robot_name,
+        name=f"{facts.name}:{model.name}",
         next_state=arrays["next_state"],
         wind_state=arrays["wind_state"],
         label=label,
