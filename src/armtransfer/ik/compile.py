@@ -488,20 +488,7 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
     home_flat = int(np.ravel_multi_index(tuple(-n_lo), dims))
     if not valid[home_flat]:
         raise UnreachableTableError("the arm's home configuration is not over a free cell of the table")
-    minus = np.full((total, dof), -1, dtype=np.int64)
-    for j in range(dof):
-        src = np.flatnonzero(plus[:, j] >= 0)
-        minus[plus[src, j], j] = src
-    seen = np.zeros(total, dtype=bool)
-    seen[home_flat] = True
-    frontier = np.array([home_flat])
-    while len(frontier):
-        nb = np.concatenate([plus[frontier].ravel(), minus[frontier].ravel()])
-        nb = np.unique(nb[nb >= 0])
-        nb = nb[~seen[nb]]
-        seen[nb] = True
-        frontier = nb
-    states = np.flatnonzero(seen)
+    minus, states = _reachable(plus, home_flat)
     n = len(states)
     index = np.full(total, -1, dtype=np.int64)
     index[states] = np.arange(n)
@@ -517,7 +504,48 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
     label = cells[states]
     tip_xy = fk.tip(qpos)
 
-    # Wind: the state labelled with the cell to the right nearest a Jacobian step.
+    wind = _joint_wind(fk, qpos, label, tip_xy, scene, (home, step, n_lo, dims, strides), index)
+    lx, ly = layout.xy_of(label).T
+    centres = np.stack([lx * cell, ly * cell], axis=1)
+    err = np.linalg.norm(tip_xy - centres, axis=1)
+    canonical = np.full(layout.n_cells, -1, dtype=np.int32)
+    order = np.lexsort((np.arange(n), err))  # closest to the cell centre first
+    for s in order[::-1]:
+        canonical[label[s]] = s
+    tips = np.column_stack([tip_xy, np.full(n, fk.tip_z)])
+    return dict(next_state=next_state.astype(np.int32), wind_state=wind.astype(np.int32),
+                label=label.astype(np.int32), canonical=canonical, qpos=qpos, tip=tips,
+                lattice=(grids[states] + n_lo).astype(np.int32), joint_step=np.array(step))
+
+
+def _reachable(plus: np.ndarray, home: int) -> tuple[np.ndarray, np.ndarray]:
+    """(minus, states): the lattice's edges along -step of each joint (``plus`` reversed), and
+    the lattice points a breadth-first search from ``home`` reaches over the edges both ways."""
+    total, dof = plus.shape
+    minus = np.full((total, dof), -1, dtype=np.int64)
+    for j in range(dof):
+        src = np.flatnonzero(plus[:, j] >= 0)
+        minus[plus[src, j], j] = src
+    seen = np.zeros(total, dtype=bool)
+    seen[home] = True
+    frontier = np.array([home])
+    while len(frontier):
+        nb = np.concatenate([plus[frontier].ravel(), minus[frontier].ravel()])
+        nb = np.unique(nb[nb >= 0])
+        nb = nb[~seen[nb]]
+        seen[nb] = True
+        frontier = nb
+    return minus, np.flatnonzero(seen)
+
+
+def _joint_wind(fk: PlanarFK, qpos: np.ndarray, label: np.ndarray, tip_xy: np.ndarray, scene: ArmScene,
+                grid: tuple, index: np.ndarray) -> np.ndarray:
+    """Where the wind pushes each state: the state labelled with the cell to the right nearest a
+    Jacobian step towards it (itself when none is). ``grid``: the lattice's (home, step, lowest
+    index, dims, strides)."""
+    layout, cell, free = scene.layout, scene.cell, scene.layout.free
+    home, step, n_lo, dims, strides = grid
+    n, dof = qpos.shape
     wind = np.arange(n, dtype=np.int64)
     lx, ly = layout.xy_of(label).T
     right = np.where(lx + 1 <= layout.hi, label + 1, -1)
@@ -538,13 +566,4 @@ def compile_joint(scene: ArmScene, step: float | None, progress: bool = False) -
         best[better] = dist[better]
         wind[better] = s2[better]
 
-    centres = np.stack([lx * cell, ly * cell], axis=1)
-    err = np.linalg.norm(tip_xy - centres, axis=1)
-    canonical = np.full(layout.n_cells, -1, dtype=np.int32)
-    order = np.lexsort((np.arange(n), err))  # closest to the cell centre first
-    for s in order[::-1]:
-        canonical[label[s]] = s
-    tips = np.column_stack([tip_xy, np.full(n, fk.tip_z)])
-    return dict(next_state=next_state.astype(np.int32), wind_state=wind.astype(np.int32),
-                label=label.astype(np.int32), canonical=canonical, qpos=qpos, tip=tips,
-                lattice=(grids[states] + n_lo).astype(np.int32), joint_step=np.array(step))
+    return wind

@@ -223,7 +223,19 @@ def compile_spatial_joint(scene: ArmScene, step: float | None, progress: bool = 
     for idx, s in index.items():
         if s >= 0:
             lattice[s] = idx
+    wind, canonical = _wind_and_canonical(next_state, label, tip, vox, cell)
+    return dict(next_state=next_state, wind_state=wind, label=label.astype(np.int32), canonical=canonical,
+                qpos=qpos, tip=tip, lattice=lattice, joint_step=np.array(step),
+                moved=np.array(moved, dtype=np.int32), levels=np.array(vox.levels),
+                wall_levels=np.array(vox.wall_levels))
 
+
+def _wind_and_canonical(next_state: np.ndarray, label: np.ndarray, tip: np.ndarray, vox: Voxels,
+                        cell: float) -> tuple[np.ndarray, np.ndarray]:
+    """(wind state, canonical state): where the wind pushes each state (one of its moves onto the +x
+    voxel at its level, the one whose tip is nearest that voxel's centre; itself when none is, or
+    on the east edge), and each voxel's state whose tip is nearest its centre (-1: unreached)."""
+    n = len(label)
     centres = _centres(label, vox, cell)
     err = np.linalg.norm(tip - centres, axis=1)
     wind = np.arange(n, dtype=np.int32)
@@ -238,10 +250,7 @@ def compile_spatial_joint(scene: ArmScene, step: float | None, progress: bool = 
     canonical = np.full(vox.n_voxels, -1, dtype=np.int32)
     for s in np.lexsort((np.arange(n), err))[::-1]:
         canonical[label[s]] = s
-    return dict(next_state=next_state, wind_state=wind, label=label.astype(np.int32), canonical=canonical,
-                qpos=qpos, tip=tip, lattice=lattice, joint_step=np.array(step),
-                moved=np.array(moved, dtype=np.int32), levels=np.array(vox.levels),
-                wall_levels=np.array(vox.wall_levels))
+    return wind, canonical
 
 
 def _centres(label: np.ndarray, vox: Voxels, cell: float) -> np.ndarray:
