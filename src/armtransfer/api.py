@@ -27,7 +27,7 @@ from armtransfer.learning.cells import CELL_METHODS, check_method
 from armtransfer.learning.method import check_k
 from armtransfer.learning.plugin_calls import probe_seconds
 from armtransfer.learning import potentials, presets
-from armtransfer.experiments import experiment
+from armtransfer.experiments import engines, experiment
 from armtransfer.learning import methods as registry
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
@@ -35,6 +35,7 @@ from armtransfer.learning.mapping import DEFAULT_MAX_SPAN, ActionMapping
 from armtransfer.learning.mapping import load_for as load_mapping
 from armtransfer.experiments.continuous import ContinuousResult
 from armtransfer.experiments.results import MappingInfo, TransferResult
+from armtransfer.learning.learner_names import SARSA
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.catalog import Task, as_xy, custom_task, table_task, world_task
 from armtransfer.worlds.layout import ROOMS, Layout
@@ -48,7 +49,7 @@ TRAJECTORY_KINDS = ("optimal", "learned", "shuffled", "random")
 
 TrajectorySpec = str | Trajectory
 
-STATES = ("discrete", "continuous")
+STATES = engines.STATES
 """How the target robot's state is known: ``discrete``, its table of states (the tabular
 learner); ``continuous``, its joint configuration with MuJoCo at every move and the linear
 learner over tile coding (``ik.continuous``, ``learning.linear``; planar arms, the ``joint``
@@ -127,12 +128,12 @@ def transfer(
     outside learner's trial that runs longer than 30 s says how far it has got on stderr every 30 s.
     """
     req = _checked(dict(locals()))
-    if req.state == "continuous":  # the engine: the linear learner on the arm's configuration
+    if req.engine == engines.CONTINUOUS:
         return _transfer_continuous(req)
     src, tgt, distance = _discrete_pair(req)
-    if req.outside is not None:  # the engine: an outside learner through the benchmark's harness
+    if req.engine == engines.OUTSIDE:
         return _transfer_outside(req, src, tgt, distance)
-    return _transfer_tabular(req, src, tgt, distance)  # the engine: the compiled kernel
+    return _transfer_tabular(req, src, tgt, distance)
 
 
 @dataclass(frozen=True)
@@ -162,6 +163,8 @@ class _Request:
     noise: float
     outside: Any
     probe_timeout: float
+    engine: str
+    """Who learns (``experiments.engines``): the kernel, the continuous learner or the outside one."""
 
 
 def _checked(a: dict[str, Any]) -> _Request:
@@ -175,10 +178,8 @@ def _checked(a: dict[str, Any]) -> _Request:
     if not method_names:
         raise InvalidParameterError(f"give at least one method; valid methods: {', '.join(registry.METHODS)}")
     outside = _outside_learner(a["learner"])
-    if outside is not None:
-        if state != "discrete":
-            raise InvalidParameterError(f"learner {outside.name!r} learns on a discrete target; valid learners for a "
-                                        "continuous one: sarsa")
+    engine = engines.engine_of(SARSA if outside is None else outside.name, state)
+    if engine == engines.OUTSIDE:
         refuse_methods(outside, method_names)
     if state == "continuous":  # the methods asked for, before their baselines join them
         for m in method_names:
@@ -223,7 +224,7 @@ def _checked(a: dict[str, Any]) -> _Request:
                                         "continuous one: " + ", ".join(CELL_METHODS))
     return _Request(a["source"], a["target"], the_task, method_names, trials, seed, wind, K, beta, specs, controls,
                     mapping, save_mapping, uses_mapping, max_span, arm_xml, options, progress, state, config, noise,
-                    outside, probe_timeout)
+                    outside, probe_timeout, engine)
 
 
 def _discrete_pair(req: _Request) -> tuple[DiscreteRobot, DiscreteRobot, int]:

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from armtransfer.errors import ArmTransferError, InvalidParameterError, InvalidTaskError
-from armtransfer.experiments import benchmark_runs, experiment, suites
+from armtransfer.experiments import benchmark_runs, engines, experiment, suites
 from armtransfer.learning import methods
 from armtransfer.learning import presets
 from armtransfer.experiments.comparisons import GOAL_ONLY as GOAL_ONLY, baseline_of as baseline_of
@@ -452,9 +452,8 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
     for section in suite.sections:
         outside = [lr for lr in (section.learners if learners is None else learners) if lr != benchmark_runs.LEARNER]
         for ci, case in enumerate(section.cases):
-            if case.state != "discrete" and outside:
-                raise InvalidParameterError(f"learner {outside[0]!r} learns on a discrete target; {case.label} has a "
-                                            f"continuous one; valid learners for it: {benchmark_runs.LEARNER}")
+            for lr in outside:
+                engines.engine_of(lr, case.state, f"{case.label} has")
             source, target = robots(case.source, case.world), robots(case.target, case.world)
             arm, placed = None, set()
             if case.state != "discrete":  # a continuous target: its arm, placed over every start before anything runs

@@ -32,7 +32,7 @@ import traceback
 from collections.abc import Callable
 
 from armtransfer.errors import ArmTransferError, PluginError
-from armtransfer.experiments import experiment
+from armtransfer.experiments import engines, experiment
 from armtransfer.experiments.stats import learning_metrics
 from armtransfer.experiments.sweep import content_key
 from armtransfer.learning import methods
@@ -276,10 +276,8 @@ def trial_result(run: dict, target: DiscreteRobot) -> dict:
         skip = ("key", "trajectory", "source_failure", "told_nothing")
         return trial_result(dict({k: v for k, v in run.items() if k not in skip}, method=run["told_nothing"]), target)
     learner = LEARNERS.get(run["learner"])
-    if run.get("state") == CONTINUOUS:
-        if learner is None:  # an outside learner learns on a table; no result of a continuous case is its
-            raise ArmTransferError(f"learner {run['learner']!r} learns on a discrete target; valid learners for "
-                                   f"a continuous one: {LEARNER}")
+    engine = engines.engine_of(run["learner"], run.get("state", "discrete"), "its case has")
+    if engine == engines.CONTINUOUS:
         learner = _continuous_trial
     elif learner is None:
         from armtransfer.learning.learners import LEARNERS as OUTSIDE

@@ -12,7 +12,7 @@ import time
 from armtransfer.tasks.catalog import custom_task
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.learning import methods, presets
-from armtransfer.experiments import experiment
+from armtransfer.experiments import engines, experiment
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.learner_names import SARSA
 
@@ -45,7 +45,7 @@ def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
         # benchmark's source runs); a run without max_total_steps has one config for both, as before
         own = learner_config({k: v for k, v in run.items() if k != "max_total_steps"})
         traj = experiment.source_trajectory(run["trajectory"], source, start, goal, own, run["seed"])
-    if run.get("learner", SARSA) != SARSA:  # an outside learner, through the benchmark's harness
+    if engines.engine_of(run.get("learner", SARSA)) == engines.OUTSIDE:  # through the benchmark's harness
         from armtransfer.experiments import learner_transfer
         from armtransfer.learning.learners import get
 
