@@ -201,13 +201,13 @@ def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target
     print_results(out_json)
     write_json_atomic(tmp / "results.json", out_json)
     write_text_atomic(tmp / "table.md", _table_md(out_json))
-    curves = {m: r["episode_steps"] for m, r in out_json["results"].items()}
-    greedy = {m: r["greedy_steps"] for m, r in out_json["results"].items()}
+    curves = {m: [t.episode_steps.tolist() for t in r.trials] for m, r in result.methods.items()}
+    greedy = {m: r.column("greedy_steps") for m, r in result.methods.items()}
     figures.learning_curves(curves, f"{source.name} -> {target.name}: steps per episode", tmp / "learning_curves.png",
                             greedy=greedy)
-    paths = _paths(out_json, source, target)
+    paths = _paths(result, source, target)
     layout = target.layout
-    traj_xy = [list(layout.xy(c % layout.n_cells)) for c in paths["trajectory_cells"]] + [list(out_json["task"]["goal"])]
+    traj_xy = [list(layout.xy(c % layout.n_cells)) for c in paths["trajectory_cells"]] + [list(result.task.goal)]
     figures.mapping_paths(layout.wall_mask, layout.lo, traj_xy, paths["target_xy"] or traj_xy, [],
                           f"{source.name} (dashed) -> {target.name} (solid)", tmp / "map.png")
     video, no_video = None, None
@@ -243,27 +243,25 @@ def arm_json(robot: DiscreteRobot) -> dict:
             "xml": arm.xml_path if arm.kind == "custom" else None}
 
 
-def _paths(out_json: dict, source: DiscreteRobot, target: DiscreteRobot) -> dict:
+def _paths(result, source: DiscreteRobot, target: DiscreteRobot) -> dict:
     """The source's transferred path and the target's converged greedy path (first
     converged trial of the first transfer method, named as ``target_method``; the target's
-    shortest path when none converged), as states and cells."""
+    shortest path when none converged), as states and cells, from the transfer's typed result."""
     layout = target.layout
-    start = layout.cell(*out_json["task"]["start"])
-    goal = layout.cell(*out_json["task"]["goal"])
-    steps = out_json["trajectory"]["steps"] if out_json["trajectory"] else []
-    traj_cells = [layout.cell(*s["cell"][:2]) + (s["cell"][2] * layout.n_cells if len(s["cell"]) == 3 else 0)
-                  for s in steps]  # [x, y, level]: a voxel above the table
-    if steps:
-        traj = Trajectory(tuple(traj_cells), tuple(s["action"] for s in steps), goal, source=source.name)
+    start, goal = layout.cell(*result.task.start), layout.cell(*result.task.goal)
+    first = result.trajectories[0] if result.trajectories else None
+    traj_cells = list(first.cells) if first is not None else []  # a voxel above the table: cell + level * cells
+    if first is not None:
+        traj = Trajectory(tuple(traj_cells), tuple(first.actions), goal, source=source.name)
         source_states = trajectories.states_along(source, traj)
     else:
         source_states = [source.start_state(start)]
     target_states, target_method = None, "shortest path"
-    for method, r in out_json["results"].items():
+    for method, run in result.methods.items():
         if method != "none":
-            for states in r.get("greedy_path_states", []):
-                if states:
-                    target_states, target_method = states, method
+            for trial in run.trials:
+                if trial.greedy_path:
+                    target_states, target_method = [int(s) for s, _ in trial.greedy_path], method
                     break
         if target_states:
             break
