@@ -92,6 +92,34 @@ def tables(summary: dict, settled: bool = True) -> str:
     return "\n".join(out).rstrip("\n") + "\n"
 
 
+def compact_cell(block: dict | None) -> str:
+    """A compact good-path cell: factor, interval and verdict; the worst pair; the settled quality
+    (median/worst first settled path over the shortest) of method vs baseline."""
+    if block is None:
+        return "n/a"
+    good = block.get("good_path")
+    if good is None or good.get("factor") is None:
+        return "not measured"
+    ci = good["ci95"]
+    interval = f" [{_x(ci[0])[:-1]}, {_x(ci[1])}]" if ci else ""
+    bounds = f", {good['bounds']} pairs capped" if good.get("bounds") else ""
+    settled = block.get("settled", {})
+    return (f"{_x(good['factor'])}{interval} {mark(good)}; worst {_x(good['worst'])}{bounds}; "
+            f"{_q(settled.get('method'))} vs {_q(settled.get('baseline'))}")
+
+
+def compact(summary: dict) -> str:
+    """The README's one headline table: a row per method against a baseline sharing its learner,
+    a column per section of the suite, each cell the good-path clock (:func:`compact_cell`)."""
+    sections = list(summary)
+    out = ["| method vs baseline | " + " | ".join(SECTIONS.get(s, s) for s in sections) + " |",
+           "|---|" + "---|" * len(sections)]
+    for m, b in COLUMNS:
+        out.append(f"| `{m}` vs `{b}` | " + " | ".join(compact_cell(summary[s].get(m, {}).get(b)) for s in sections)
+                   + " |")
+    return "\n".join(out) + "\n"
+
+
 LEARNER_COLUMNS = (("pseudo", "good_path"), ("dense", "good_path"), ("pseudo", "convergence"), ("dense", "convergence"),
                    ("pseudo", "first_exposure"), ("dense", "first_exposure"))
 """The learner table's columns: each transfer method against its learner's own ``none``."""
@@ -129,13 +157,20 @@ def main(argv: list[str] | None = None) -> int:
 
     p = script.parser(__doc__)
     p.add_argument("results", type=Path, help="a benchmark's results.json or results.json.gz")
-    p.add_argument("--good-only", action="store_true", help="the good-path table alone (the README's)")
+    p.add_argument("--good-only", action="store_true", help="the good-path table alone")
+    p.add_argument("--compact", action="store_true", help="the README's headline table: a row per comparison, "
+                   "a column per section, the good-path clock with the settled quality")
     p.add_argument("--learners", action="store_true",
                    help="one row per learner (a suite with several, such as small) instead of one per section")
     args = p.parse_args(argv)
     try:
         summary = pooled(args.results)
-        text = learner_table(summary) if args.learners else tables(summary, settled=not args.good_only)
+        if args.learners:
+            text = learner_table(summary)
+        elif args.compact:
+            text = compact(summary)
+        else:
+            text = tables(summary, settled=not args.good_only)
     except ArmTransferError as err:
         print(f"readme_table.py: error: {err}", file=sys.stderr)
         return 2

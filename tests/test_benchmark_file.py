@@ -156,18 +156,43 @@ def test_the_learner_table_puts_each_learner_against_its_own_none():
 PAPER = ROOT / "docs" / "benchmark-paper" / "results.json.gz"
 
 
-def test_the_readme_shows_the_good_path_tables_of_the_kept_paper_report():
-    """README's headline tables (the good-path clock first) are research/readme_table.py's output
-    on the kept paper-suite results, character for character; the control lazy is among them."""
+def test_the_paper_suites_good_path_tables_are_those_of_its_kept_report():
+    """docs/benchmark.md's paper-suite tables (the good-path clock first) are research/readme_table.py's
+    output on the kept paper-suite results, character for character; the control lazy is among them."""
     module = _readme_table_module()
-    readme = (ROOT / "README.md").read_text()
-    shown = readme.split("<!-- paper-clock-tables -->\n", 1)[1].split("<!-- /paper-clock-tables -->", 1)[0]
+    page = (ROOT / "docs" / "benchmark.md").read_text()
+    shown = page.split("<!-- paper-clock-tables -->\n", 1)[1].split("<!-- /paper-clock-tables -->", 1)[0]
     assert shown == module.tables(module.pooled(PAPER), settled=False)
     assert shown.startswith("**Good path") and "`lazy` vs `plan`" in shown.splitlines()[2]
 
 
-def test_the_readme_shows_the_calibrated_seeds_table():
-    """README's paper-calibrated table is research/calibrated_seeds.py's summary of the kept studies."""
+def test_the_readme_headline_is_the_compact_table_of_the_kept_standard_report():
+    """README's one headline table is research/readme_table.py --compact on the kept standard results:
+    a row per comparison (the control lazy last), a column per section, the good-path clock with
+    the settled quality beside it."""
+    module = _readme_table_module()
+    readme = (ROOT / "README.md").read_text()
+    shown = readme.split("<!-- headline-table -->\n", 1)[1].split("<!-- /headline-table -->", 1)[0]
+    assert shown == module.compact(module.pooled(KEPT))
+    rows = shown.splitlines()
+    assert rows[-1].startswith("| `lazy` vs `plan` |") and len(rows) == 2 + len(module.COLUMNS)
+    assert "not measured" not in shown  # the kept standard run has the good-path clock
+
+
+def test_a_compact_cell_carries_the_factor_its_interval_the_worst_pair_and_the_settled_quality():
+    module = _readme_table_module()
+    block = {"good_path": {"factor": 3.0, "ci95": [1.5, 6.0], "worst": 0.5, "seeds": 10, "p_holm": 0.001,
+                           "verdicts": 4, "detectable": [0.5, 2.0], "bounds": 2},
+             "settled": {"method": {"median": 1.0, "worst": 1.2}, "baseline": {"median": 1.05, "worst": 1.4}}}
+    text = module.compact_cell(block)
+    assert text.startswith("3× [1.5, 6×] ") and "worst 0.5×, 2 pairs capped" in text
+    assert text.endswith("; 1.00/1.20 vs 1.05/1.40")
+    assert module.compact_cell(None) == "n/a" and module.compact_cell({"good_path": None}) == "not measured"
+
+
+def test_the_results_page_shows_the_calibrated_seeds_table():
+    """docs/results.md's paper-calibrated table (Tables II and V beside ours, which the README's claim
+    cites) is research/calibrated_seeds.py's summary of the kept studies."""
     import importlib.util
 
     spec = importlib.util.spec_from_file_location("calibrated_seeds", ROOT / "research" / "calibrated_seeds.py")
@@ -176,6 +201,6 @@ def test_the_readme_shows_the_calibrated_seeds_table():
     kept = ROOT / "docs" / "reproduce-calibrated" / "seeds"
     studies = {int(p.name.split("-")[1].split(".")[0]): module.load(p) for p in sorted(kept.glob("study-*.json.gz"))}
     assert len(studies) >= 3
-    readme = (ROOT / "README.md").read_text()
-    shown = readme.split("<!-- calibrated-seeds -->\n", 1)[1].split("<!-- /calibrated-seeds -->", 1)[0]
+    page = (ROOT / "docs" / "results.md").read_text()
+    shown = page.split("<!-- calibrated-seeds -->\n", 1)[1].split("<!-- /calibrated-seeds -->", 1)[0]
     assert shown == module.table(studies) and (kept / "seeds.md").read_text() == module.summary(studies)
