@@ -36,7 +36,24 @@ def pytest_configure(config):
             pass  # pytest_collection_modifyitems skips the tests that render, saying why
 
 
+HEAVY = frozenset({
+    "test_api.py", "test_arm_files.py", "test_arm_transfer.py", "test_arms_cli.py", "test_benchmark.py",
+    "test_benchmark_continuous.py", "test_benchmark_store.py", "test_byo_arms.py", "test_compile.py",
+    "test_docs.py", "test_first_exposure.py", "test_generated_arms.py", "test_held_tool.py",
+    "test_hostile_audit.py", "test_hostile_kills.py", "test_learner_commands.py", "test_learners.py",
+    "test_plugins.py", "test_render.py", "test_replay_reach.py", "test_script_errors.py", "test_sweep.py",
+    "test_sweep_guards.py", "test_voxels.py",
+})
+"""Test modules whose default-suite tests compile arms, start processes or learn for seconds:
+marked ``heavy``, so that ``-m "not slow and not heavy"`` is the quick subset (docs/setup.md).
+Chosen from the default suite's measured durations (2026-12-06), the heaviest modules first, until
+the rest summed to under 150 s of test time."""
+
+
 def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if item.path.name in HEAVY:
+            item.add_marker(pytest.mark.heavy)
     rendering = [item for item in items if item.get_closest_marker("rendering")]
     if not rendering:
         return

@@ -358,3 +358,10 @@ def test_issue_pattern_catches_the_forms_seen() -> None:
         assert ISSUE_NUMBER.search(text), text
     for text in ("a known issue", "results.md#menagerie-arms", "colour &#8212;", "step 36"):
         assert not ISSUE_NUMBER.search(text), text
+
+
+def test_the_quick_subset_names_only_test_modules_that_exist() -> None:
+    from conftest import HEAVY
+
+    assert HEAVY and all((ROOT / "tests" / name).is_file() for name in HEAVY)
+    assert 'python -m pytest -m "not slow and not heavy"' in (ROOT / "docs" / "setup.md").read_text()
