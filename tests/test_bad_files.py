@@ -83,6 +83,7 @@ trials = 1
 """
 
 
+@pytest.mark.slow
 def test_a_broken_run_file_is_set_aside_and_the_run_redone(tmp_path, capsys):
     sweep = tmp_path / "s.toml"
     sweep.write_text(GOOD_SWEEP)

@@ -179,7 +179,8 @@ def test_transfer_both_ways_between_menagerie_style_arms(ur5e, panda):
         assert any(s is not None for s in r.methods["pseudo"].column("exploration_steps"))
 
 
-@pytest.mark.parametrize("which", ["ur5e", "panda", pytest.param("so100", marks=pytest.mark.slow)])
+@pytest.mark.parametrize("which", ["ur5e", pytest.param("panda", marks=pytest.mark.slow),  # panda: 11 s
+                                   pytest.param("so100", marks=pytest.mark.slow)])
 def test_physics_replay_reaches_the_goal(request, which):
     from armtransfer.ik.replay import replay
 
@@ -222,6 +223,7 @@ FREE_JOINT_XML = """<mujoco model="flying">
 """
 
 
+@pytest.mark.slow
 def test_cli_lists_a_menagerie_style_arm(files, ur5e):
     proc = run_cli("arms", "list", "--arm", "planar2", "--actions", "cartesian", "--arm-xml", str(files["ur5e"]),
                    "--tip-site", "attachment_site", "--tip-offset=0,0,0.12")

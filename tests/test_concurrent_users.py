@@ -18,6 +18,7 @@ from armtransfer.experiments import sweep as sweeps
 from armtransfer.experiments.store import LOCK, ResultStore
 
 
+@pytest.mark.slow
 def test_a_finished_store_keeps_no_lock_and_summarize_respects_a_live_one(tmp_path, capsys):
     path = tmp_path / "s.toml"
     path.write_text(GOOD)

@@ -227,6 +227,7 @@ def test_continuous_arm_names_the_valid_arms():
         continuous_arm("puma")
 
 
+@pytest.mark.slow
 def test_benchmark_fast_mode_writes_its_report(tmp_path):
     out = tmp_path / "bench"
     done = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "bench_continuous.py"), "--fast", "--out", str(out)],

@@ -291,6 +291,7 @@ def test_hashed_tiles_are_the_dense_tiles_under_the_documented_hash():
             TileCoding.over(lo, hi, 0.24, 8, table_bits=bad)
 
 
+@pytest.mark.slow
 def test_hashed_tiles_generalise_two_steps_and_their_memory_does_not_grow_with_the_joints():
     """A 6-joint planar arm: its dense tiles are refused (the lattice is too big), hashed ones
     take 2**16 features per action whatever the joint count; a configuration two steps away

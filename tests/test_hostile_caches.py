@@ -51,6 +51,7 @@ def test_a_cache_entry_that_is_not_an_entry_is_rebuilt(kind, own_cache, scara_xm
     assert arm_robot(None, "cartesian", xml_path=scara_xml, **POSE).arm.cache == "hit"
 
 
+@pytest.mark.slow
 def test_a_lock_that_is_a_fifo_does_not_hang(own_cache, scara_xml):
     first = arm_robot(None, "cartesian", xml_path=scara_xml, **POSE)
     entry = _entry(first)
