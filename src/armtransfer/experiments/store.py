@@ -20,7 +20,7 @@ import fcntl
 import os
 import shutil
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, cast
@@ -100,21 +100,15 @@ class ResultStore:
             self.root.mkdir(parents=True, exist_ok=True)
         except OSError as err:
             raise OutputError(f"cannot write {str(self.root)!r}: {err.strerror}") from None
-        while True:
+        def create() -> int:
             try:
-                fd = os.open(self.root / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+                return os.open(self.root / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
             except OSError as err:
                 raise OutputError(f"cannot write {str(self.root)!r}: {err.strerror}") from None
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
-                os.close(fd)
-                raise StoreError(f"store {str(self.root)!r} is in use by another sweep or summarize; wait for it or "
-                                 "choose another --out") from None
-            if _same_file(fd, self.root / LOCK):
-                break
-            os.close(fd)  # its holder removed it as this process opened it: take the new one
-        self._lock_fd: int | None = fd
+
+        self._lock_fd: int | None = _flocked(
+            self.root / LOCK, create, fcntl.LOCK_EX,
+            f"store {str(self.root)!r} is in use by another sweep or summarize; wait for it or choose another --out")
 
     def unlock(self, remove: bool = True) -> None:
         """Release the store, and (``remove``) delete its lock file first, while it is held."""
@@ -134,27 +128,22 @@ class ResultStore:
         store a running sweep or benchmark holds is refused in one line (its report would race the
         writer's); a writer starting meanwhile is refused until the block ends."""
         path = self.root / LOCK
-        while True:
+
+        def existing() -> int | None:
             try:
-                fd = os.open(path, os.O_RDONLY)
+                return os.open(path, os.O_RDONLY)
             except FileNotFoundError:
-                yield  # no writer has it; a writer creating it now is not waited for
-                return
+                return None  # no writer has it; a writer creating it now is not waited for
             except OSError as err:
                 raise StoreError(f"cannot read the lock of store {str(self.root)!r}: {err.strerror}") from None
-            try:
-                fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
-            except BlockingIOError:
-                os.close(fd)
-                raise StoreError(f"store {str(self.root)!r} is being written by a running sweep or benchmark; "
-                                 "summarize it when that has finished") from None
-            if _same_file(fd, path):
-                break
-            os.close(fd)
+
+        fd = _flocked(path, existing, fcntl.LOCK_SH, f"store {str(self.root)!r} is being written by a running sweep "
+                      "or benchmark; summarize it when that has finished")
         try:
             yield
         finally:
-            os.close(fd)
+            if fd is not None:
+                os.close(fd)
 
     @classmethod
     def open_existing(cls, root: str | os.PathLike) -> "ResultStore":
@@ -362,6 +351,24 @@ def _run_problem(record: object, key: str) -> str | None:
     if len(lengths) != 1:
         return "has result lists of different lengths"
     return None
+
+
+def _flocked(path: Path, opener: Callable[[], int | None], mode: int, busy: str) -> int | None:
+    """A descriptor ``opener`` opens on ``path``, flocked with ``mode`` without waiting and still
+    the file at ``path`` (one its holder removed as this process opened it is opened again); None
+    when ``opener`` finds no file. Held by another process: ``busy``, in one line."""
+    while True:
+        fd = opener()
+        if fd is None:
+            return None
+        try:
+            fcntl.flock(fd, mode | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(fd)
+            raise StoreError(busy) from None
+        if _same_file(fd, path):
+            return fd
+        os.close(fd)
 
 
 def _same_file(fd: int, path: Path) -> bool:
