@@ -14,26 +14,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_plugins import fake_plugin, run_cli
+from test_plugins import fake_plugin, registered, run_cli  # noqa: F401  (registered: a fixture)
 
 import armtransfer
 from armtransfer.errors import InvalidParameterError, PluginError
 from armtransfer.learning import methods
-
-
-@pytest.fixture
-def registered():
-    names: list[str] = []
-
-    def register(method, **kw):
-        m = armtransfer.register_method(method, **kw)
-        names.append(m.name)
-        return m
-
-    yield register
-    for name in names:
-        if name in methods.METHODS:
-            del methods.METHODS[name]
 
 
 class Unprintable(Exception):
