@@ -3,10 +3,27 @@ its resampling of whole cases and seeds, Holm's correction, and the seed-cluster
 
 from __future__ import annotations
 
+import importlib.util
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from armtransfer.experiments.stats import hierarchical, multiplicity, survival
+
+
+def _coverage_study():
+    """research/interval_coverage.py, whose centred draws (normal, heavy-tailed t with 3 degrees
+    of freedom, skewed gamma of shape 2 and log-normal of sigma 0.5) these tests share."""
+    spec = importlib.util.spec_from_file_location("interval_coverage",
+                                                  Path(__file__).resolve().parents[1] / "research" /
+                                                  "interval_coverage.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+_draw = _coverage_study().draw
 
 
 def _coverage(make, datasets: int, seed: int) -> float:
@@ -16,18 +33,6 @@ def _coverage(make, datasets: int, seed: int) -> float:
         lo, hi = hierarchical.bootstrap_t(make(rng), resamples=999, seed=i)["ci95"]
         hits += lo <= 0.0 <= hi
     return hits / datasets
-
-
-def _draw(kind, rng, shape):
-    """Centred draws: normal, heavy-tailed (t, 3 degrees of freedom) or skewed (gamma of shape 2,
-    skewness 1.4; log-normal of sigma 0.5, skewness 1.75)."""
-    if kind == "normal":
-        return rng.normal(0.0, 1.0, shape)
-    if kind == "t3":
-        return rng.standard_t(3, shape) / np.sqrt(3.0)
-    if kind == "gamma2":
-        return rng.gamma(2.0, 1.0, shape) - 2.0
-    return rng.lognormal(0.0, 0.5, shape) - np.exp(0.125)
 
 
 @pytest.mark.parametrize("kind", ["normal", "t3", "gamma2", "lognormal05"])
