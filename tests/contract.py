@@ -31,13 +31,17 @@ def refused(argv: list[str], tmp_path: Path, monkeypatch, capsys) -> str:
 def session(sid: int) -> list[int]:
     """Live processes of session ``sid`` (field 6 of /proc/PID/stat)."""
     out = []
-    for stat in Path("/proc").glob("[0-9]*/stat"):
+    # os.listdir, not Path.glob: glob stats each entry, and a process that ends between the
+    # listing and the stat raises ProcessLookupError from inside glob.
+    for name in os.listdir("/proc"):
+        if not name.isdigit():
+            continue
         try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
+            fields = Path(f"/proc/{name}/stat").read_text().rsplit(")", 1)[1].split()
         except OSError:
             continue
         if int(fields[3]) == sid and fields[0] != "Z":
-            out.append(int(stat.parent.name))
+            out.append(int(name))
     return out
 
 

@@ -53,13 +53,19 @@ def start_time(pid: int) -> str | None:
     return fields[19] if fields else None
 
 
+def _pids() -> list[int]:
+    """The pids in /proc now (a plain listing: nothing is stat'ed, so a process that ends
+    meanwhile cannot raise here)."""
+    return [int(name) for name in os.listdir("/proc") if name.isdigit()]
+
+
 def descendants(pids: set[int]) -> set[int]:
     """``pids`` and every living process below them."""
     children: dict[int, list[int]] = {}
-    for entry in Path("/proc").glob("[0-9]*"):
-        fields = _stat(int(entry.name))
+    for pid in _pids():
+        fields = _stat(pid)
         if fields and fields[0] != "Z":
-            children.setdefault(int(fields[1]), []).append(int(entry.name))
+            children.setdefault(int(fields[1]), []).append(pid)
     out, todo = set(), list(pids)
     while todo:
         pid = todo.pop()
@@ -114,13 +120,13 @@ def carrying(mark: str) -> set[int]:
     """Every process whose environment has ``MARK=mark`` (those of other users are not read)."""
     needle = f"{MARK}={mark}".encode() + b"\0"
     out = set()
-    for entry in Path("/proc").glob("[0-9]*"):
+    for pid in _pids():
         try:
-            environ = (entry / "environ").read_bytes()
+            environ = Path(f"/proc/{pid}/environ").read_bytes()
         except OSError:
             continue
         if b"\0" + needle in b"\0" + environ:
-            out.add(int(entry.name))
+            out.add(pid)
     return out
 
 
