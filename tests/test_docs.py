@@ -6,8 +6,11 @@ A block runs in a fresh temporary directory that links the repository's script f
 relative paths (`scripts/...`, `examples/sweeps/...`) work and every output (`--out runs/x`,
 `runs/<timestamp>`) lands in the temporary directory. `pip install` is left out of a command
 (the package is installed already). A block whose line before the fence is `<!-- slow -->` runs
-only under `-m slow`, one marked `<!-- needs-sb3 -->` only where the sb3 extra is installed; the block after `<!-- test-command -->` is what CI runs (`.ci/run`) and is
-checked word for word instead of run.
+only under `-m slow`; one whose markers also hold `<!-- hours -->` (a whole held-out suite) is
+marked `hours` as well, so that CI's slow run, `-m "slow and not hours"`, spends its time on
+tests that can end in it. One marked `<!-- needs-sb3 -->` runs only where the sb3 extra is
+installed; the block after `<!-- test-command -->` is what CI runs (`.ci/run`) and is checked
+word for word instead of run.
 
 What a block prints, where a page shows it, is checked too: a ```text block marked
 `<!-- output -->`, directly after the bash or python block, is that block's standard output
@@ -102,6 +105,9 @@ NO_SB3 = importlib.util.find_spec("stable_baselines3") is None
 
 def _param(b: Block):
     marks = [pytest.mark.slow] if "slow" in b.markers else []
+    if "hours" in b.markers:
+        assert "slow" in b.markers, f"{b.id}: a block marked hours must be marked slow too"
+        marks.append(pytest.mark.hours)
     if "needs-sb3" in b.markers:  # the dqn and ppo learners: only where the sb3 extra is installed
         marks.append(pytest.mark.skipif(NO_SB3, reason="needs the sb3 extra (pip install -e '.[sb3]')"))
     return pytest.param(b, id=b.id, marks=marks)
