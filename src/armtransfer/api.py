@@ -21,27 +21,30 @@ from typing import Any
 
 import armtransfer.checks as checks
 from armtransfer.errors import InvalidCellError, InvalidParameterError, InvalidTaskError
+from armtransfer.experiments import continuous as runs, engines, experiment, learner_transfer, learner_trial
+from armtransfer.experiments.continuous import ContinuousResult
 from armtransfer.experiments.learner_trial import refuse_methods
+from armtransfer.experiments.results import MappingInfo, TransferResult
 from armtransfer.io import check_writable
-from armtransfer.learning.cells import CELL_METHODS, check_method
-from armtransfer.learning.method import check_k
-from armtransfer.learning.plugin_calls import probe_seconds
-from armtransfer.learning import potentials, presets
-from armtransfer.experiments import engines, experiment
+from armtransfer.learning import learners, potentials, presets
 from armtransfer.learning import methods as registry
 from armtransfer.learning import trajectory as trajectories
+from armtransfer.learning.cells import CELL_METHODS, check_method
 from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.learner_names import SARSA
 from armtransfer.learning.mapping import DEFAULT_MAX_SPAN, ActionMapping
 from armtransfer.learning.mapping import load_for as load_mapping
-from armtransfer.experiments.continuous import ContinuousResult
-from armtransfer.experiments.results import MappingInfo, TransferResult
-from armtransfer.learning.learner_names import SARSA
+from armtransfer.learning.method import check_k
+from armtransfer.learning.plugin_calls import probe_seconds
 from armtransfer.learning.trajectory import Trajectory
+from armtransfer.tasks.arms import walls_cause
 from armtransfer.tasks.catalog import Task, as_xy, custom_task, table_task, world_task
-from armtransfer.worlds.layout import ROOMS, Layout
-from armtransfer.worlds.resolve import world as resolve_world
+from armtransfer.tasks.continuous import ARM_KEYWORDS, continuous_arm
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.tasks.specs import resolve
+from armtransfer.tasks.unreachable import hint
+from armtransfer.worlds.layout import ROOMS, Layout
+from armtransfer.worlds.resolve import world as resolve_world
 
 TRAJECTORY_KINDS = ("optimal", "learned", "shuffled", "random")
 """``learned``: the source's converged greedy path after SARSA(lambda), the paper's protocol
@@ -315,8 +318,6 @@ def _by_method_and_control(runs) -> tuple[dict, dict]:
 def _outside_learner(learner: object):
     """The outside learner ``learner`` names (None: the built-in ``sarsa``); an unknown name is
     one line listing the learners."""
-    from armtransfer.learning import learners
-
     if not isinstance(learner, str):
         raise InvalidParameterError(f"learner is a learner's name; valid learners: {', '.join(learners.LEARNERS)}")
     found = learners.get(learner)
@@ -326,8 +327,6 @@ def _outside_learner(learner: object):
 def _transfer_outside(req: _Request, src: DiscreteRobot, tgt: DiscreteRobot, distance: int) -> TransferResult:
     """``transfer`` by an outside learner (see its docstring): probed first, then every method
     through the harness; no controls (``controls`` is not read)."""
-    from armtransfer.experiments import learner_trial, learner_transfer
-
     learner, the_task = req.outside, req.task
     start, goal = list(the_task.start), list(the_task.goal)
     learner_trial.probe(learner, tgt, start, goal, req.probe_timeout)  # a learner that raises: one line, before anything is learned
@@ -354,9 +353,6 @@ def _transfer_continuous(req: _Request) -> ContinuousResult:
     source, target, the_task, method_names, specs = req.source, req.target, req.task, req.methods, req.specs
     trials, seed, K, config, arm_xml, options = req.trials, req.seed, req.K, req.config, req.arm_xml, req.options
     progress, noise = req.progress, req.noise
-    from armtransfer.experiments import continuous as runs
-    from armtransfer.tasks.continuous import ARM_KEYWORDS, continuous_arm
-
     if isinstance(target, DiscreteRobot) or not isinstance(target, str):
         raise InvalidParameterError("a continuous target is named by a string: an arm such as "
                                     f"'planar3:joint' or 'ur5e_like:joint', PATH.xml or 'custom' with arm_xml, "
@@ -457,9 +453,6 @@ def _as_sequence(value, what: str) -> Sequence:
 
 def _with_walls_cause(message: str, robot: DiscreteRobot) -> str:
     """``message``, and why, when an arm misses cells because its geometry meets the walls."""
-    from armtransfer.tasks.arms import walls_cause
-    from armtransfer.tasks.unreachable import hint
-
     if robot.arm is None:
         return message + hint(robot)
     cause = walls_cause(robot)

@@ -29,13 +29,16 @@ from armtransfer import api
 from armtransfer.commands import common
 from armtransfer.commands.rooms import print_results, results_table
 from armtransfer.errors import InvalidParameterError
-from armtransfer.learning import trajectory as trajectories
-from armtransfer.learning.trajectory import Trajectory
-from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.experiments import experiment
 from armtransfer.experiments.reports import figures
-from armtransfer.tasks.specs import CUSTOM, resolve
+from armtransfer.ik import offscreen
+from armtransfer.ik.offscreen import OffscreenError
 from armtransfer.io import check_distinct_outputs, check_writable, copy_atomic, staged_directory, write_json_atomic, write_text_atomic
+from armtransfer.learning import trajectory as trajectories
+from armtransfer.learning.trajectory import Trajectory
+from armtransfer.tasks.catalog import world_task
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.tasks.specs import CUSTOM, resolve
 
 DEFAULT_SOURCE = "planar2:joint"
 DEFAULT_TARGET = "ur5e_like:cartesian"
@@ -112,19 +115,15 @@ def run(args: argparse.Namespace) -> int:
         if extra:
             check_writable(extra)
     if args.render:
-        from armtransfer.ik.render import video_format
+        from armtransfer.ik.render import video_format  # MuJoCo: not on --help's path
 
         video_format(args.render, None)
     common.check_arm_flags(args)
     renders = not args.no_video or bool(args.render)
     if renders:  # before anything is compiled or learned: a machine without OpenGL is told what to install
-        from armtransfer.ik import offscreen
-
         offscreen.require(_without(args))
     layout = common.world_of(args)  # the world and its task, checked before compiling
     if args.task is not None:
-        from armtransfer.tasks.catalog import world_task
-
         world_task(layout, args.task)
     with common.phase("compiling arms"):  # before anything is written: a bad arm writes nothing
         options = arm_options(args)
@@ -134,7 +133,7 @@ def run(args: argparse.Namespace) -> int:
                          **options)
         scenes: dict = {}  # the checked scenes, rendered from: each is built once
         if renders:  # a replay that cannot be made fails now, not after learning
-            from armtransfer.ik.replay import check_replayable
+            from armtransfer.ik.replay import check_replayable  # MuJoCo: not on --help's path
 
             for robot in (source, target):
                 if robot.arm is not None:
@@ -166,8 +165,6 @@ def _without(args: argparse.Namespace) -> str:
 def _try_video(result: dict, args, path: Path, scenes: dict | None) -> str | None:
     """Render the video to ``path``; None when written, else why not (the render failed after
     the learning, e.g. the GL context could not be made, and the run keeps everything else)."""
-    from armtransfer.ik.offscreen import OffscreenError
-
     try:
         result["stats"] = _video(result, args, path, scenes)
     except OffscreenError as err:
@@ -280,7 +277,7 @@ def _paths(result, source: DiscreteRobot, target: DiscreteRobot) -> dict:
 
 
 def _video(result: dict, args, path: Path, scenes: dict | None = None) -> dict:
-    from armtransfer.ik.render import rollout_video
+    from armtransfer.ik.render import rollout_video  # MuJoCo: not on --help's path
 
     paths = result["paths"]
     fps = 10.0 if args.fast else 30.0

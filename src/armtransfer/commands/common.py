@@ -7,10 +7,19 @@ import math
 import sys
 from dataclasses import fields
 
+from armtransfer.api import TRAJECTORY_KINDS
 from armtransfer.checks import MAX_COUNT, integer_text
 from armtransfer.errors import ArmModelError, ArmTransferError, InvalidParameterError, InvalidTaskError
+from armtransfer.experiments.learner_trial import refuse_methods
+from armtransfer.ik.tool import parse_held, parse_offset
+from armtransfer.learning import mapping as mappings, methods, potentials, presets
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.tasks.catalog import parse_xy
+from armtransfer.learning.learners import LEARNERS, SARSA, get
+from armtransfer.learning.method import MAX_K, check_k
+from armtransfer.learning.plugin_calls import MAX_PROBE_SECONDS, PROBE_SECONDS, probe_seconds
+from armtransfer.tasks.arms import check_arm_name
+from armtransfer.tasks.catalog import parse_xy, world_task
+from armtransfer.worlds.resolve import DEFAULT_WORLD, VALID, is_default, world
 
 
 def _integer_at_least(lo: int, what: str):
@@ -38,8 +47,6 @@ def probability(text: str) -> float:
 
 
 def k_value(text: str) -> float | str:
-    from armtransfer.learning.method import MAX_K, check_k
-
     if text == "auto":
         return text
     try:
@@ -49,8 +56,6 @@ def k_value(text: str) -> float | str:
 
 
 def probe_timeout(text: str) -> float:
-    from armtransfer.learning.plugin_calls import MAX_PROBE_SECONDS, probe_seconds
-
     try:
         return probe_seconds(float(text))
     except (ValueError, ArmTransferError):
@@ -59,8 +64,6 @@ def probe_timeout(text: str) -> float:
 
 
 def add_probe_timeout_argument(p: argparse.ArgumentParser) -> None:
-    from armtransfer.learning.plugin_calls import PROBE_SECONDS
-
     p.add_argument("--probe-timeout", type=probe_timeout, default=PROBE_SECONDS, metavar="SECONDS",
                    help="the time limit of each plugin's probe (a method's potential built once, an outside learner "
                         "learning a few steps) before anything is run; a plugin that overruns it is named in one line "
@@ -68,10 +71,6 @@ def add_probe_timeout_argument(p: argparse.ArgumentParser) -> None:
 
 
 def add_method_arguments(p: argparse.ArgumentParser, default: list[str] | None = None) -> None:
-    from armtransfer.api import TRAJECTORY_KINDS
-    from armtransfer.learning import mapping as mappings
-    from armtransfer.learning import methods, potentials
-
     default = default or ["none", "pseudo"]
     listing = "; ".join(f"{m.name}: {m.description}" for m in methods.METHODS.values())
     p.add_argument("--method", nargs="+", default=default, metavar="METHOD",
@@ -95,8 +94,6 @@ def add_method_arguments(p: argparse.ArgumentParser, default: list[str] | None =
 
 
 def add_world_argument(p: argparse.ArgumentParser) -> None:
-    from armtransfer.worlds.resolve import DEFAULT_WORLD, VALID
-
     p.add_argument("--world", default=None, metavar="NAME|PATH",
                    help=f"the world the robots move in (default {DEFAULT_WORLD}, the paper's 51 x 51 rooms): "
                         f"{VALID} (docs/worlds.md)")
@@ -105,16 +102,12 @@ def add_world_argument(p: argparse.ArgumentParser) -> None:
 def world_of(args: argparse.Namespace):
     """The world --world names (the paper's rooms without it), checked: a one-line error for
     an unknown name or a bad layout file."""
-    from armtransfer.worlds.resolve import world
-
     return world(getattr(args, "world", None))
 
 
 def refuse_world(args: argparse.Namespace, command: str, why: str) -> None:
     """``command`` runs on the paper's rooms only: any other world is a one-line error saying
     ``why`` (a world that does not load names its own fault first)."""
-    from armtransfer.worlds.resolve import DEFAULT_WORLD, is_default
-
     if getattr(args, "world", None) is not None and not is_default(world_of(args)):
         raise InvalidParameterError(f"--world {str(args.world)[:100]} does not apply to {command}: {why}; "
                                     f"valid worlds: {DEFAULT_WORLD}")
@@ -143,8 +136,6 @@ def add_learning_arguments(p: argparse.ArgumentParser, trials: int = 10) -> None
 def add_learner_argument(p: argparse.ArgumentParser, several: bool = False) -> None:
     """--learner: who learns on the target, the built-in sarsa or a learner of
     ``armtransfer.LEARNERS`` (its installed plugins read now, so that --help lists them)."""
-    from armtransfer.learning.learners import LEARNERS, SARSA
-
     learned = "; ".join(f"{name}: {lr.description}" for name, lr in LEARNERS.items())
     p.add_argument("--learner", default=SARSA, metavar="NAME[,NAME...]" if several else "NAME",
                    help=("the learners, comma-separated, each running every method beside the none it runs"
@@ -157,9 +148,6 @@ def add_learner_argument(p: argparse.ArgumentParser, several: bool = False) -> N
 def check_learner(args: argparse.Namespace, flag: str = "--method") -> None:
     """--learner checked before anything is built: a known learner (a typo lists them) that
     runs every method of ``flag`` (else one line listing the methods it runs)."""
-    from armtransfer.experiments.learner_trial import refuse_methods
-    from armtransfer.learning.learners import SARSA, get
-
     learner = get(args.learner)
     if learner.name != SARSA:
         refuse_methods(learner, getattr(args, flag.lstrip("-")))
@@ -167,8 +155,6 @@ def check_learner(args: argparse.Namespace, flag: str = "--method") -> None:
 
 def add_preset_argument(p: argparse.ArgumentParser) -> None:
     """--preset: a named set of learner settings (``learning.presets``) that the flags override."""
-    from armtransfer.learning import presets
-
     p.add_argument("--preset", type=preset_name, default=presets.DEFAULT, metavar="NAME",
                    help=f"learner settings by name, which the learner's flags override: {', '.join(presets.names())} "
                         "(default: default; paper-calibrated: fitted to the paper's no-transfer columns, "
@@ -176,8 +162,6 @@ def add_preset_argument(p: argparse.ArgumentParser) -> None:
 
 
 def preset_name(text: str) -> str:
-    from armtransfer.learning import presets
-
     if text not in presets.PRESETS:
         raise argparse.ArgumentTypeError(f"unknown preset {text!r}; valid presets: {', '.join(presets.names())}")
     return text
@@ -236,8 +220,6 @@ def transfer_kwargs(args: argparse.Namespace) -> dict:
     refuse_unused_method_options(args)
     world = world_of(args)
     if args.task is not None:
-        from armtransfer.tasks.catalog import world_task
-
         world_task(world, args.task)  # an unknown task is named before anything else is done
     return dict(
         world=world, task=args.task, start=start, goal=goal, methods=args.method, trials=args.trials, seed=args.seed,
@@ -251,8 +233,6 @@ def transfer_kwargs(args: argparse.Namespace) -> dict:
 def refuse_unused_method_options(args: argparse.Namespace, flag: str = "--method") -> None:
     """A method's option given (different from its default) while no method of ``flag``
     uses it is an error naming the methods that do, instead of being silently ignored."""
-    from armtransfer.learning import methods
-
     names = getattr(args, flag.lstrip("-"))
     chosen = [methods.get(m) for m in names]
     users = {
@@ -333,7 +313,7 @@ class phase:
 
 def progress_bar(total: int, desc: str):
     """A tqdm bar on a terminal, nothing otherwise."""
-    from tqdm import tqdm
+    from tqdm import tqdm  # start-up: only when a bar is shown
 
     return tqdm(total=total, desc=desc, disable=not sys.stderr.isatty(), leave=False)
 
@@ -399,15 +379,11 @@ def check_arm_flags(args: argparse.Namespace) -> None:
 
 def arm_file_options(args: argparse.Namespace) -> dict:
     """The bring-your-own arm's options as ``arm_robot`` keywords, checked."""
-    from armtransfer.ik.tool import parse_held, parse_offset
-
     if args.tip_site is not None and args.tip_body is not None:
         raise ArmModelError("give --tip-site or --tip-body, not both")
     if args.arm_name is not None and not args.arm_name.strip():
         raise ArmModelError("--arm-name must not be empty")
     if args.arm_name is not None:
-        from armtransfer.tasks.arms import check_arm_name
-
         check_arm_name(args.arm_name, "--arm-name")
     return dict(tip_site=args.tip_site, tip_body=args.tip_body,
                 tip_offset=parse_offset(args.tip_offset) if args.tip_offset is not None else None,

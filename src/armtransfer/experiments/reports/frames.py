@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 from armtransfer.errors import MissingExtraError  # noqa: F401  (kept importable from here)
 
 if TYPE_CHECKING:
-    import pandas as pd
+    import pandas as pd  # the frames extra
 
 EXTRA = "frames"
 COUNTS = ("exploration_steps", "total_steps", "greedy_steps", "episodes", "step_cap", "good_path_steps",
@@ -37,7 +37,7 @@ missing value, which pandas' ``groupby`` and plots would drop."""
 def pandas():
     """The ``pandas`` module, or a one-line :class:`MissingExtraError` naming the extra."""
     try:
-        import pandas as pd
+        import pandas as pd  # the frames extra
     except ImportError:
         raise MissingExtraError(f"to_frame() needs pandas: pip install 'armtransfer[{EXTRA}]'") from None
     return pd
