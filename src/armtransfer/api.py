@@ -63,7 +63,7 @@ def transfer(
     source: str | DiscreteRobot = "coarse",
     target: str | DiscreteRobot = "fine",
     *,
-    task: int | None = None,
+    task: int | str | Task | None = None,
     start: tuple[int, int] | str | None = None,
     goal: tuple[int, int] | str | None = None,
     methods: Sequence[str] = ("none", "pseudo"),
@@ -92,7 +92,8 @@ def transfer(
     """Transfer a trajectory from ``source`` to ``target`` and learn with each method.
 
     ``task`` is a Table I task (1-4) or give ``start`` and ``goal`` cells; with neither, a
-    trajectory file names its task, else task 1. ``trajectory`` is one or several of
+    trajectory file names its task, else task 1. A :class:`~armtransfer.tasks.catalog.Task`
+    (the command line's, checked once there) is taken as it is, in its own world. ``trajectory`` is one or several of
     :data:`TRAJECTORY_KINDS`, trajectory JSON files or :class:`Trajectory` objects (default
     ``learned``). ``controls`` also runs every reward-only method with a shuffled and a
     random trajectory, each trial with its own draw (``experiment.run_control``). ``baselines``
@@ -203,7 +204,8 @@ def _checked(a: dict[str, Any]) -> _Request:
     beta = None if a["beta"] is None else checks.real(a["beta"], "beta", 0.0)
     arm_xml = None if a["arm_xml"] is None else checks.path(a["arm_xml"], "arm_xml")
     options = _arm_options(a["arm_options"])
-    layout = _world(a["world"], a["source"], a["target"])
+    world = a["task"].layout if a["world"] is None and isinstance(a["task"], Task) else a["world"]
+    layout = _world(world, a["source"], a["target"])
     specs = list(_as_sequence(a["trajectory"], "trajectory")) if a["trajectory"] is not None else ["learned"]
     uses_mapping = any(registry.get(m).macros for m in method_names)
     mapping = a["mapping"]
@@ -421,6 +423,10 @@ def _world(world, source, target) -> Layout:
 
 
 def _task(task, start, goal, specs, layout: Layout = ROOMS) -> Task:
+    if isinstance(task, Task) and start is None and goal is None:
+        if task.layout != layout:
+            raise InvalidTaskError(f"the task {task.name!r} is of another world than the transfer's")
+        return task  # checked where it was made
     if start is not None or goal is not None:
         if task is not None:
             raise InvalidTaskError("give either a task or start/goal cells, not both")

@@ -36,7 +36,6 @@ from armtransfer.ik.offscreen import OffscreenError
 from armtransfer.io import check_distinct_outputs, check_writable, copy_atomic, staged_directory, write_json_atomic, write_text_atomic
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.trajectory import Trajectory
-from armtransfer.tasks.catalog import world_task
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.tasks.specs import CUSTOM, resolve
 
@@ -122,9 +121,8 @@ def run(args: argparse.Namespace) -> int:
     renders = not args.no_video or bool(args.render)
     if renders:  # before anything is compiled or learned: a machine without OpenGL is told what to install
         offscreen.require(_without(args))
-    layout = common.world_of(args)  # the world and its task, checked before compiling
-    if args.task is not None:
-        world_task(layout, args.task)
+    where = common.world_and_task(args)  # the world and its task, checked once, before compiling
+    layout = where[0]
     with common.phase("compiling arms"):  # before anything is written: a bad arm writes nothing
         options = arm_options(args)
         source = resolve(args.source, xml_path=args.arm_xml, progress=common.interactive(), layout=layout,
@@ -139,7 +137,7 @@ def run(args: argparse.Namespace) -> int:
                 if robot.arm is not None:
                     scenes[id(robot)] = check_replayable(robot)
     with staged_directory(out) as tmp:
-        result = _run_into(args, tmp, source, target, out, scenes)
+        result = _run_into(args, where, tmp, source, target, out, scenes)
         if args.json:
             write_json_atomic(args.json, result["json"])
         if args.render and result["video"]:
@@ -172,11 +170,12 @@ def _try_video(result: dict, args, path: Path, scenes: dict | None) -> str | Non
     return None
 
 
-def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target: DiscreteRobot,
+def _run_into(args: argparse.Namespace, where: tuple, tmp: Path, source: DiscreteRobot, target: DiscreteRobot,
               final: Path, scenes: dict | None = None) -> dict:
     """Everything into ``tmp``, which becomes ``final`` when complete (paths in results.json name ``final``).
-    ``scenes``: the robots' checked scenes by ``id(robot)``, rendered from."""
-    kwargs = {**common.transfer_kwargs(args), **_fast_overrides(args)}
+    ``where``: the world and task (``common.world_and_task``); ``scenes``: the robots' checked
+    scenes by ``id(robot)``, rendered from."""
+    kwargs = {**common.transfer_kwargs(args, where), **_fast_overrides(args)}
     if args.source_planner == "learn" and not args.trajectory:
         kwargs["trajectory"] = ["learned"]
     elif not args.trajectory:

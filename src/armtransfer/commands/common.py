@@ -18,7 +18,8 @@ from armtransfer.learning.learners import LEARNERS, SARSA, get
 from armtransfer.learning.method import MAX_K, check_k
 from armtransfer.learning.plugin_calls import MAX_PROBE_SECONDS, PROBE_SECONDS, probe_seconds
 from armtransfer.tasks.arms import check_arm_name
-from armtransfer.tasks.catalog import parse_xy, world_task
+from armtransfer.tasks.catalog import Task, custom_task, parse_xy, world_task
+from armtransfer.worlds.layout import Layout
 from armtransfer.worlds.resolve import DEFAULT_WORLD, VALID, is_default, world
 
 
@@ -205,24 +206,49 @@ def config_options(args: argparse.Namespace) -> dict:
     return {"preset": args.preset, **out}
 
 
-def transfer_kwargs(args: argparse.Namespace) -> dict:
-    """The keyword arguments of ``armtransfer.transfer`` that the common flags give (the task's
-    flags are checked here, so that errors name them)."""
-    start, goal = args.start, args.goal
-    if start is not None or goal is not None:
-        if args.task is not None:
-            raise InvalidTaskError("give either --task or --start/--goal, not both")
-        if start is None or goal is None:
-            raise InvalidTaskError("--start and --goal go together")
-        start, goal = parse_xy(start, "--start"), parse_xy(goal, "--goal")
+def _cells(args: argparse.Namespace) -> tuple[tuple[int, int], tuple[int, int]] | None:
+    """--start and --goal as cells (None when neither is given), checked against --task."""
+    if args.start is None and args.goal is None:
+        return None
+    if args.task is not None:
+        raise InvalidTaskError("give either --task or --start/--goal, not both")
+    if args.start is None or args.goal is None:
+        raise InvalidTaskError("--start and --goal go together")
+    return parse_xy(args.start, "--start"), parse_xy(args.goal, "--goal")
+
+
+def _task_in(layout: Layout, args: argparse.Namespace, cells) -> Task | None:
+    """The task --task or --start/--goal (``cells``) name in the world ``layout``; None when
+    neither is given (the API's default: a trajectory file's task, else the world's first)."""
+    if args.task is not None:
+        return world_task(layout, args.task)
+    if cells is not None:
+        return custom_task(cells[0], cells[1], layout)
+    return None
+
+
+def world_and_task(args: argparse.Namespace) -> tuple[Layout, Task | None]:
+    """The world --world names and the task of --task or --start/--goal in it, each checked once
+    (a one-line error naming the flag) and handed down typed: the API checks them no more."""
+    cells = _cells(args)
+    layout = world_of(args)
+    return layout, _task_in(layout, args, cells)
+
+
+def transfer_kwargs(args: argparse.Namespace, where: tuple[Layout, Task | None] | None = None) -> dict:
+    """The keyword arguments of ``armtransfer.transfer`` that the common flags give. The world
+    and task are ``where`` (:func:`world_and_task`, when the command checked them already) or
+    checked here, so that errors name the flags."""
+    cells = _cells(args) if where is None else None
     if args.mapping is not None and "mapping" not in args.method:
         raise InvalidParameterError("--mapping goes with --method mapping")
     refuse_unused_method_options(args)
-    world = world_of(args)
-    if args.task is not None:
-        world_task(world, args.task)  # an unknown task is named before anything else is done
+    if where is None:
+        layout = world_of(args)
+        where = layout, _task_in(layout, args, cells)  # an unknown task is named before anything is done
+    world, task = where
     return dict(
-        world=world, task=args.task, start=start, goal=goal, methods=args.method, trials=args.trials, seed=args.seed,
+        world=world, task=task, methods=args.method, trials=args.trials, seed=args.seed,
         wind=args.wind, K=args.K, beta=args.beta, trajectory=args.trajectory, controls=not args.no_controls,
         mapping=args.mapping, save_mapping=args.mapping is not None, max_span=args.max_span,
         probe_timeout=getattr(args, "probe_timeout", 60.0),
