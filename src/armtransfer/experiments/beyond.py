@@ -12,7 +12,7 @@ from collections.abc import Callable
 from dataclasses import replace
 
 from armtransfer.experiments import experiment
-from armtransfer.experiments.reports.report import fmt_ci, fmt_mean, fmt_num, markdown_table
+from armtransfer.experiments.tables import fmt_ci, fmt_mean, fmt_num, markdown_table
 from armtransfer.experiments.stats import metrics
 from armtransfer.learning import farming, methods, potentials, sarsa
 from armtransfer.learning import trajectory as trajectories

@@ -18,8 +18,7 @@ from typing import TYPE_CHECKING
 import armtransfer.checks as checks
 from armtransfer.errors import InvalidParameterError
 from armtransfer.experiments.experiment import MethodResult, summarize, trial_rng
-from armtransfer.experiments.reports import frames, report
-from armtransfer.experiments.results import _per_trial
+from armtransfer.experiments import frames, tables
 from armtransfer.learning import cells, linear
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.tiles import MAX_TABLE_BITS, TileCoding
@@ -163,7 +162,7 @@ class ContinuousResult:
         for m, e in out["results"].items():
             imp = e.get("improvement_percent")
             conv = e.get("converged", [])
-            rows.append([m, f"{report.fmt_mean(e)} {report.fmt_ci(e['ci95'])}", report.fmt_reached(e),
+            rows.append([m, f"{tables.fmt_mean(e)} {tables.fmt_ci(e['ci95'])}", tables.fmt_reached(e),
                          f"{sum(bool(c) for c in conv)}/{len(conv)}", "" if imp is None else f"{imp:+.1f}%"])
         return rows
 
@@ -205,5 +204,5 @@ class ContinuousResult:
                     **self.config.to_dict()}
         rows = []
         for m, entry in out["results"].items():
-            rows += frames.trial_rows(m, None, _per_trial(entry, self.config.max_total_steps), settings)
+            rows += frames.trial_rows(m, None, frames.per_trial_columns(entry, self.config.max_total_steps), settings)
         return frames.frame(rows)

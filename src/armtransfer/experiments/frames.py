@@ -87,3 +87,22 @@ def frame(rows: list[dict]) -> "pd.DataFrame":
             df[name] = df[name].astype("Int64")
     lead = [c for c in LEAD if c in df]
     return df[lead + [c for c in df.columns if c not in lead]]
+
+
+PER_TRIAL = ("exploration_steps", "converged", "total_steps", "greedy_steps", "episodes", "mapped_fraction",
+             "macro_steps_first_episode", "good_path_steps", "shortest_path_steps", "settled_ratio", "final_ratio",
+             "optimal", "good_len", "steps_run")
+"""The per-trial lists of a summary entry that a frame takes as columns."""
+
+
+def per_trial_columns(entry: dict, cap: int) -> dict:
+    """A summary entry's per-trial metrics by column name (the K used, the step cap, ``cap``
+    where the entry names none, and the transfer metrics included)."""
+    out = {name: entry[name] for name in PER_TRIAL if name in entry}
+    if "K" in entry:
+        out["K_used"] = entry["K"]
+    out["step_cap"] = entry.get("cap") or cap
+    for name, block in entry.get("transfer_metrics", {}).items():
+        if isinstance(block, dict) and "per_trial" in block:
+            out[name] = block["per_trial"]
+    return out

@@ -26,7 +26,7 @@ import numpy as np
 from armtransfer.errors import InvalidParameterError
 from armtransfer.experiments import sweep as sweeps
 from armtransfer.experiments.lazy import pyplot
-from armtransfer.experiments.reports.report import markdown_table
+from armtransfer.experiments.tables import markdown_table
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.learner_names import SARSA, label, parse_label
 from armtransfer.learning.methods import with_baselines

@@ -9,7 +9,7 @@ from __future__ import annotations
 from armtransfer.experiments import beyond, paper
 from armtransfer.experiments.lazy import scipy_stats
 from armtransfer.experiments.reports import calibrated_report
-from armtransfer.experiments.reports.report import fmt_ci, fmt_mean, fmt_num, markdown_table
+from armtransfer.experiments.tables import fmt_ci, fmt_mean, fmt_num, markdown_table
 from armtransfer.learning.mapping import ActionMapping
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.worlds.layout import ROOMS

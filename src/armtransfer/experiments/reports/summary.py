@@ -13,7 +13,7 @@ trial i of seed s of a method with trial i of seed s of ``none`` (the same rando
 from __future__ import annotations
 
 from armtransfer.experiments.reports.figures import bar_chart
-from armtransfer.experiments.reports.report import (CAP_NOTE, fmt_ci, fmt_improvement, fmt_mean, fmt_num, markdown_table,
+from armtransfer.experiments.tables import (CAP_NOTE, fmt_ci, fmt_improvement, fmt_mean, fmt_num, markdown_table,
                                           median_column)
 from armtransfer.experiments.stats import metrics
 from armtransfer.experiments.sweep import group_key
