@@ -258,8 +258,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
     spatial = model.kind == "joint" and kind != "planar" and not _is_planar_file(path, tool, mount, yaw, cell_size,
                                                                                  layout, kind)
     if spatial:  # over the 3D workspace: its own key (the 2D robots' keys are as they were)
-        # MuJoCo, only when an arm is built
-        from armtransfer.ik.voxels import LEVELS, MAX_STATES, MOVED, SPATIAL_STEPS, STEP_CELLS
+        from armtransfer.ik.voxels import LEVELS, MAX_STATES, MOVED, SPATIAL_STEPS, STEP_CELLS  # MuJoCo, only when an arm is built
 
         parts["workspace"] = {"levels": LEVELS, "moved": MOVED, "max_states": MAX_STATES,
                               "steps": list(SPATIAL_STEPS), "step_cells": STEP_CELLS, "version": 1}
