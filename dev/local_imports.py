@@ -2,6 +2,7 @@
 
     python dev/local_imports.py            # counts per package and the total
     python dev/local_imports.py --list     # every one, as path:line: module (and its comment)
+    python dev/local_imports.py --bare     # those with no comment beside them or heading their run
 
 A lazy import is kept only for an optional extra or for start-up time, with a comment that
 says so; this lists them so a reviewer can check each one has its reason.
@@ -45,9 +46,13 @@ def main(argv: list[str]) -> None:
     for path in sorted(SRC.rglob("*.py")):
         hits = local_imports(path)
         counts[package_of(path)] += len(hits)
-        if "--list" in argv:
-            lines = path.read_text().splitlines()
-            for line, module in hits:
+        lines = path.read_text().splitlines()
+        for line, module in hits:
+            above = line - 2  # a comment may head a run of imports
+            while above >= 0 and lines[above].strip().startswith(("import ", "from ")):
+                above -= 1
+            said = "#" in lines[line - 1] or (above >= 0 and lines[above].strip().startswith("#"))
+            if "--list" in argv or ("--bare" in argv and not said):
                 print(f"{path.relative_to(SRC.parent)}:{line}: {module}  | {lines[line - 1].strip()}")
     for package, n in counts.most_common():
         print(f"{n:5d}  {package}")
