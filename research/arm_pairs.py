@@ -17,7 +17,7 @@ from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.experiments import experiment
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.io import write_text_atomic
-from armtransfer.experiments.reports.report import fmt_ci, fmt_num, markdown_table
+from armtransfer.experiments.tables import fmt_ci, fmt_num, markdown_table
 
 PAIRS = [
     ("planar2:joint", "ur5e_like:cartesian"),

@@ -36,7 +36,7 @@ from armtransfer.learning import controls, potentials, sarsa
 from armtransfer.experiments import experiment
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.controls import CONTROLS
-from armtransfer.experiments.reports.report import fmt_ci, markdown_table
+from armtransfer.experiments.tables import fmt_ci, markdown_table
 from armtransfer.learning.shaping import Shaping
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.specs import resolve

@@ -32,7 +32,7 @@ from armtransfer.io import check_output_dir, staged_directory, write_json_atomic
 from armtransfer.experiments import experiment
 from armtransfer.experiments.stats import metrics
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.experiments.reports.report import fmt_ci, markdown_table
+from armtransfer.experiments.tables import fmt_ci, markdown_table
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.specs import resolve

@@ -29,7 +29,7 @@ from armtransfer.io import check_output_dir, staged_directory, write_json_atomic
 from armtransfer.experiments import experiment
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import ActionMapping, MacroTable
-from armtransfer.experiments.reports.report import markdown_table
+from armtransfer.experiments.tables import markdown_table
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.tasks.specs import resolve

@@ -89,6 +89,17 @@ def test_layering_follows_the_readme():
     assert bad == []
 
 
+def test_results_print_without_the_reports():
+    """Inside experiments/, the text tables and tidy frames import nothing of the experiments,
+    and the result types nothing of reports/ (the top of experiments/: what a person reads)."""
+    graph = _graph()
+    for name in ("armtransfer.experiments.tables", "armtransfer.experiments.frames"):
+        assert name in graph and [m for m in graph[name] if m.startswith("armtransfer.experiments")] == [], name
+    for name in ("armtransfer.experiments.results", "armtransfer.experiments.continuous",
+                 "armtransfer.experiments.experiment"):
+        assert [m for m in graph[name] if m.startswith("armtransfer.experiments.reports")] == [], name
+
+
 def test_import_graph_has_no_cycles():
     graph = _graph()
     # a package's __init__ importing its own submodules is not a cycle of the design

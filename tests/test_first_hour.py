@@ -11,7 +11,7 @@ import pytest
 
 import armtransfer
 from armtransfer.cli import COMMANDS, build_parser, main
-from armtransfer.experiments.reports import report
+from armtransfer.experiments import tables
 
 pd = pytest.importorskip("pandas")  # the 'frames' extra, in the 'test' extra too
 
@@ -32,7 +32,7 @@ def test_the_repr_of_a_10_trial_result_is_short_and_names_the_methods_and_means(
     for label, entry in [*summary["results"].items(),
                          *((f"{m} [{k}]", e) for k, by in summary["controls"].items() for m, e in by.items())]:
         line = next(line for line in text.splitlines() if line.strip().startswith(label + " "))
-        assert report.fmt_mean(entry) in line, (label, line)
+        assert tables.fmt_mean(entry) in line, (label, line)
 
 
 def test_a_method_result_is_one_line(ten_trials):
@@ -48,25 +48,25 @@ def test_jupyter_shows_the_table_the_command_prints(capsys):
     result = armtransfer.transfer("coarse", "fine", task=1, methods=["none", "pseudo"], trials=3, seed=2,
                                   controls=False)
     shown = result._repr_markdown_()
-    table = report.transfer_table(result.to_json())
+    table = tables.transfer_table(result.to_json())
     assert table in shown and table in printed
-    assert report.transfer_heading(result.to_json()) in shown
+    assert tables.transfer_heading(result.to_json()) in shown
 
 
 def test_a_3_trial_table_heads_its_median_column_with_the_coverage_it_holds(ten_trials):
     three = armtransfer.transfer("coarse", "fine", task=1, methods=["none", "pseudo"], trials=3, seed=2,
                                  controls=False)
-    table = report.transfer_table(three.to_json())
+    table = tables.transfer_table(three.to_json())
     header = table.splitlines()[0]
     assert "median [75% CI]" in header and "95% CI]" not in header.split("median")[1].split("|")[0]
     assert "(75% CI)" not in table
-    assert "median [95% CI]" in report.transfer_table(ten_trials.to_json()).splitlines()[0]
+    assert "median [95% CI]" in tables.transfer_table(ten_trials.to_json()).splitlines()[0]
 
 
 def test_rows_of_different_coverage_name_it_in_each_cell():
     entry = {"exploration_steps": [1, 2, 3], "mean": 2.0, "ci95": [1.0, 3.0], "median": 2.0,
              "median_ci95": [1.0, 3.0], "converged": [True] * 3}
-    table = report.method_table({"a": dict(entry, median_ci_coverage=0.75),
+    table = tables.method_table({"a": dict(entry, median_ci_coverage=0.75),
                                  "b": dict(entry, median_ci_coverage=0.98)})
     assert "median [CI, coverage named when below 95%]" in table and "(75% CI)" in table
 

@@ -10,7 +10,7 @@ from armtransfer.experiments.reports import figures
 
 from armtransfer.experiments.stats import learning_metrics, metrics
 from armtransfer.experiments.experiment import MethodResult, summarize
-from armtransfer.experiments.reports.report import method_table
+from armtransfer.experiments.tables import method_table
 from armtransfer.learning.trial_result import TrialResult
 from armtransfer.experiments.reports.summary import summarize as sweep_summarize, summary_markdown
 

@@ -21,27 +21,30 @@ from typing import Any
 
 import armtransfer.checks as checks
 from armtransfer.errors import InvalidCellError, InvalidParameterError, InvalidTaskError
+from armtransfer.experiments import continuous as runs, engines, experiment, learner_transfer, learner_trial
+from armtransfer.experiments.continuous import ContinuousResult
 from armtransfer.experiments.learner_trial import refuse_methods
+from armtransfer.experiments.results import MappingInfo, TransferResult
 from armtransfer.io import check_writable
-from armtransfer.learning.cells import CELL_METHODS, check_method
-from armtransfer.learning.method import check_k
-from armtransfer.learning.plugin_calls import probe_seconds
-from armtransfer.learning import potentials, presets
-from armtransfer.experiments import engines, experiment
+from armtransfer.learning import learners, potentials, presets
 from armtransfer.learning import methods as registry
 from armtransfer.learning import trajectory as trajectories
+from armtransfer.learning.cells import CELL_METHODS, check_method
 from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.learner_names import SARSA
 from armtransfer.learning.mapping import DEFAULT_MAX_SPAN, ActionMapping
 from armtransfer.learning.mapping import load_for as load_mapping
-from armtransfer.experiments.continuous import ContinuousResult
-from armtransfer.experiments.results import MappingInfo, TransferResult
-from armtransfer.learning.learner_names import SARSA
+from armtransfer.learning.method import check_k
+from armtransfer.learning.plugin_calls import probe_seconds
 from armtransfer.learning.trajectory import Trajectory
+from armtransfer.tasks.arms import walls_cause
 from armtransfer.tasks.catalog import Task, as_xy, custom_task, table_task, world_task
-from armtransfer.worlds.layout import ROOMS, Layout
-from armtransfer.worlds.resolve import world as resolve_world
+from armtransfer.tasks.continuous import ARM_KEYWORDS, continuous_arm
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.tasks.specs import resolve
+from armtransfer.tasks.unreachable import hint
+from armtransfer.worlds.layout import ROOMS, Layout
+from armtransfer.worlds.resolve import world as resolve_world
 
 TRAJECTORY_KINDS = ("optimal", "learned", "shuffled", "random")
 """``learned``: the source's converged greedy path after SARSA(lambda), the paper's protocol
@@ -60,7 +63,7 @@ def transfer(
     source: str | DiscreteRobot = "coarse",
     target: str | DiscreteRobot = "fine",
     *,
-    task: int | None = None,
+    task: int | str | Task | None = None,
     start: tuple[int, int] | str | None = None,
     goal: tuple[int, int] | str | None = None,
     methods: Sequence[str] = ("none", "pseudo"),
@@ -89,7 +92,8 @@ def transfer(
     """Transfer a trajectory from ``source`` to ``target`` and learn with each method.
 
     ``task`` is a Table I task (1-4) or give ``start`` and ``goal`` cells; with neither, a
-    trajectory file names its task, else task 1. ``trajectory`` is one or several of
+    trajectory file names its task, else task 1. A :class:`~armtransfer.tasks.catalog.Task`
+    (the command line's, checked once there) is taken as it is, in its own world. ``trajectory`` is one or several of
     :data:`TRAJECTORY_KINDS`, trajectory JSON files or :class:`Trajectory` objects (default
     ``learned``). ``controls`` also runs every reward-only method with a shuffled and a
     random trajectory, each trial with its own draw (``experiment.run_control``). ``baselines``
@@ -200,7 +204,8 @@ def _checked(a: dict[str, Any]) -> _Request:
     beta = None if a["beta"] is None else checks.real(a["beta"], "beta", 0.0)
     arm_xml = None if a["arm_xml"] is None else checks.path(a["arm_xml"], "arm_xml")
     options = _arm_options(a["arm_options"])
-    layout = _world(a["world"], a["source"], a["target"])
+    world = a["task"].layout if a["world"] is None and isinstance(a["task"], Task) else a["world"]
+    layout = _world(world, a["source"], a["target"])
     specs = list(_as_sequence(a["trajectory"], "trajectory")) if a["trajectory"] is not None else ["learned"]
     uses_mapping = any(registry.get(m).macros for m in method_names)
     mapping = a["mapping"]
@@ -315,8 +320,6 @@ def _by_method_and_control(runs) -> tuple[dict, dict]:
 def _outside_learner(learner: object):
     """The outside learner ``learner`` names (None: the built-in ``sarsa``); an unknown name is
     one line listing the learners."""
-    from armtransfer.learning import learners
-
     if not isinstance(learner, str):
         raise InvalidParameterError(f"learner is a learner's name; valid learners: {', '.join(learners.LEARNERS)}")
     found = learners.get(learner)
@@ -326,8 +329,6 @@ def _outside_learner(learner: object):
 def _transfer_outside(req: _Request, src: DiscreteRobot, tgt: DiscreteRobot, distance: int) -> TransferResult:
     """``transfer`` by an outside learner (see its docstring): probed first, then every method
     through the harness; no controls (``controls`` is not read)."""
-    from armtransfer.experiments import learner_trial, learner_transfer
-
     learner, the_task = req.outside, req.task
     start, goal = list(the_task.start), list(the_task.goal)
     learner_trial.probe(learner, tgt, start, goal, req.probe_timeout)  # a learner that raises: one line, before anything is learned
@@ -354,9 +355,6 @@ def _transfer_continuous(req: _Request) -> ContinuousResult:
     source, target, the_task, method_names, specs = req.source, req.target, req.task, req.methods, req.specs
     trials, seed, K, config, arm_xml, options = req.trials, req.seed, req.K, req.config, req.arm_xml, req.options
     progress, noise = req.progress, req.noise
-    from armtransfer.experiments import continuous as runs
-    from armtransfer.tasks.continuous import ARM_KEYWORDS, continuous_arm
-
     if isinstance(target, DiscreteRobot) or not isinstance(target, str):
         raise InvalidParameterError("a continuous target is named by a string: an arm such as "
                                     f"'planar3:joint' or 'ur5e_like:joint', PATH.xml or 'custom' with arm_xml, "
@@ -425,6 +423,10 @@ def _world(world, source, target) -> Layout:
 
 
 def _task(task, start, goal, specs, layout: Layout = ROOMS) -> Task:
+    if isinstance(task, Task) and start is None and goal is None:
+        if task.layout != layout:
+            raise InvalidTaskError(f"the task {task.name!r} is of another world than the transfer's")
+        return task  # checked where it was made
     if start is not None or goal is not None:
         if task is not None:
             raise InvalidTaskError("give either a task or start/goal cells, not both")
@@ -457,9 +459,6 @@ def _as_sequence(value, what: str) -> Sequence:
 
 def _with_walls_cause(message: str, robot: DiscreteRobot) -> str:
     """``message``, and why, when an arm misses cells because its geometry meets the walls."""
-    from armtransfer.tasks.arms import walls_cause
-    from armtransfer.tasks.unreachable import hint
-
     if robot.arm is None:
         return message + hint(robot)
     cause = walls_cause(robot)

@@ -7,13 +7,22 @@ one line on stderr with exit code 2; anything else is a bug and keeps its traceb
 
 from __future__ import annotations
 
+import _thread
 import argparse
 import errno
 import importlib
+import re
 import sys
 import textwrap
+import threading
+import time
+import warnings
 
-from armtransfer import script as _script
+from armtransfer import __version__, script as _script
+from armtransfer.environment import check_environment
+from armtransfer.errors import ArmTransferError
+from armtransfer.io import path_error
+from armtransfer.learning.lazy_registry import PluginWarning
 from armtransfer.script import OneLineParser as _Parser  # a usage error is one line
 
 # Subcommand name -> module in armtransfer.commands. Each module has
@@ -46,8 +55,6 @@ def command_list(modules: dict) -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from armtransfer import __version__
-
     modules = {name: importlib.import_module(f"armtransfer.commands.{module}") for name, module in COMMANDS.items()}
     parser = _Parser(prog="armtransfer", usage="%(prog)s [-h] [--version] COMMAND ...", description=f"{textwrap.fill(DESCRIPTION, 88)}\n\n{command_list(modules)}",
                      epilog="'armtransfer COMMAND --help' lists a command's options.",
@@ -103,8 +110,6 @@ class _InterruptAgain:
     :func:`main` has answered it; anything else goes to the ``previous`` hook."""
 
     def __init__(self, previous) -> None:
-        import threading
-
         self.previous = previous
         self.pending = threading.Event()
 
@@ -112,15 +117,10 @@ class _InterruptAgain:
         if not isinstance(unraisable.exc_value, KeyboardInterrupt):
             self.previous(unraisable)
         elif not self.pending.is_set():
-            import threading
-
             self.pending.set()
             threading.Thread(target=self._deliver, daemon=True).start()
 
     def _deliver(self) -> None:
-        import _thread
-        import time
-
         while True:
             time.sleep(0.05)  # let the main thread leave this hook first: raised in it, it is lost
             if not self.pending.is_set():
@@ -129,12 +129,6 @@ class _InterruptAgain:
 
 
 def _main(argv: list[str]) -> int:
-    from armtransfer.errors import ArmTransferError
-
-    import warnings
-
-    from armtransfer.learning.lazy_registry import PluginWarning
-
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PluginWarning)  # said here, in one line each
         try:
@@ -151,8 +145,7 @@ def _warn_left_out(argv: list[str]) -> None:
     """One warning line for every installed plugin left out (it cannot be imported or used),
     naming it and how to remove it; none for a plugin the command line names, whose use is then
     its one-line error (unless it took a built-in's name, which names the built-in)."""
-    import re
-
+    # here, not at the top: main() answers a Ctrl-C while numba and Gymnasium load
     from armtransfer.learning.learners import LEARNERS
     from armtransfer.learning.methods import METHODS
 
@@ -165,12 +158,9 @@ def _warn_left_out(argv: list[str]) -> None:
 
 
 def _run(parser: argparse.ArgumentParser, argv: list[str]) -> int:
-    from armtransfer.errors import ArmTransferError
-
     args = parser.parse_args(_join_xy_values(argv))
     try:
-        from armtransfer.commands.common import refuse_empty
-        from armtransfer.environment import check_environment
+        from armtransfer.commands.common import refuse_empty  # loaded by build_parser, inside main()
 
         refuse_empty(args)
         check_environment()  # before anything is written
@@ -181,8 +171,6 @@ def _run(parser: argparse.ArgumentParser, argv: list[str]) -> int:
     except OSError as err:
         if isinstance(err, BrokenPipeError) or not _on_a_path(err):
             raise  # a bug keeps its traceback
-        from armtransfer.io import path_error
-
         print(f"armtransfer {args.command}: error: {path_error(err)}", file=sys.stderr)
         return 2
 

@@ -12,6 +12,7 @@ one, :mod:`armtransfer.learning.lazy_registry`), ``ARMTRANSFER_CPUS`` (threads p
 from __future__ import annotations
 
 import os
+import stat
 from pathlib import Path
 
 from armtransfer.cpus import ENV as CPUS_ENV
@@ -61,8 +62,6 @@ def _check_folder(name: str, value: str) -> None:
             raise InvalidParameterError(f"environment variable {name}: cannot use {shown!r}: "
                                         f"{err.strerror or err}") from None
         break
-    import stat
-
     if not stat.S_ISDIR(st.st_mode):
         what = "is not a folder" if probe == path else f"is below {str(probe)!r}, which is not a folder"
         raise InvalidParameterError(f"environment variable {name} must name a folder; {shown!r} {what}")

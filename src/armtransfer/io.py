@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import fcntl
 import json
+import math
 import os
 import shutil
 import stat
 import tempfile
 import time
+import tomllib
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -299,8 +301,6 @@ def parse_json_bytes(raw: bytes) -> object:
 def parse_toml_bytes(raw: bytes) -> dict:
     """TOML from a file's bytes, as :func:`parse_json_bytes` does JSON (the same reasons), and
     its numbers checked as a user's file's (:func:`check_user_numbers`)."""
-    import tomllib
-
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError:
@@ -331,8 +331,6 @@ def check_user_numbers(data: object) -> None:
     """ValueError naming the first number of a user's parsed file that no value of the project
     can be: an integer of magnitude above :data:`MAX_FILE_INT` or more than :data:`MAX_DIGITS`
     digits, a float that is not finite (inf, nan, 1e999)."""
-    import math
-
     stack = [data]
     while stack:
         item = stack.pop()

@@ -25,7 +25,7 @@ MAX_EPISODE_STEPS = 100_000
 
 def register_envs() -> None:
     """Register this project's environments with Gymnasium (idempotent)."""
-    import gymnasium as gym
+    import gymnasium as gym  # start-up: run once Gymnasium is imported (register_on_import)
 
     for env_id, entry_point in ENVIRONMENTS.items():
         if env_id not in gym.registry:

@@ -12,6 +12,9 @@ import sys
 from collections.abc import Callable
 from typing import NoReturn
 
+from armtransfer.environment import check_environment
+from armtransfer.errors import ArmTransferError
+
 
 class OneLineParser(argparse.ArgumentParser):
     """argparse, but a usage error is one line (the usage is in --help)."""
@@ -27,9 +30,6 @@ def parser(doc: str | None) -> OneLineParser:
 
 def run(body: Callable[..., int | None], *args) -> int:
     """``body(*args)``'s exit code, or 2 after one line on stderr for an ``ArmTransferError``."""
-    from armtransfer.environment import check_environment
-    from armtransfer.errors import ArmTransferError
-
     try:
         check_environment()  # before anything is written, as the command does
         return int(body(*args) or 0)
@@ -149,7 +149,5 @@ def experiment_options(p: argparse.ArgumentParser, fast: str) -> None:
 
 def check_trials_seed(trials: int, seed: int) -> None:
     """The trial count and seed every experiment script takes."""
-    from armtransfer.errors import ArmTransferError
-
     if trials < 1 or seed < 0:
         raise ArmTransferError("--trials must be >= 1 and --seed >= 0")

@@ -29,13 +29,15 @@ from armtransfer import api
 from armtransfer.commands import common
 from armtransfer.commands.rooms import print_results, results_table
 from armtransfer.errors import InvalidParameterError
+from armtransfer.experiments import experiment
+from armtransfer.experiments.reports import figures
+from armtransfer.ik import offscreen
+from armtransfer.ik.offscreen import OffscreenError
+from armtransfer.io import check_distinct_outputs, check_writable, copy_atomic, staged_directory, write_json_atomic, write_text_atomic
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.robot import DiscreteRobot
-from armtransfer.experiments import experiment
-from armtransfer.experiments.reports import figures
 from armtransfer.tasks.specs import CUSTOM, resolve
-from armtransfer.io import check_distinct_outputs, check_writable, copy_atomic, staged_directory, write_json_atomic, write_text_atomic
 
 DEFAULT_SOURCE = "planar2:joint"
 DEFAULT_TARGET = "ur5e_like:cartesian"
@@ -112,20 +114,15 @@ def run(args: argparse.Namespace) -> int:
         if extra:
             check_writable(extra)
     if args.render:
-        from armtransfer.ik.render import video_format
+        from armtransfer.ik.render import video_format  # MuJoCo: not on --help's path
 
         video_format(args.render, None)
     common.check_arm_flags(args)
     renders = not args.no_video or bool(args.render)
     if renders:  # before anything is compiled or learned: a machine without OpenGL is told what to install
-        from armtransfer.ik import offscreen
-
         offscreen.require(_without(args))
-    layout = common.world_of(args)  # the world and its task, checked before compiling
-    if args.task is not None:
-        from armtransfer.tasks.catalog import world_task
-
-        world_task(layout, args.task)
+    where = common.world_and_task(args)  # the world and its task, checked once, before compiling
+    layout = where[0]
     with common.phase("compiling arms"):  # before anything is written: a bad arm writes nothing
         options = arm_options(args)
         source = resolve(args.source, xml_path=args.arm_xml, progress=common.interactive(), layout=layout,
@@ -134,13 +131,13 @@ def run(args: argparse.Namespace) -> int:
                          **options)
         scenes: dict = {}  # the checked scenes, rendered from: each is built once
         if renders:  # a replay that cannot be made fails now, not after learning
-            from armtransfer.ik.replay import check_replayable
+            from armtransfer.ik.replay import check_replayable  # MuJoCo: not on --help's path
 
             for robot in (source, target):
                 if robot.arm is not None:
                     scenes[id(robot)] = check_replayable(robot)
     with staged_directory(out) as tmp:
-        result = _run_into(args, tmp, source, target, out, scenes)
+        result = _run_into(args, where, tmp, source, target, out, scenes)
         if args.json:
             write_json_atomic(args.json, result["json"])
         if args.render and result["video"]:
@@ -166,8 +163,6 @@ def _without(args: argparse.Namespace) -> str:
 def _try_video(result: dict, args, path: Path, scenes: dict | None) -> str | None:
     """Render the video to ``path``; None when written, else why not (the render failed after
     the learning, e.g. the GL context could not be made, and the run keeps everything else)."""
-    from armtransfer.ik.offscreen import OffscreenError
-
     try:
         result["stats"] = _video(result, args, path, scenes)
     except OffscreenError as err:
@@ -175,11 +170,12 @@ def _try_video(result: dict, args, path: Path, scenes: dict | None) -> str | Non
     return None
 
 
-def _run_into(args: argparse.Namespace, tmp: Path, source: DiscreteRobot, target: DiscreteRobot,
+def _run_into(args: argparse.Namespace, where: tuple, tmp: Path, source: DiscreteRobot, target: DiscreteRobot,
               final: Path, scenes: dict | None = None) -> dict:
     """Everything into ``tmp``, which becomes ``final`` when complete (paths in results.json name ``final``).
-    ``scenes``: the robots' checked scenes by ``id(robot)``, rendered from."""
-    kwargs = {**common.transfer_kwargs(args), **_fast_overrides(args)}
+    ``where``: the world and task (``common.world_and_task``); ``scenes``: the robots' checked
+    scenes by ``id(robot)``, rendered from."""
+    kwargs = {**common.transfer_kwargs(args, where), **_fast_overrides(args)}
     if args.source_planner == "learn" and not args.trajectory:
         kwargs["trajectory"] = ["learned"]
     elif not args.trajectory:
@@ -280,7 +276,7 @@ def _paths(result, source: DiscreteRobot, target: DiscreteRobot) -> dict:
 
 
 def _video(result: dict, args, path: Path, scenes: dict | None = None) -> dict:
-    from armtransfer.ik.render import rollout_video
+    from armtransfer.ik.render import rollout_video  # MuJoCo: not on --help's path
 
     paths = result["paths"]
     fps = 10.0 if args.fast else 30.0

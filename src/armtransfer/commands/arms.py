@@ -7,7 +7,16 @@ import argparse
 import sys
 from typing import Any
 
-from armtransfer.commands import common
+from armtransfer.commands import arm_transfer, common
+from armtransfer.errors import ArmModelError
+from armtransfer.ik.actions import ACTION_MODELS
+from armtransfer.io import check_output_dir
+from armtransfer.models import ARMS
+from armtransfer.models.generate import FAMILIES, check_family
+from armtransfer.tasks.arms import (NotCached, arm_robot, arm_scene, is_spatial_joint, robot_specs, spatial_joint_specs,
+                                    tasks_solvable, walls_cause)
+from armtransfer.tasks.generated import generate_arm
+from armtransfer.worlds.resolve import is_default
 
 HELP = ("Transfer a trajectory from one MuJoCo arm to another; write results, table, figures and a rollout video "
         "('arms list' lists the arms, 'arms generate' draws new ones).")
@@ -42,8 +51,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-cache", action="store_true", help="compile without the cache")
     parser.add_argument("--compile", action="store_true",
                         help="arms list: compile every built-in robot not in the cache yet (minutes on a new machine)")
-    from armtransfer.commands import arm_transfer
-
     arm_transfer.add_arguments(parser)
 
 
@@ -52,8 +59,6 @@ def run(args: argparse.Namespace) -> int:
         common.refuse_other_options(args, GENERATE_OPTIONS, "'arms generate'")
         return generate(args)
     if args.action != "list":
-        from armtransfer.commands import arm_transfer
-
         common.refuse_other_options(args, {a.dest for a in common.options_of(args)} - LIST_ONLY - GENERATE_ONLY,
                                     "an arm transfer ('arms' without list or generate)")
         return arm_transfer.run(args)
@@ -65,10 +70,6 @@ def run(args: argparse.Namespace) -> int:
 def _jobs(args: argparse.Namespace, layout) -> list[dict[str, Any]]:
     """The robots ``arms list`` reports: the built-in ones --arm and --actions pick, in the
     registry's order, then the arm file's (checked first, so a bad file fails fast)."""
-    from armtransfer.ik.actions import ACTION_MODELS
-    from armtransfer.errors import ArmModelError
-    from armtransfer.tasks.arms import robot_specs, spatial_joint_specs
-
     wanted = None
     if args.actions:
         wanted = [a.strip() for a in args.actions.split(",") if a.strip()]
@@ -76,8 +77,6 @@ def _jobs(args: argparse.Namespace, layout) -> list[dict[str, Any]]:
             if a not in ACTION_MODELS:
                 raise ArmModelError(
                     f"unknown action model {a!r}; valid action models: {', '.join(ACTION_MODELS)}")
-    from armtransfer.models import ARMS
-
     arms = None
     if args.arm:
         arms = [a.strip() for a in args.arm.split(",") if a.strip()]
@@ -93,8 +92,6 @@ def _jobs(args: argparse.Namespace, layout) -> list[dict[str, Any]]:
     if args.arm_xml:
         custom = [a for a in (wanted or ["cartesian"])]
         # Validate the file before the long built-in listing, so bad input fails fast.
-        from armtransfer.tasks.arms import arm_scene
-
         options = common.arm_file_options(args)
         arm_scene(xml_path=args.arm_xml, cell_size=args.cell_size, layout=layout,
                   **{k: v for k, v in options.items() if k != "arm_name"})
@@ -105,10 +102,6 @@ def _jobs(args: argparse.Namespace, layout) -> list[dict[str, Any]]:
 
 def _list(args: argparse.Namespace) -> int:
     """``arms list``: a row per robot, compiled where asked, from the cache otherwise."""
-    from armtransfer.models import ARMS
-    from armtransfer.tasks.arms import NotCached, arm_robot, is_spatial_joint, tasks_solvable, walls_cause
-    from armtransfer.worlds.resolve import is_default
-
     layout = common.world_of(args)
     jobs = _jobs(args, layout)
 
@@ -181,17 +174,11 @@ def mount_line(arm) -> str:
 
 def generate(args: argparse.Namespace) -> int:
     """``arms generate --family F --dof N --seed S --out DIR``: one usable arm, or why not."""
-    from armtransfer.errors import ArmModelError
-    from armtransfer.models.generate import FAMILIES, check_family
-    from armtransfer.tasks.generated import generate_arm
-
     if args.family is None or args.out is None:
         raise ArmModelError(f"arms generate needs --family ({', '.join(FAMILIES)}), --dof and --out DIR")
     known = FAMILIES.get(args.family)  # None: an unknown family, which check_family names before any dof
     dof = args.dof if args.dof is not None or known is None else known[0]
     check_family(args.family, dof)
-    from armtransfer.io import check_output_dir
-
     check_output_dir(args.out)  # absent or empty, as --out's help says
     with common.phase("drawing and compiling"):
         arm = generate_arm(args.family, dof, args.seed, args.out, progress=common.interactive())

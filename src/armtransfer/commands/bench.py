@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import gymnasium as gym
 import os
 import platform
 import statistics
@@ -12,12 +13,15 @@ import numpy as np
 
 from armtransfer.commands.common import (add_world_argument, non_negative_int, options_of, positive_int,
                                          refuse_other_options, world_of)
-from armtransfer.tasks.catalog import world_task
-from armtransfer.worlds.layout import ROOMS, Layout
-from armtransfer.tasks.grid_robots import grid_robot
-from armtransfer.learning import sarsa
-from armtransfer.learning.config import LearnerConfig
+from armtransfer.experiments import learner_trial
 from armtransfer.io import check_writable, write_json_atomic
+from armtransfer.learning import reference, sarsa
+from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.learners import BUILTIN, get
+from armtransfer.registration import MAX_EPISODE_STEPS
+from armtransfer.tasks.catalog import world_task
+from armtransfer.tasks.grid_robots import grid_robot
+from armtransfer.worlds.layout import ROOMS, Layout
 
 HELP = "Measure how many learning steps per second the learner runs on this machine."
 EXAMPLE = "armtransfer bench --repeats 3"
@@ -63,8 +67,6 @@ def measure(steps: int, seed: int, layout: Layout = ROOMS) -> tuple[int, float]:
 
 def measure_reference(steps: int, seed: int, layout: Layout = ROOMS) -> tuple[int, float]:
     """The baseline: the dense, line-by-line Algorithm 1 in plain Python (transfer.reference)."""
-    from armtransfer.learning import reference
-
     robot = grid_robot("fine", layout)
     start, goal = world_task(layout).cells()
     rng = np.random.default_rng(seed)
@@ -79,12 +81,6 @@ def measure_reference(steps: int, seed: int, layout: Layout = ROOMS) -> tuple[in
 def measure_learner(name: str, steps: int, seed: int, layout: Layout = ROOMS) -> tuple[int, float]:
     """``steps`` steps of learner ``name`` (``learning.learners``) on the world's first task, fine
     robot, no transfer, in the harness's environment (``learner_trial``): (steps it took, seconds)."""
-    import gymnasium as gym
-
-    from armtransfer.experiments import learner_trial
-    from armtransfer.learning.learners import get
-    from armtransfer.registration import MAX_EPISODE_STEPS
-
     learner = get(name)
     robot = grid_robot("fine", layout)
     task = world_task(layout)
@@ -103,8 +99,6 @@ def measure_learner(name: str, steps: int, seed: int, layout: Layout = ROOMS) ->
 
 def run_learner(args: argparse.Namespace, layout: Layout) -> int:
     """``bench --learner NAME``: an outside learner's steps per second."""
-    from armtransfer.learning.learners import BUILTIN, get
-
     name = get(args.learner).name  # a typo lists the valid names
     if name in BUILTIN:
         args.learner = None

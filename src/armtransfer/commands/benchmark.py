@@ -14,23 +14,27 @@ again from the store.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import datetime as _dt
 import json
 import os
 import time
 from pathlib import Path
 
+from armtransfer.checks import MAX_COUNT
 from armtransfer.commands import common
-from armtransfer.errors import InvalidParameterError
 from armtransfer.commands.sweep import add_executor_arguments, check_executor_options
-from armtransfer.experiments import benchmark, suites
+from armtransfer.errors import InvalidParameterError, PluginError
+from armtransfer.experiments import benchmark, learner_trial, suite_files, suites
 from armtransfer.experiments.benchmark_runs import execute_recorded as execute
 from armtransfer.experiments.reports import benchmark_report
 from armtransfer.experiments.stats import benchmark_stats
 from armtransfer.experiments.store import ResultStore, StoreError
 from armtransfer.experiments.sweep import Sweep, content_key
 from armtransfer.io import check_writable, write_bytes_atomic, write_json_atomic, write_text_atomic
-from armtransfer.checks import MAX_COUNT
+from armtransfer.learning import methods
+from armtransfer.learning.learners import BUILTIN, LEARNERS, RUN_TIME, get, parse
+from armtransfer.learning.methods import probe_on, refuse_run_time
 from armtransfer.parallel.executors import _check_reachable, _import_ray, run_local, run_ray
 
 HELP = "Compare every method with the baselines that share its learner on a fixed suite, over many source seeds."
@@ -49,8 +53,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--method", nargs="+", default=None, metavar="METHOD",
                    help="run only these methods, each beside its baselines (default: the suite's methods and "
                         "every method of an installed plugin); a method's records are the same bytes either way")
-    from armtransfer.learning.learners import LEARNERS
-
     learned = "; ".join(f"{name}: {lr.description}" for name, lr in LEARNERS.items())
     p.add_argument("--learner", default=None, metavar="NAME[,NAME...]",
                    help="the learners every method runs on, each method beside the baseline the same learner runs "
@@ -95,20 +97,14 @@ def run(args: argparse.Namespace) -> int:
         # a suite file's methods: those its sections name (a section may name its own)
         wanted = tuple(dict.fromkeys(m for s in suite.sections for m in s.methods or ()))
     if args.method is not None:
-        from armtransfer.learning import methods
-
         wanted = tuple(methods.get(m).name for m in args.method)  # a typo lists the valid names
     ran, missing = benchmark.methods_to_run(wanted)
     learners = None
     if args.learner is not None:
-        from armtransfer.learning.learners import parse
-
         learners = parse(args.learner)  # a typo lists the valid names
     robots = benchmark.Robots({})
     plan = benchmark.plan(suite, args.seed, robots, ran, missing, preset=args.preset, learners=learners,
                           quality=args.quality, run_on=args.run_on)
-    from armtransfer.learning.methods import probe_on, refuse_run_time
-
     # a plugin's fault stops the run here, in one line, before its store is opened
     probe_on(plan.methods, [robots(p.case.target, p.case.world) for p in plan.pairs], args.probe_timeout)
     refuse_run_time(plan.methods, "a benchmark's runs")  # every case's task checked before anything is written
@@ -154,10 +150,6 @@ def probe_learners(plan: benchmark.Plan, robots: benchmark.Robots, seconds: floa
     case of each of its target robots (``learner_trial.probe``): a learner's fault is one line
     now, before the store is opened; a learner registered in this process only is refused (the
     runs go to worker processes, which cannot see it)."""
-    from armtransfer.errors import PluginError
-    from armtransfer.experiments import learner_trial
-    from armtransfer.learning.learners import BUILTIN, RUN_TIME, get
-
     seen: set[tuple[str, str, str]] = set()
     for pair in plan.pairs:
         for name, ms in plan.entries(pair):
@@ -261,8 +253,6 @@ def write_report_files(out: Path, suite: suites.Suite, seed: int, ran: list[str]
     if timings is not None:
         write_json_atomic(out / "timings.json", timings)
     if any(s.name not in summary for s in suite.sections):  # a section whose every record failed: in the
-        import dataclasses  # failures' table alone
-
         suite = dataclasses.replace(suite, sections=tuple(s for s in suite.sections if s.name in summary))
     benchmark_report.write_figures(summary, suite, out)
     write_text_atomic(out / "report.md", benchmark_report.report_markdown(suite, seed, summary, ran, missing,
@@ -272,8 +262,6 @@ def write_report_files(out: Path, suite: suites.Suite, seed: int, ran: list[str]
 def plan_of(store: ResultStore) -> benchmark.Plan:
     """The plan of a benchmark store, made again by this build; a store of a suite this build
     defines otherwise (another version) or does not have is a one-line error."""
-    from armtransfer.experiments import suite_files
-
     spec = store.meta["spec"]["benchmark"]
     try:
         suite = suite_files.from_dict(spec["suite"], f"{str(store.root)!r}")

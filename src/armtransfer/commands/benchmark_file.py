@@ -13,12 +13,13 @@ import json
 import zlib
 from pathlib import Path
 
-from armtransfer.errors import InvalidParameterError
 from armtransfer.checks import MAX_COUNT
-from armtransfer.io import parse_json_bytes, read_input, staged_directory
+from armtransfer.commands.benchmark import results_bytes, write_report_files
+from armtransfer.errors import InvalidParameterError
 from armtransfer.experiments import suite_files, suites
 from armtransfer.experiments.reports import benchmark_report
 from armtransfer.experiments.stats import benchmark_stats
+from armtransfer.io import parse_json_bytes, read_input, staged_directory
 
 MAX_UNPACKED_BYTES = 1 << 30
 """The largest results file read once decompressed (1 GiB); a standard suite's is tens of MiB."""
@@ -60,8 +61,6 @@ def read_results(path: Path) -> tuple[dict, bytes]:
 
 def report_from_file(path: Path, out: str | None) -> int:
     """``armtransfer summarize FILE --out DIR``."""
-    from armtransfer.commands.benchmark import results_bytes, write_report_files
-
     if out is None:
         raise InvalidParameterError("a results file needs --out DIR: an absent or empty directory for its report")
     data, raw = read_results(path)

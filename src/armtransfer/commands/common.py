@@ -7,10 +7,20 @@ import math
 import sys
 from dataclasses import fields
 
+from armtransfer.api import TRAJECTORY_KINDS
 from armtransfer.checks import MAX_COUNT, integer_text
 from armtransfer.errors import ArmModelError, ArmTransferError, InvalidParameterError, InvalidTaskError
+from armtransfer.experiments.learner_trial import refuse_methods
+from armtransfer.ik.tool import parse_held, parse_offset
+from armtransfer.learning import mapping as mappings, methods, potentials, presets
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.tasks.catalog import parse_xy
+from armtransfer.learning.learners import LEARNERS, SARSA, get
+from armtransfer.learning.method import MAX_K, check_k
+from armtransfer.learning.plugin_calls import MAX_PROBE_SECONDS, PROBE_SECONDS, probe_seconds
+from armtransfer.tasks.arms import check_arm_name
+from armtransfer.tasks.catalog import Task, custom_task, parse_xy, world_task
+from armtransfer.worlds.layout import Layout
+from armtransfer.worlds.resolve import DEFAULT_WORLD, VALID, is_default, world
 
 
 def _integer_at_least(lo: int, what: str):
@@ -38,8 +48,6 @@ def probability(text: str) -> float:
 
 
 def k_value(text: str) -> float | str:
-    from armtransfer.learning.method import MAX_K, check_k
-
     if text == "auto":
         return text
     try:
@@ -49,8 +57,6 @@ def k_value(text: str) -> float | str:
 
 
 def probe_timeout(text: str) -> float:
-    from armtransfer.learning.plugin_calls import MAX_PROBE_SECONDS, probe_seconds
-
     try:
         return probe_seconds(float(text))
     except (ValueError, ArmTransferError):
@@ -59,8 +65,6 @@ def probe_timeout(text: str) -> float:
 
 
 def add_probe_timeout_argument(p: argparse.ArgumentParser) -> None:
-    from armtransfer.learning.plugin_calls import PROBE_SECONDS
-
     p.add_argument("--probe-timeout", type=probe_timeout, default=PROBE_SECONDS, metavar="SECONDS",
                    help="the time limit of each plugin's probe (a method's potential built once, an outside learner "
                         "learning a few steps) before anything is run; a plugin that overruns it is named in one line "
@@ -68,10 +72,6 @@ def add_probe_timeout_argument(p: argparse.ArgumentParser) -> None:
 
 
 def add_method_arguments(p: argparse.ArgumentParser, default: list[str] | None = None) -> None:
-    from armtransfer.api import TRAJECTORY_KINDS
-    from armtransfer.learning import mapping as mappings
-    from armtransfer.learning import methods, potentials
-
     default = default or ["none", "pseudo"]
     listing = "; ".join(f"{m.name}: {m.description}" for m in methods.METHODS.values())
     p.add_argument("--method", nargs="+", default=default, metavar="METHOD",
@@ -95,8 +95,6 @@ def add_method_arguments(p: argparse.ArgumentParser, default: list[str] | None =
 
 
 def add_world_argument(p: argparse.ArgumentParser) -> None:
-    from armtransfer.worlds.resolve import DEFAULT_WORLD, VALID
-
     p.add_argument("--world", default=None, metavar="NAME|PATH",
                    help=f"the world the robots move in (default {DEFAULT_WORLD}, the paper's 51 x 51 rooms): "
                         f"{VALID} (docs/worlds.md)")
@@ -105,16 +103,12 @@ def add_world_argument(p: argparse.ArgumentParser) -> None:
 def world_of(args: argparse.Namespace):
     """The world --world names (the paper's rooms without it), checked: a one-line error for
     an unknown name or a bad layout file."""
-    from armtransfer.worlds.resolve import world
-
     return world(getattr(args, "world", None))
 
 
 def refuse_world(args: argparse.Namespace, command: str, why: str) -> None:
     """``command`` runs on the paper's rooms only: any other world is a one-line error saying
     ``why`` (a world that does not load names its own fault first)."""
-    from armtransfer.worlds.resolve import DEFAULT_WORLD, is_default
-
     if getattr(args, "world", None) is not None and not is_default(world_of(args)):
         raise InvalidParameterError(f"--world {str(args.world)[:100]} does not apply to {command}: {why}; "
                                     f"valid worlds: {DEFAULT_WORLD}")
@@ -143,8 +137,6 @@ def add_learning_arguments(p: argparse.ArgumentParser, trials: int = 10) -> None
 def add_learner_argument(p: argparse.ArgumentParser, several: bool = False) -> None:
     """--learner: who learns on the target, the built-in sarsa or a learner of
     ``armtransfer.LEARNERS`` (its installed plugins read now, so that --help lists them)."""
-    from armtransfer.learning.learners import LEARNERS, SARSA
-
     learned = "; ".join(f"{name}: {lr.description}" for name, lr in LEARNERS.items())
     p.add_argument("--learner", default=SARSA, metavar="NAME[,NAME...]" if several else "NAME",
                    help=("the learners, comma-separated, each running every method beside the none it runs"
@@ -157,9 +149,6 @@ def add_learner_argument(p: argparse.ArgumentParser, several: bool = False) -> N
 def check_learner(args: argparse.Namespace, flag: str = "--method") -> None:
     """--learner checked before anything is built: a known learner (a typo lists them) that
     runs every method of ``flag`` (else one line listing the methods it runs)."""
-    from armtransfer.experiments.learner_trial import refuse_methods
-    from armtransfer.learning.learners import SARSA, get
-
     learner = get(args.learner)
     if learner.name != SARSA:
         refuse_methods(learner, getattr(args, flag.lstrip("-")))
@@ -167,8 +156,6 @@ def check_learner(args: argparse.Namespace, flag: str = "--method") -> None:
 
 def add_preset_argument(p: argparse.ArgumentParser) -> None:
     """--preset: a named set of learner settings (``learning.presets``) that the flags override."""
-    from armtransfer.learning import presets
-
     p.add_argument("--preset", type=preset_name, default=presets.DEFAULT, metavar="NAME",
                    help=f"learner settings by name, which the learner's flags override: {', '.join(presets.names())} "
                         "(default: default; paper-calibrated: fitted to the paper's no-transfer columns, "
@@ -176,8 +163,6 @@ def add_preset_argument(p: argparse.ArgumentParser) -> None:
 
 
 def preset_name(text: str) -> str:
-    from armtransfer.learning import presets
-
     if text not in presets.PRESETS:
         raise argparse.ArgumentTypeError(f"unknown preset {text!r}; valid presets: {', '.join(presets.names())}")
     return text
@@ -221,26 +206,49 @@ def config_options(args: argparse.Namespace) -> dict:
     return {"preset": args.preset, **out}
 
 
-def transfer_kwargs(args: argparse.Namespace) -> dict:
-    """The keyword arguments of ``armtransfer.transfer`` that the common flags give (the task's
-    flags are checked here, so that errors name them)."""
-    start, goal = args.start, args.goal
-    if start is not None or goal is not None:
-        if args.task is not None:
-            raise InvalidTaskError("give either --task or --start/--goal, not both")
-        if start is None or goal is None:
-            raise InvalidTaskError("--start and --goal go together")
-        start, goal = parse_xy(start, "--start"), parse_xy(goal, "--goal")
+def _cells(args: argparse.Namespace) -> tuple[tuple[int, int], tuple[int, int]] | None:
+    """--start and --goal as cells (None when neither is given), checked against --task."""
+    if args.start is None and args.goal is None:
+        return None
+    if args.task is not None:
+        raise InvalidTaskError("give either --task or --start/--goal, not both")
+    if args.start is None or args.goal is None:
+        raise InvalidTaskError("--start and --goal go together")
+    return parse_xy(args.start, "--start"), parse_xy(args.goal, "--goal")
+
+
+def _task_in(layout: Layout, args: argparse.Namespace, cells) -> Task | None:
+    """The task --task or --start/--goal (``cells``) name in the world ``layout``; None when
+    neither is given (the API's default: a trajectory file's task, else the world's first)."""
+    if args.task is not None:
+        return world_task(layout, args.task)
+    if cells is not None:
+        return custom_task(cells[0], cells[1], layout)
+    return None
+
+
+def world_and_task(args: argparse.Namespace) -> tuple[Layout, Task | None]:
+    """The world --world names and the task of --task or --start/--goal in it, each checked once
+    (a one-line error naming the flag) and handed down typed: the API checks them no more."""
+    cells = _cells(args)
+    layout = world_of(args)
+    return layout, _task_in(layout, args, cells)
+
+
+def transfer_kwargs(args: argparse.Namespace, where: tuple[Layout, Task | None] | None = None) -> dict:
+    """The keyword arguments of ``armtransfer.transfer`` that the common flags give. The world
+    and task are ``where`` (:func:`world_and_task`, when the command checked them already) or
+    checked here, so that errors name the flags."""
+    cells = _cells(args) if where is None else None
     if args.mapping is not None and "mapping" not in args.method:
         raise InvalidParameterError("--mapping goes with --method mapping")
     refuse_unused_method_options(args)
-    world = world_of(args)
-    if args.task is not None:
-        from armtransfer.tasks.catalog import world_task
-
-        world_task(world, args.task)  # an unknown task is named before anything else is done
+    if where is None:
+        layout = world_of(args)
+        where = layout, _task_in(layout, args, cells)  # an unknown task is named before anything is done
+    world, task = where
     return dict(
-        world=world, task=args.task, start=start, goal=goal, methods=args.method, trials=args.trials, seed=args.seed,
+        world=world, task=task, methods=args.method, trials=args.trials, seed=args.seed,
         wind=args.wind, K=args.K, beta=args.beta, trajectory=args.trajectory, controls=not args.no_controls,
         mapping=args.mapping, save_mapping=args.mapping is not None, max_span=args.max_span,
         probe_timeout=getattr(args, "probe_timeout", 60.0),
@@ -251,8 +259,6 @@ def transfer_kwargs(args: argparse.Namespace) -> dict:
 def refuse_unused_method_options(args: argparse.Namespace, flag: str = "--method") -> None:
     """A method's option given (different from its default) while no method of ``flag``
     uses it is an error naming the methods that do, instead of being silently ignored."""
-    from armtransfer.learning import methods
-
     names = getattr(args, flag.lstrip("-"))
     chosen = [methods.get(m) for m in names]
     users = {
@@ -333,7 +339,7 @@ class phase:
 
 def progress_bar(total: int, desc: str):
     """A tqdm bar on a terminal, nothing otherwise."""
-    from tqdm import tqdm
+    from tqdm import tqdm  # start-up: only when a bar is shown
 
     return tqdm(total=total, desc=desc, disable=not sys.stderr.isatty(), leave=False)
 
@@ -399,15 +405,11 @@ def check_arm_flags(args: argparse.Namespace) -> None:
 
 def arm_file_options(args: argparse.Namespace) -> dict:
     """The bring-your-own arm's options as ``arm_robot`` keywords, checked."""
-    from armtransfer.ik.tool import parse_held, parse_offset
-
     if args.tip_site is not None and args.tip_body is not None:
         raise ArmModelError("give --tip-site or --tip-body, not both")
     if args.arm_name is not None and not args.arm_name.strip():
         raise ArmModelError("--arm-name must not be empty")
     if args.arm_name is not None:
-        from armtransfer.tasks.arms import check_arm_name
-
         check_arm_name(args.arm_name, "--arm-name")
     return dict(tip_site=args.tip_site, tip_body=args.tip_body,
                 tip_offset=parse_offset(args.tip_offset) if args.tip_offset is not None else None,

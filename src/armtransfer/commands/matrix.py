@@ -10,13 +10,20 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from armtransfer.checks import integer_text
 from armtransfer.commands import common
 from armtransfer.commands.sweep import add_executor_arguments, check_executor_options, run_sweep
-from armtransfer.checks import integer_text
-from armtransfer.errors import InvalidParameterError
-from armtransfer.io import write_bytes_atomic, write_json_atomic, write_text_atomic
-from armtransfer.experiments import matrix
+from armtransfer.errors import InvalidParameterError, InvalidTaskError
+from armtransfer.experiments import matrix, sweep as sweeps
+from armtransfer.experiments.learner_trial import refuse_methods
 from armtransfer.experiments.store import ResultStore
+from armtransfer.io import write_bytes_atomic, write_json_atomic, write_text_atomic
+from armtransfer.learning import methods
+from armtransfer.learning.learners import SARSA, get, parse
+from armtransfer.models import ARMS
+from armtransfer.tasks.grid_robots import GRID_ROBOTS
+from armtransfer.tasks.specs import CUSTOM, xml_arm_name
+from armtransfer.worlds.resolve import is_default
 
 HELP = "Measure which robots help which: every ordered source -> target pair of a set of robots, as a heatmap."
 EXAMPLE = "armtransfer matrix --robots coarse,fine --tasks 1 --trials 5 --out runs/matrix"
@@ -36,9 +43,6 @@ def _task_list(text: str) -> list[str]:
 def world_tasks(parts: list[str] | None, layout) -> list:
     """The tasks of ``--tasks`` in the world (every task of it when None): numbers on the rooms
     (its Table I tasks), names elsewhere; a one-line error naming an unknown one."""
-    from armtransfer.errors import InvalidTaskError
-    from armtransfer.worlds.resolve import is_default
-
     names = [t[0] for t in layout.tasks]
     rooms = is_default(layout)
     if parts is None:
@@ -97,15 +101,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from armtransfer.learning import methods
-
     check_executor_options(args)
     for m in args.methods:
         methods.get(m)
     common.refuse_unused_method_options(args, "--methods")
-    from armtransfer.experiments.learner_trial import refuse_methods
-    from armtransfer.learning.learners import SARSA, get, parse
-
     learners = parse(args.learner)  # a typo lists the valid names
     for name in learners:
         if name != SARSA:
@@ -126,10 +125,6 @@ def arm_file_robots(args: argparse.Namespace) -> tuple[list[str], dict]:
     """The robots with the arm of --arm-xml (``custom`` or its name) named by its name, and
     that arm as a sweep's ``[arms.NAME]`` table: the store's runs name the arm as ``arms list``
     prints it, and carry its file and options."""
-    from armtransfer.models import ARMS
-    from armtransfer.tasks.grid_robots import GRID_ROBOTS
-    from armtransfer.tasks.specs import CUSTOM, xml_arm_name
-
     common.check_arm_flags(args)
     if not args.arm_xml:
         return list(args.robots), {}
@@ -172,6 +167,4 @@ def write_summary(store: ResultStore, out: Path) -> str:
 
 
 def store_runs(spec: dict) -> list[dict]:
-    from armtransfer.experiments import sweep as sweeps
-
     return sweeps.expand(spec)

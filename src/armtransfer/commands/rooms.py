@@ -9,7 +9,7 @@ from armtransfer.commands import common
 from armtransfer.io import check_distinct_outputs, check_writable, write_json_atomic
 from armtransfer.experiments import experiment
 
-from armtransfer.experiments.reports import report
+from armtransfer.experiments import tables
 HELP = ("Transfer a trajectory between two grid robots in a world (the paper's rooms by default; --world: rooms11, "
         "rooms15, generated:SEED or your layout file) and print its Table II-style table.")
 EXAMPLE = "armtransfer rooms --task 2 --trials 5"
@@ -41,14 +41,14 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-results_table = report.transfer_table
+results_table = tables.transfer_table
 
 
 def print_results(out: dict) -> None:
-    print(report.transfer_heading(out))
+    print(tables.transfer_heading(out))
     print(results_table(out))
     if out.get("controls"):
-        print(report.CONTROLS_NOTE)
+        print(tables.CONTROLS_NOTE)
     info = out["mapping"]
     if info is not None:
         if info["macro_states"] == 0:

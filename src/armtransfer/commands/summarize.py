@@ -8,10 +8,14 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from armtransfer.commands.benchmark import summarize as benchmark_report
+from armtransfer.commands.benchmark_file import report_from_file
+from armtransfer.commands.matrix import write_summary
 from armtransfer.errors import InvalidParameterError
-from armtransfer.io import write_json_atomic, write_text_atomic
-from armtransfer.experiments.store import ResultStore, is_benchmark
+from armtransfer.experiments.matrix import is_matrix
 from armtransfer.experiments.reports.summary import plot, summarize, summary_markdown
+from armtransfer.experiments.store import ResultStore, is_benchmark
+from armtransfer.io import write_json_atomic, write_text_atomic
 
 HELP = ("Turn a result store into tables and a plot: summary.md, summary.json and summary.png (a benchmark's "
         "store: its report again; a benchmark's results.json[.gz]: its statistics recomputed from its records).")
@@ -27,8 +31,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     if Path(args.dir).is_file():
-        from armtransfer.commands.benchmark_file import report_from_file
-
         return report_from_file(Path(args.dir), args.out)
     if not Path(args.dir).exists():
         raise InvalidParameterError(f"{args.dir!r} does not exist (expected a result store or a results file)")
@@ -41,8 +43,6 @@ def run(args: argparse.Namespace) -> int:
 
 def _summarize(store: ResultStore, args: argparse.Namespace) -> int:
     if is_benchmark(store.meta["spec"]):
-        from armtransfer.commands.benchmark import summarize as benchmark_report
-
         return benchmark_report(store)
     records = store.records()
     rows = summarize(records)
@@ -56,11 +56,7 @@ def _summarize(store: ResultStore, args: argparse.Namespace) -> int:
     write_text_atomic(out / "summary.md", f"# Sweep {store.meta['name']!r}\n\n{len(records)} finished runs, "
                       f"{len(failures)} failed.\n\n{text}\n")
     print(text)
-    from armtransfer.experiments.matrix import is_matrix
-
     if is_matrix(store.meta["spec"]):
-        from armtransfer.commands.matrix import write_summary
-
         print(write_summary(store, out))
     if failures:
         print(f"{len(failures)} runs failed; see {out / 'failed'}")

@@ -30,6 +30,7 @@ from armtransfer.dmc.shaping import TransferShaping
 from armtransfer.dmc.task import RoomsTask
 from armtransfer.errors import InvalidParameterError
 from armtransfer.ik.physics import ArmPhysics
+from armtransfer.ik.replay import robot_scene
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.reward_term import TrajectoryLike
 from armtransfer.registration import MAX_EPISODE_STEPS
@@ -80,8 +81,6 @@ def load(arm: str | None = None, actions: str = "joint", task: int | None = 1, *
     the_task = rooms_task(task, start, goal, world)  # a bad world or task fails before any compiling
     robot = rooms_arm(arm, actions, dict(arm_options), the_task.layout)
     rooms = RoomsTask(robot, the_task, wind=wind, step_reward=step_reward, goal_reward=goal_reward, random=random)
-    from armtransfer.ik.replay import robot_scene
-
     physics = ArmPhysics.from_scene(robot_scene(robot))
     environment = control.Environment(physics, rooms, time_limit=_time_limit(physics, step_limit, environment_kwargs),
                                       **environment_kwargs)

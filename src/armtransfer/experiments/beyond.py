@@ -11,13 +11,15 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import replace
 
-from armtransfer.tasks.catalog import TABLE_I
-from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.experiments import experiment
-from armtransfer.learning import methods
+from armtransfer.experiments.tables import fmt_ci, fmt_mean, fmt_num, markdown_table
+from armtransfer.experiments.stats import metrics
+from armtransfer.learning import farming, methods, potentials, sarsa
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.experiments.reports.report import fmt_ci, fmt_mean, fmt_num, markdown_table
+from armtransfer.learning.shaping import Shaping
+from armtransfer.tasks.catalog import TABLE_I
+from armtransfer.tasks.robot import DiscreteRobot
 
 SHAPING = methods.BUILTIN_SHAPED
 """The built-in transfer methods (a plugin's are not part of the paper's reproduction)."""
@@ -198,10 +200,6 @@ def metrics_markdown(res: dict) -> str:
 def oracle_markdown(coarse: DiscreteRobot, fine: DiscreteRobot, trials: int, seed: int,
                     config: LearnerConfig) -> tuple[str, dict]:
     """The oracle control: a potential from the true map distance (no robot has it)."""
-    from armtransfer.learning import farming, potentials, sarsa
-    from armtransfer.experiments.stats import metrics
-    from armtransfer.learning.shaping import Shaping
-
     out = {}
     cells = []
     for t in TASKS:

@@ -12,16 +12,19 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from html import escape
 from typing import TYPE_CHECKING
 
 import armtransfer.checks as checks
 from armtransfer.errors import InvalidParameterError
-from armtransfer.experiments.experiment import MethodResult, trial_rng
+from armtransfer.experiments.experiment import MethodResult, summarize, trial_rng
+from armtransfer.experiments import frames, tables
 from armtransfer.learning import cells, linear
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.tiles import MAX_TABLE_BITS, TileCoding
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.catalog import Task
+from armtransfer.worlds.resolve import is_default, world_name
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -141,11 +144,7 @@ class ContinuousResult:
     methods: dict[str, MethodResult]
 
     def to_json(self) -> dict:
-        from armtransfer.experiments.experiment import summarize
-
         summary = summarize(list(self.methods.values()), baseline="none" if "none" in self.methods else "")
-        from armtransfer.worlds.resolve import is_default, world_name
-
         t = self.task
         world = {} if is_default(t.layout) else {"world": world_name(t.layout)}  # the rooms' JSON is as it was
         return {"state": "continuous", "task": {"name": t.name, "start": list(t.start), "goal": list(t.goal)},
@@ -159,13 +158,11 @@ class ContinuousResult:
         """The table of :meth:`__repr__` and :meth:`_repr_html_`: a header, then per method its
         mean exploration steps with their 95% CI, how many trials reached the goal and
         converged, and the improvement over ``none``."""
-        from armtransfer.experiments.reports import report
-
         rows = [["method", "mean exploration steps [95% CI]", "reached", "converged", "improvement"]]
         for m, e in out["results"].items():
             imp = e.get("improvement_percent")
             conv = e.get("converged", [])
-            rows.append([m, f"{report.fmt_mean(e)} {report.fmt_ci(e['ci95'])}", report.fmt_reached(e),
+            rows.append([m, f"{tables.fmt_mean(e)} {tables.fmt_ci(e['ci95'])}", tables.fmt_reached(e),
                          f"{sum(bool(c) for c in conv)}/{len(conv)}", "" if imp is None else f"{imp:+.1f}%"])
         return rows
 
@@ -184,8 +181,6 @@ class ContinuousResult:
 
     def _repr_html_(self) -> str:
         """What Jupyter shows: the heading and the table of :meth:`__repr__`, as HTML."""
-        from html import escape
-
         rows = self._rows(self.to_json())
         head = "".join(f"<th>{escape(c)}</th>" for c in rows[0])
         body = "".join("<tr>" + "".join(f"<td>{escape(c)}</td>" for c in r) + "</tr>" for r in rows[1:])
@@ -199,9 +194,6 @@ class ContinuousResult:
         tile coding, every learner setting). A trial that never reached the goal has
         ``reached`` False and ``exploration_steps`` missing, censored at ``step_cap``. Needs
         pandas (``pip install 'armtransfer[frames]'``)."""
-        from armtransfer.experiments.reports import frames
-        from armtransfer.experiments.results import _per_trial
-
         frames.pandas()
         out = self.to_json()
         t = self.task
@@ -212,5 +204,5 @@ class ContinuousResult:
                     **self.config.to_dict()}
         rows = []
         for m, entry in out["results"].items():
-            rows += frames.trial_rows(m, None, _per_trial(entry, self.config.max_total_steps), settings)
+            rows += frames.trial_rows(m, None, frames.per_trial_columns(entry, self.config.max_total_steps), settings)
         return frames.frame(rows)

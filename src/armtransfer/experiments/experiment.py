@@ -16,17 +16,17 @@ import numpy as np
 
 from armtransfer.cpus import cpus as _cpus
 from armtransfer.errors import InvalidParameterError
-from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.experiments.stats import learning_metrics as lm, metrics
 from armtransfer.learning import controls, farming, methods, potentials, sarsa
-from armtransfer.learning.trial_result import TrialResult
-from armtransfer.experiments.stats import metrics
-from armtransfer.learning.controls import CONTROLS
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.controls import CONTROLS
 from armtransfer.learning.lazy_registry import Names
 from armtransfer.learning.mapping import DEFAULT_MAX_SPAN, ActionMapping, MacroTable
 from armtransfer.learning.shaping import Shaping
 from armtransfer.learning.trajectory import Trajectory
+from armtransfer.learning.trial_result import TrialResult
+from armtransfer.tasks.robot import DiscreteRobot
 
 T = TypeVar("T")
 SHAPING_METHODS = methods.SHAPED
@@ -449,8 +449,6 @@ def control_trajectories(
 
 def add_transfer_metrics(summary: dict, optimal: int, baseline: str = "none") -> None:
     """Add Taylor and Stone's metrics (``transfer.learning_metrics``) to every method."""
-    from armtransfer.experiments.stats import learning_metrics as lm
-
     base = summary.get(baseline)
     if base is None:
         return

@@ -12,10 +12,12 @@ by ``ContinuousArm.move``. An arm with actuation noise has no compiled move: Non
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numba
 
-from armtransfer.ik import fastmove, fastmove3d
-from armtransfer.learning import linear
+from armtransfer.ik import fastline, fastmove, fastmove3d
+from armtransfer.learning import jitcache, linear, sarsa, tiles, traces
 
 REACHED, LIMIT, REFILL, PYTHON = range(4)
 
@@ -106,10 +108,6 @@ def episode_steps(arm) -> linear.EpisodeSteps | None:
 def _stale_caches() -> None:
     """numba keys a cached kernel on its own file only: empty these kernels' caches when a file
     they call into changed (``learning.jitcache``)."""
-    from pathlib import Path
-
-    from armtransfer.learning import jitcache, sarsa, tiles, traces
-
     arcs = Path(fastmove.__file__).with_name("arcs.py")
     jitcache.invalidate_stale(fastmove.__name__, [fastmove._touches_now, fastmove._touches, fastmove.move,
                                                   fastmove.planar_move],
@@ -119,8 +117,6 @@ def _stale_caches() -> None:
     handles = Path(fastmove3d.__file__).with_name("handles.py")
     jitcache.invalidate_stale(fastmove3d.__name__, [fastmove3d.move, fastmove3d.spatial_move],
                               [swept, handles, fastmove.__file__])
-    from armtransfer.ik import fastline
-
     jitcache.invalidate_stale(fastline.__name__, [fastline.line_move], [swept, handles, fastmove.__file__])
     jitcache.invalidate_stale(__name__, [_run, _run3d], [fastmove.__file__, fastmove3d.__file__, swept, handles, arcs,
                                                          linear.__file__, tiles.__file__, traces.__file__,

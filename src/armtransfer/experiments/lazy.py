@@ -8,16 +8,16 @@ from __future__ import annotations
 
 def scipy_stats():
     """``scipy.stats``."""
-    from scipy import stats
+    from scipy import stats  # start-up (the module docstring)
 
     return stats
 
 
 def pyplot():
     """``matplotlib.pyplot`` on the Agg backend (files only, no window)."""
-    import matplotlib
+    import matplotlib  # start-up (the module docstring)
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # start-up (the module docstring)
 
     return plt

@@ -25,10 +25,13 @@ import numpy as np
 
 from armtransfer.errors import InvalidParameterError
 from armtransfer.experiments import sweep as sweeps
+from armtransfer.experiments.lazy import pyplot
+from armtransfer.experiments.tables import markdown_table
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.learner_names import SARSA, label, parse_label
 from armtransfer.learning.methods import with_baselines
-from armtransfer.experiments.reports.report import markdown_table
+from armtransfer.models import ARMS
+from armtransfer.tasks.grid_robots import GRID_ROBOTS
 
 BOOTSTRAP = 2000
 BOOTSTRAP_SEED = 0
@@ -37,9 +40,6 @@ BOOTSTRAP_SEED = 0
 def family(spec: str) -> str:
     """A robot's family, for grouping: ``grid``, ``planar``/``spatial`` (built-in arms, by
     kind), ``gen-FAMILY`` (generated arms), ``custom`` (an arm file)."""
-    from armtransfer.models import ARMS
-    from armtransfer.tasks.grid_robots import GRID_ROBOTS
-
     if spec in GRID_ROBOTS:
         return "grid"
     name = spec.split(":")[0]
@@ -205,11 +205,7 @@ def markdown(all_cells: list[Cell], robots: list[str]) -> str:
 
 def heatmap_png(all_cells: list[Cell], robots: list[str]) -> bytes:
     """The heatmaps (one panel per method) as PNG bytes."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     methods = sorted({c.method for c in all_cells})
     n = len(robots)
     fig, axes = plt.subplots(1, len(methods), figsize=(1.1 * n * len(methods) + 2, 1.0 * n + 2), squeeze=False)

@@ -6,7 +6,7 @@ with every trial (:class:`~armtransfer.learning.trial_result.TrialResult`). Cont
 given a shuffled or random trajectory) are kept apart, under ``controls[kind][method]``.
 
 ``to_json()`` is exactly what ``armtransfer rooms --json`` and ``armtransfer arms`` write;
-``to_frame()`` is a tidy pandas DataFrame, one row per trial (``armtransfer.experiments.reports.frames``).
+``to_frame()`` is a tidy pandas DataFrame, one row per trial (``armtransfer.experiments.frames``).
 ``repr()`` is a few lines (task, robots, each method's headline numbers), and in Jupyter the
 result shows the table ``armtransfer rooms`` prints.
 """
@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from armtransfer.experiments.reports import frames, report
+from armtransfer.experiments import frames, tables
 from armtransfer.experiments.experiment import MethodResult, summary_of
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import ActionMapping
@@ -92,17 +92,17 @@ class TransferResult:
         rows = [["method", "mean exploration steps [95% CI]", "reached", "improvement"]]
         for run, e in zip(self.runs(), self._entries(out)):
             imp = e.get("improvement_percent")
-            rows.append([run.label, f"{report.fmt_mean(e)} {report.fmt_ci(e['ci95'])}", report.fmt_reached(e),
+            rows.append([run.label, f"{tables.fmt_mean(e)} {tables.fmt_ci(e['ci95'])}", tables.fmt_reached(e),
                          "" if imp is None else f"{imp:+.1f}%"])
         widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
         lines = ["  " + "  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows]
-        return f"<TransferResult {report.transfer_heading(out)}\n" + "\n".join(lines) + ">"
+        return f"<TransferResult {tables.transfer_heading(out)}\n" + "\n".join(lines) + ">"
 
     def _repr_markdown_(self) -> str:
         """What Jupyter shows: the heading and table ``armtransfer rooms`` prints."""
         out = self.to_json()
-        text = f"**{report.transfer_heading(out)}**\n\n{report.transfer_table(out)}"
-        return text + (f"\n\n{report.CONTROLS_NOTE}" if out["controls"] else "")
+        text = f"**{tables.transfer_heading(out)}**\n\n{tables.transfer_table(out)}"
+        return text + (f"\n\n{tables.CONTROLS_NOTE}" if out["controls"] else "")
 
     def _entries(self, out: dict) -> list[dict]:
         """The summary entries of :meth:`runs`, in that order."""
@@ -125,7 +125,8 @@ class TransferResult:
                     **self.config.to_dict()}
         rows = []
         for run, entry in zip(self.runs(), self._entries(out)):
-            rows += frames.trial_rows(run.method, run.control, _per_trial(entry, self.config.max_total_steps), settings)
+            rows += frames.trial_rows(run.method, run.control, frames.per_trial_columns(entry, self.config.max_total_steps),
+                                     settings)
         return frames.frame(rows)
 
     def to_json(self) -> dict:
@@ -151,22 +152,3 @@ class TransferResult:
             "results": {m: summary[r.label] for m, r in self.methods.items()},
             "controls": {kind: {m: summary[r.label] for m, r in by.items()} for kind, by in self.controls.items()},
         }
-
-
-PER_TRIAL = ("exploration_steps", "converged", "total_steps", "greedy_steps", "episodes", "mapped_fraction",
-             "macro_steps_first_episode", "good_path_steps", "shortest_path_steps", "settled_ratio", "final_ratio",
-             "optimal", "good_len", "steps_run")
-"""The per-trial lists of a summary entry that a frame takes as columns."""
-
-
-def _per_trial(entry: dict, cap: int) -> dict:
-    """A summary entry's per-trial metrics by column name (the K used, the step cap, ``cap``
-    where the entry names none, and the transfer metrics included)."""
-    out = {name: entry[name] for name in PER_TRIAL if name in entry}
-    if "K" in entry:
-        out["K_used"] = entry["K"]
-    out["step_cap"] = entry.get("cap") or cap
-    for name, block in entry.get("transfer_metrics", {}).items():
-        if isinstance(block, dict) and "per_trial" in block:
-            out[name] = block["per_trial"]
-    return out

@@ -39,9 +39,18 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
-from armtransfer.io import parse_user_file_bytes
-from armtransfer.errors import InvalidParameterError
+from armtransfer.errors import ArmTransferError, InvalidParameterError, InvalidWorldError
 from armtransfer.experiments import suite_model as suites
+from armtransfer.io import parse_user_file_bytes
+from armtransfer.learning import learners, methods
+from armtransfer.models import ARMS
+from armtransfer.tasks.arms import parse_robot_spec
+from armtransfer.tasks.catalog import custom_task, world_task
+from armtransfer.tasks.grid_robots import GRID_ROBOTS
+from armtransfer.tasks.specs import resolve
+from armtransfer.worlds.files import layout_data
+from armtransfer.worlds.generate import PREFIX
+from armtransfer.worlds.resolve import FILE_WORLDS, VALID, world
 
 DATA = Path(__file__).resolve().parent / "suite_data"
 MAX_BYTES = 1 << 20
@@ -158,11 +167,6 @@ class _Worlds:
         if isinstance(value, str) and (value in self.seen or value in self.content or (
                 not self.check and not value.lower().endswith((".toml", ".json")))):
             return self.seen.get(value, value)  # a world the suite carries, or a name of a shipped suite's
-        from armtransfer.errors import InvalidWorldError
-        from armtransfer.worlds.files import layout_data
-        from armtransfer.worlds.generate import PREFIX
-        from armtransfer.worlds.resolve import FILE_WORLDS, VALID, world
-
         if not isinstance(value, str) or not value:
             raise _fail(where, f"world must be a name or a layout file; valid worlds: {VALID}; got {value!r}")
         builtin = value == suites.DEFAULT_WORLD or value in FILE_WORLDS or value.split(":")[0] == PREFIX
@@ -183,9 +187,6 @@ class _Worlds:
 
     def task(self, world: str, case: suites.Case, where: str) -> None:
         """``case``'s task or cells checked on its world (when this file's worlds were loaded)."""
-        from armtransfer.errors import ArmTransferError
-        from armtransfer.tasks.catalog import custom_task, world_task
-
         layout = self.layouts.get(world)
         if layout is None:
             return
@@ -253,18 +254,10 @@ def _robot(value: object, where: str, key: str, check: bool = True) -> str:
         raise _fail(where, f"{key} must be a robot name, got {value!r}")
     if not check:
         return value
-    from armtransfer.errors import ArmTransferError
-    from armtransfer.models import ARMS
-    from armtransfer.tasks.grid_robots import GRID_ROBOTS
-
     try:
         if value.partition(":")[0] in ARMS:
-            from armtransfer.tasks.arms import parse_robot_spec
-
             parse_robot_spec(value)
         elif value not in GRID_ROBOTS and not value.startswith("gen:") and ".xml" not in value:
-            from armtransfer.tasks.specs import resolve
-
             resolve(value)  # not a robot: its one-line error, listing the valid ones
     except ArmTransferError as err:
         raise _fail(where, f"{key}: {err}") from None
@@ -286,8 +279,6 @@ def _shared(t: dict, where: str, inherited: dict, check: bool) -> dict:
 
 
 def _methods(value: object, where: str) -> tuple[str, ...]:
-    from armtransfer.learning import methods
-
     names = _names(value, where, "methods")
     try:
         return tuple(methods.get(n).name for n in names)
@@ -296,10 +287,8 @@ def _methods(value: object, where: str) -> tuple[str, ...]:
 
 
 def _learners(value: object, where: str) -> tuple[str, ...]:
-    from armtransfer.learning.learners import parse
-
     try:
-        return parse(list(_names(value, where, "learners")))
+        return learners.parse(list(_names(value, where, "learners")))
     except InvalidParameterError as err:
         raise _fail(where, str(err)) from None
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 
 from armtransfer.errors import InvalidParameterError
+from armtransfer.worlds.resolve import layout_of_data
 
 METHODS = ("none", "pseudo", "dense", "guided", "plan", "goal-only", "pseudo-plan", "corridor")
 """The methods every suite runs (those this build's registry has), each beside its baseline."""
@@ -162,6 +163,4 @@ class Suite:
 
     def layouts(self) -> dict:
         """The worlds of :attr:`worlds`, by id (``worlds.layout.Layout``)."""
-        from armtransfer.worlds.resolve import layout_of_data
-
         return {k: layout_of_data(v, f"suite {self.name!r}: world {k!r}") for k, v in self.worlds.items()}

@@ -5,6 +5,8 @@ suite file named on the command line. What a suite is: ``experiments.suite_model
 from __future__ import annotations
 
 from armtransfer.errors import InvalidParameterError
+from armtransfer.experiments import suite_files
+from armtransfer.experiments.suite_files import builtin
 from armtransfer.experiments.suite_model import (
     BUDGET_FACTOR as BUDGET_FACTOR, CELLS as CELLS, DEFAULT_LEARNERS as DEFAULT_LEARNERS,
     DEFAULT_WORLD as DEFAULT_WORLD, METHODS as METHODS, MIN_SEEDS_FOR_CLAIM as MIN_SEEDS_FOR_CLAIM,
@@ -12,8 +14,6 @@ from armtransfer.experiments.suite_model import (
 
 
 def _load() -> dict[str, Suite]:
-    from armtransfer.experiments.suite_files import builtin
-
     return builtin()
 
 
@@ -38,8 +38,6 @@ def get(name: str) -> Suite:
 
 def named(text: str) -> Suite:
     """The suite ``--suite TEXT`` names: a built-in one, or a suite file (``.toml``, ``.json``)."""
-    from armtransfer.experiments import suite_files
-
     return suite_files.load(text, SUITES) if suite_files.is_file_name(text) else get(text)
 
 

@@ -37,15 +37,16 @@ from __future__ import annotations
 
 import itertools
 import math
+import sys
 from collections import deque
 
 import mujoco
 import numpy as np
 
 from armtransfer.errors import ArmModelError, UnreachableTableError
+from armtransfer.ik.diagnose import why_unreachable
 from armtransfer.ik.labels import OFF_TABLE, cells_of_xy
 from armtransfer.ik.scene import ArmScene, ContactChecker, _support
-from armtransfer.ik.diagnose import why_unreachable
 from armtransfer.ik.seeds import RING, SEED_RESTARTS, _cells_by_distance, reach_bound, seed_cells  # noqa: F401
 from armtransfer.ik.solve import MAX_TIP_HEIGHT, TIP_HEIGHT, TipIK
 from armtransfer.ik.sweep import SweepChecker
@@ -171,8 +172,6 @@ def _shown_clear(q0: np.ndarray, j: int, step: float, n: int, reach: float, exte
 
 def _progress(enabled: bool, text: str) -> None:
     if enabled:
-        import sys
-
         print(text, file=sys.stderr, flush=True)
 
 

@@ -43,10 +43,10 @@ import mujoco
 import numpy as np
 
 from armtransfer.errors import ArmModelError, InvalidCellError, UnreachableTableError
-from armtransfer.ik import swept
+from armtransfer.ik import fastline, fastmove, handles, swept
 from armtransfer.ik.arcs import _cell, _sweep, _sweep_turn
-from armtransfer.ik.fastmove import PYTHON
 from armtransfer.ik.compile import joint_box, near_wall_mask
+from armtransfer.ik.fastmove import PYTHON
 from armtransfer.ik.labels import OFF_TABLE, cells_of_xy
 from armtransfer.ik.scene import ArmScene, ContactChecker
 from armtransfer.ik.solve import TipIK
@@ -445,8 +445,6 @@ class ContinuousArm(NoisyJointMoves):
         """The table ``ik.fastline.line_move`` reads, or None (no compiled move)."""
         if self._line_table is not None:
             return self._line_table
-        from armtransfer.ik import fastline, handles
-
         if self._fast is False:
             self._fast = self._build_fast()
         if not isinstance(self._fast, tuple):
@@ -570,8 +568,6 @@ class ContinuousArm(NoisyJointMoves):
             if state is None:
                 return self.move(a)
             if self._table is None:
-                from armtransfer.ik import fastmove, handles
-
                 self._table = handles.of_state(fastmove.PLANAR, state)
                 self._kernel = fastmove.planar_move
             self._fresh = True
@@ -599,8 +595,6 @@ class ContinuousArm(NoisyJointMoves):
         self.moves = int(state[26][0])
 
     def _build_fast(self) -> tuple | None:
-        from armtransfer.ik import fastmove
-
         c = self.checker
         g = np.arange(self.model.ngeom)
         grid1, grid2 = np.meshgrid(g, g, indexing="ij")

@@ -39,9 +39,9 @@ import mujoco
 import numpy as np
 
 from armtransfer.errors import ArmModelError, InvalidCellError, UnreachableTableError
+from armtransfer.ik import fastline, fastmove, fastmove3d, handles, swept
 from armtransfer.ik.compile import joint_box
 from armtransfer.ik.continuous import BLOCKED, MAX_NOISE, NoisyJointMoves
-from armtransfer.ik import swept
 from armtransfer.ik.fastmove import PYTHON
 from armtransfer.ik.scene import ArmScene, ContactChecker
 from armtransfer.ik.voxels import (SpatialFK, _move_clear, choose_step, moved_joints, spatial_origin,
@@ -374,8 +374,6 @@ class SpatialContinuousArm(NoisyJointMoves):
         compiled move)."""
         if self._line_table is not None or self._sampled or self._start is None:
             return self._line_table
-        from armtransfer.ik import fastline, handles
-
         if self._fast is False:
             self._fast = self._build_fast()
         if not isinstance(self._fast, tuple):
@@ -502,8 +500,6 @@ class SpatialContinuousArm(NoisyJointMoves):
             state = self.fast()
             if state is None:
                 return self.move(a)
-            from armtransfer.ik import fastmove3d, handles
-
             self._table = handles.of_state(fastmove3d.SPATIAL, state)
             self._kernel = fastmove3d.spatial_move
         elif self._noisy or self._off:
@@ -527,8 +523,6 @@ class SpatialContinuousArm(NoisyJointMoves):
         self._full[self._qidx] = self._q
 
     def _build_fast(self) -> tuple | None:
-        from armtransfer.ik import fastmove
-
         c = self.checker
         g = np.arange(self.model.ngeom)
         g1, g2 = (x.ravel() for x in np.meshgrid(g, g, indexing="ij"))

@@ -50,7 +50,7 @@ _COL: Any = None
 
 def _library():
     """``mj_kinematics`` and ``mj_collision`` of the bindings' own library, as ctypes functions."""
-    import mujoco
+    import mujoco  # here: experiments.fastloop imports this module and loads no MuJoCo
 
     global _KIN, _COL
     if _KIN is None:
@@ -73,7 +73,7 @@ def _int32_at(address: int, n: int) -> np.ndarray:
 def layout(model, data, counts: np.ndarray, configurations: np.ndarray) -> tuple | None:
     """The raw views the compiled move reads, checked against the bindings at ``configurations``
     (some with contacts), or None. Leaves ``data.qpos`` as it found it."""
-    import mujoco
+    import mujoco  # here: experiments.fastloop imports this module and loads no MuJoCo
 
     if _library() is None or not hasattr(data, "_address") or not hasattr(model, "_address"):
         return None

@@ -13,7 +13,7 @@ def check_joint_ranges(path: Path, where: str) -> None:
     """Raise a one-line :class:`ArmModelError` for the first joint of the arm file ``path`` whose
     range has its lower end above its upper. A file MuJoCo cannot compile is left to the
     loader, which says why."""
-    import mujoco
+    import mujoco  # here: tasks import this module and load no MuJoCo
 
     try:
         model = mujoco.MjSpec.from_file(str(path)).compile()

@@ -404,7 +404,7 @@ def _pad_even(frame: np.ndarray) -> np.ndarray:
 
 class _Writer:
     def __init__(self, tmp: str, fmt: str, fps: float, quality: int | None) -> None:
-        import imageio
+        import imageio  # start-up: only when a video is written
 
         self.fmt = fmt
         self._mp4: Format.Writer | None = None  # one of the two is set
@@ -415,7 +415,7 @@ class _Writer:
                 pixelformat="yuv420p", macro_block_size=1, quality=quality or 7,
                 ffmpeg_log_level="error", output_params=["-preset", "veryfast"])
         else:
-            import imageio.v3 as iio
+            import imageio.v3 as iio  # start-up: only when a GIF is written
 
             self._gif = iio.imopen(tmp, "w", plugin="pillow", extension=".gif")
             self._duration = 1000.0 / fps

@@ -370,116 +370,19 @@ def _simulate(robot, path_states: Sequence[int], *, goal_cell: int | None, segme
     data = mujoco.MjData(model)
     tip_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, scene.tip)
     way = np.asarray(qtable[states], dtype=float)
-    planned_tip = np.asarray(arm.tip[states], dtype=float) if arm.tip is not None else None
+    planned_tip = _planned_tips(robot, arm, model, data, way, states, tip_id)
 
-    data.qpos[:] = way[0]
-    data.ctrl[:] = _ctrl_of(model, way[0])
-    mujoco.mj_forward(model, data)
-    if planned_tip is not None and np.linalg.norm(data.site_xpos[tip_id] - planned_tip[0]) > 1e-5:
-        raise ReplayError(f"the rebuilt scene of {robot.name} does not match its compiled tips; "
-                          "recompile the robot")
-    if planned_tip is None:
-        planned_tip = np.array([_fk(model, data, q, tip_id) for q in way])
-        data.qpos[:] = way[0]
-        mujoco.mj_forward(model, data)
-
-    kv = _tune_gains(model, data, bandwidth_hz)
-    joint_of = model.actuator_trnid[:, 0]
-    dof_of = model.jnt_dofadr[joint_of]
-    qadr_of = model.jnt_qposadr[joint_of]
-    damping = model.dof_damping[dof_of] + kv
-    motors = [] if own_servos else _motors_in(model, arm)
-    tq = np.array([a for a, _ in motors], dtype=np.int64)  # the actuators (scene servos) they replace
-    tq_kp, tq_kv = model.actuator_gainprm[tq, 0].copy(), kv[tq]
-    tq_lo = np.array([m.lower for _, m in motors])
-    tq_hi = np.array([m.upper for _, m in motors])
-    tq_dof, tq_qadr = dof_of[tq], qadr_of[tq]
-    model.actuator_gainprm[tq, 0] = 0.0  # the joint's own servo does nothing: the motors drive it
-    model.actuator_biasprm[tq, :3] = 0.0
-    limited = model.actuator_forcelimited.astype(bool) & ~np.isin(np.arange(model.nu), tq)
-    f_lo, f_hi = model.actuator_forcerange[limited].T
-    at_limit = np.zeros(model.nu, dtype=np.int64)
-
+    run = _Drive(model, data, scene, tip_id, feedforward,
+                 _tune_gains(model, data, bandwidth_hz), [] if own_servos else _motors_in(model, arm))
     dt = float(model.opt.timestep)
     seg_steps = max(1, int(round(segment_seconds / dt)))
     settle_steps = int(round(settle_seconds / dt))
-    qpos_l: list[np.ndarray] = [data.qpos.copy()]
-    tip_l: list[np.ndarray] = [data.site_xpos[tip_id].copy()]
-    depth_l: list[float] = [0.0]
-    waypoint_index = np.zeros(len(way), dtype=np.int64)
-    env, moving = scene.env_geoms, scene.arm_geoms
-    deepest: list = [0.0, (-1, -1)]  # depth (m), geoms
-
-    def step(ctrl_q: np.ndarray, vel_q: np.ndarray) -> None:
-        data.ctrl[:] = ctrl_q[qadr_of]
-        mujoco.mj_step1(model, data)
-        if feedforward:
-            data.qfrc_applied[:] = data.qfrc_bias
-            data.qfrc_applied[dof_of] += damping * vel_q[qadr_of]
-        if len(tq):  # computed torque, within the motors' range
-            base = data.qfrc_applied[tq_dof] if feedforward else 0.0
-            tau = base + tq_kp * (ctrl_q[tq_qadr] - data.qpos[tq_qadr]) - tq_kv * data.qvel[tq_dof]
-            clipped = np.clip(tau, tq_lo, tq_hi)
-            at_limit[tq] += clipped != tau
-            data.qfrc_applied[tq_dof] = clipped
-        mujoco.mj_step2(model, data)
-        if limited.any():
-            force = data.actuator_force[limited]
-            at_limit[limited] += (force <= f_lo + 1e-9 * np.abs(f_lo)) | (force >= f_hi - 1e-9 * np.abs(f_hi))
-        depth = 0.0
-        n = data.ncon
-        if n:  # the contacts of this step's collision, at its start
-            g1, g2 = data.contact.geom1[:n], data.contact.geom2[:n]
-            hit = (env[g1] & moving[g2]) | (env[g2] & moving[g1])
-            if hit.any():
-                i = int(np.argmin(np.where(hit, data.contact.dist[:n], np.inf)))
-                depth = max(0.0, -float(data.contact.dist[i]))
-                if depth > deepest[0]:
-                    deepest[0], deepest[1] = depth, (int(g1[i]), int(g2[i]))
-        qpos_l.append(data.qpos.copy())
-        tip_l.append(data.site_xpos[tip_id].copy())
-        depth_l.append(depth)
-
-    probe = mujoco.MjData(model)
-    saved = mujoco.MjData(model)
-    miss = TRACKING_LIMIT * scene.cell
     slow_ok = not own_servos and max_slowdown > 1
-    factors = []
-    for i in range(1, len(way)):
-        q0, q1 = way[i - 1], way[i]
-        factor = 1
-        while True:
-            if slow_ok:
-                mujoco.mj_copyData(saved, model, data)
-                mark, limits, before = len(qpos_l), at_limit.copy(), list(deepest)
-            steps = seg_steps * factor
-            vel = (q1 - q0) / (steps * dt)
-            for j in range(1, steps + 1):
-                step(q0 + (q1 - q0) * (j / steps), vel)
-            if slow_ok and 2 * factor <= max_slowdown and np.any(at_limit > limits):
-                seg = _tips_of(model, np.array(qpos_l[mark:]), tip_id, probe)
-                off = polyline_distance(seg, planned_tip[i - 1:i + 1]).max()
-                if off > miss or np.linalg.norm(seg[-1] - planned_tip[i]) > miss:  # missed, saturated: slower
-                    mujoco.mj_copyData(data, model, saved)
-                    del qpos_l[mark:], tip_l[mark:], depth_l[mark:]
-                    at_limit[:] = limits
-                    deepest[:] = before
-                    factor *= 2
-                    continue
-            break
-        factors.append(factor)
-        waypoint_index[i] = len(qpos_l) - 1
+    factors, waypoint_index = run.follow(way, planned_tip, seg_steps, slow_ok, max_slowdown)
     zero = np.zeros(model.nq)
     for _ in range(settle_steps):
-        step(way[-1], zero)
-    k = len(qpos_l) - 1
-    qpos, tip, depths = np.array(qpos_l), np.array(tip_l), np.array(depth_l)
-    # site_xpos after mj_step2 is from the step's start; refresh the last sample exactly.
-    mujoco.mj_kinematics(model, data)
-    tip[k] = data.site_xpos[tip_id]
-    # Likewise every recorded tip lags its qpos by one step: recompute them from qpos.
-    if k > 1:
-        tip[1:k] = _tips_of(model, qpos[1:k], tip_id)
+        run.step(way[-1], zero)
+    qpos, tip, depths = run.recorded()
 
     layout = scene.layout
     planned_cells = _dedupe(robot.label[states].tolist())
@@ -491,18 +394,161 @@ def _simulate(robot, path_states: Sequence[int], *, goal_cell: int | None, segme
                                 "slowed_segments": sum(f > 1 for f in factors)}
     if slow_ok:
         settings["max_slowdown"] = max_slowdown
-    if motors:
-        settings["torque_motors"] = {m.joint: {"actuators": list(m.actuators), "torque_range": [m.lower, m.upper],
-                                               "steps_at_limit": int(at_limit[a])} for a, m in motors}
-    names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_ACTUATOR, a) or f"#{a}" for a in range(model.nu)]
-    for a, m in motors:  # a joint the motors drive is named by them, not by the servo that stood in
-        names[a] = "+".join(m.actuators)
-    settings["at_limit_steps"] = {names[a].removeprefix(PREFIX): int(at_limit[a]) for a in range(model.nu)}
+    settings.update(run.limit_settings())
     return Replay(robot=robot.name, scene=scene, path_states=tuple(states), goal_cell=goal,
-                  planned_xy=planned_xy, planned_tip=planned_tip, time=np.arange(k + 1) * dt,
+                  planned_xy=planned_xy, planned_tip=planned_tip, time=np.arange(len(qpos)) * dt,
                   qpos=qpos, tip=tip, waypoint_index=waypoint_index, penetration=depths,
-                  penetration_what=_contact_name(model, scene, *deepest[1]) if deepest[0] > 0 else "",
+                  penetration_what=_contact_name(model, scene, *run.deepest[1]) if run.deepest[0] > 0 else "",
                   settings=settings)
+
+
+def _planned_tips(robot, arm: ArmDescription, model: mujoco.MjModel, data: mujoco.MjData, way: np.ndarray,
+                  states: list[int], tip_id: int) -> np.ndarray:
+    """Put the arm at the first waypoint; the compiled tips of the path (checked against the
+    rebuilt scene), or the scene's own where the description has none."""
+    planned_tip = np.asarray(arm.tip[states], dtype=float) if arm.tip is not None else None
+    data.qpos[:] = way[0]
+    data.ctrl[:] = _ctrl_of(model, way[0])
+    mujoco.mj_forward(model, data)
+    if planned_tip is not None and np.linalg.norm(data.site_xpos[tip_id] - planned_tip[0]) > 1e-5:
+        raise ReplayError(f"the rebuilt scene of {robot.name} does not match its compiled tips; "
+                          "recompile the robot")
+    if planned_tip is None:
+        planned_tip = np.array([_fk(model, data, q, tip_id) for q in way])
+        data.qpos[:] = way[0]
+        mujoco.mj_forward(model, data)
+    return planned_tip
+
+
+class _Drive:
+    """The arm driven through one replay: its servos (and torque motors) step by step, with
+    what each step recorded (qpos, tip, deepest contact) and the steps each actuator spent at
+    its force limit."""
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, scene: ArmScene, tip_id: int,
+                 feedforward: bool, kv: np.ndarray, motors: list) -> None:
+        self.model, self.data, self.scene, self.tip_id, self.feedforward = model, data, scene, tip_id, feedforward
+        joint_of = model.actuator_trnid[:, 0]
+        self.dof_of = model.jnt_dofadr[joint_of]
+        self.qadr_of = model.jnt_qposadr[joint_of]
+        self.damping = model.dof_damping[self.dof_of] + kv
+        self.motors = motors
+        tq = np.array([a for a, _ in motors], dtype=np.int64)  # the actuators (scene servos) they replace
+        self.tq = tq
+        self.tq_kp, self.tq_kv = model.actuator_gainprm[tq, 0].copy(), kv[tq]
+        self.tq_lo = np.array([m.lower for _, m in motors])
+        self.tq_hi = np.array([m.upper for _, m in motors])
+        self.tq_dof, self.tq_qadr = self.dof_of[tq], self.qadr_of[tq]
+        model.actuator_gainprm[tq, 0] = 0.0  # the joint's own servo does nothing: the motors drive it
+        model.actuator_biasprm[tq, :3] = 0.0
+        self.limited = model.actuator_forcelimited.astype(bool) & ~np.isin(np.arange(model.nu), tq)
+        self.f_lo, self.f_hi = model.actuator_forcerange[self.limited].T
+        self.at_limit = np.zeros(model.nu, dtype=np.int64)
+        self.qpos_l: list[np.ndarray] = [data.qpos.copy()]
+        self.tip_l: list[np.ndarray] = [data.site_xpos[tip_id].copy()]
+        self.depth_l: list[float] = [0.0]
+        self.env, self.moving = scene.env_geoms, scene.arm_geoms
+        self.deepest: list = [0.0, (-1, -1)]  # depth (m), geoms
+
+    def step(self, ctrl_q: np.ndarray, vel_q: np.ndarray) -> None:
+        model, data, tq = self.model, self.data, self.tq
+        data.ctrl[:] = ctrl_q[self.qadr_of]
+        mujoco.mj_step1(model, data)
+        if self.feedforward:
+            data.qfrc_applied[:] = data.qfrc_bias
+            data.qfrc_applied[self.dof_of] += self.damping * vel_q[self.qadr_of]
+        if len(tq):  # computed torque, within the motors' range
+            base = data.qfrc_applied[self.tq_dof] if self.feedforward else 0.0
+            tau = (base + self.tq_kp * (ctrl_q[self.tq_qadr] - data.qpos[self.tq_qadr])
+                   - self.tq_kv * data.qvel[self.tq_dof])
+            clipped = np.clip(tau, self.tq_lo, self.tq_hi)
+            self.at_limit[tq] += clipped != tau
+            data.qfrc_applied[self.tq_dof] = clipped
+        mujoco.mj_step2(model, data)
+        limited = self.limited
+        if limited.any():
+            force = data.actuator_force[limited]
+            f_lo, f_hi = self.f_lo, self.f_hi
+            self.at_limit[limited] += (force <= f_lo + 1e-9 * np.abs(f_lo)) | (force >= f_hi - 1e-9 * np.abs(f_hi))
+        depth = 0.0
+        n = data.ncon
+        if n:  # the contacts of this step's collision, at its start
+            env, moving, deepest = self.env, self.moving, self.deepest
+            g1, g2 = data.contact.geom1[:n], data.contact.geom2[:n]
+            hit = (env[g1] & moving[g2]) | (env[g2] & moving[g1])
+            if hit.any():
+                i = int(np.argmin(np.where(hit, data.contact.dist[:n], np.inf)))
+                depth = max(0.0, -float(data.contact.dist[i]))
+                if depth > deepest[0]:
+                    deepest[0], deepest[1] = depth, (int(g1[i]), int(g2[i]))
+        self.qpos_l.append(data.qpos.copy())
+        self.tip_l.append(data.site_xpos[self.tip_id].copy())
+        self.depth_l.append(depth)
+
+    def follow(self, way: np.ndarray, planned_tip: np.ndarray, seg_steps: int, slow_ok: bool,
+               max_slowdown: int) -> tuple[list[int], np.ndarray]:
+        """Ramp through the waypoints, a segment slowed down (``slow_ok``) where the file's
+        actuators missed it at their force limit; each segment's factor and the step at which
+        each waypoint was reached."""
+        model, data, tip_id = self.model, self.data, self.tip_id
+        qpos_l, tip_l, depth_l, at_limit, deepest = self.qpos_l, self.tip_l, self.depth_l, self.at_limit, self.deepest
+        dt = float(model.opt.timestep)
+        waypoint_index = np.zeros(len(way), dtype=np.int64)
+        probe = mujoco.MjData(model)
+        saved = mujoco.MjData(model)
+        miss = TRACKING_LIMIT * self.scene.cell
+        factors = []
+        for i in range(1, len(way)):
+            q0, q1 = way[i - 1], way[i]
+            factor = 1
+            while True:
+                if slow_ok:
+                    mujoco.mj_copyData(saved, model, data)
+                    mark, limits, before = len(qpos_l), at_limit.copy(), list(deepest)
+                steps = seg_steps * factor
+                vel = (q1 - q0) / (steps * dt)
+                for j in range(1, steps + 1):
+                    self.step(q0 + (q1 - q0) * (j / steps), vel)
+                if slow_ok and 2 * factor <= max_slowdown and np.any(at_limit > limits):
+                    seg = _tips_of(model, np.array(qpos_l[mark:]), tip_id, probe)
+                    off = polyline_distance(seg, planned_tip[i - 1:i + 1]).max()
+                    if off > miss or np.linalg.norm(seg[-1] - planned_tip[i]) > miss:  # missed, saturated: slower
+                        mujoco.mj_copyData(data, model, saved)
+                        del qpos_l[mark:], tip_l[mark:], depth_l[mark:]
+                        at_limit[:] = limits
+                        deepest[:] = before
+                        factor *= 2
+                        continue
+                break
+            factors.append(factor)
+            waypoint_index[i] = len(qpos_l) - 1
+        return factors, waypoint_index
+
+    def recorded(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """qpos, tip and deepest contact of every step, the tips recomputed from qpos."""
+        model, data, tip_id = self.model, self.data, self.tip_id
+        k = len(self.qpos_l) - 1
+        qpos, tip, depths = np.array(self.qpos_l), np.array(self.tip_l), np.array(self.depth_l)
+        # site_xpos after mj_step2 is from the step's start; refresh the last sample exactly.
+        mujoco.mj_kinematics(model, data)
+        tip[k] = data.site_xpos[tip_id]
+        # Likewise every recorded tip lags its qpos by one step: recompute them from qpos.
+        if k > 1:
+            tip[1:k] = _tips_of(model, qpos[1:k], tip_id)
+        return qpos, tip, depths
+
+    def limit_settings(self) -> dict[str, Any]:
+        """The torque motors and the steps each actuator spent at its force limit."""
+        model, at_limit, motors = self.model, self.at_limit, self.motors
+        settings: dict[str, Any] = {}
+        if motors:
+            settings["torque_motors"] = {m.joint: {"actuators": list(m.actuators), "torque_range": [m.lower, m.upper],
+                                                   "steps_at_limit": int(at_limit[a])} for a, m in motors}
+        names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_ACTUATOR, a) or f"#{a}" for a in range(model.nu)]
+        for a, m in motors:  # a joint the motors drive is named by them, not by the servo that stood in
+            names[a] = "+".join(m.actuators)
+        settings["at_limit_steps"] = {names[a].removeprefix(PREFIX): int(at_limit[a]) for a in range(model.nu)}
+        return settings
 
 
 def _motors_in(model: mujoco.MjModel, arm: ArmDescription) -> list:

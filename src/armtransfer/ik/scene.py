@@ -27,6 +27,7 @@ import hashlib
 import math
 import os
 import warnings
+import xml.etree.ElementTree as ET
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -37,9 +38,9 @@ import mujoco
 import numpy as np
 
 from armtransfer.errors import ArmModelError
-from armtransfer.io import check_input
 from armtransfer.ik.tool import Tool
 from armtransfer.ik.workspace import DEFAULT_CELL, WALL_HEIGHT, build_workspace
+from armtransfer.io import check_input
 
 if TYPE_CHECKING:  # the layout is passed in from armtransfer.tasks, never imported
     from armtransfer.worlds.layout import Layout
@@ -255,8 +256,6 @@ def model_files(path: Path) -> list[Path]:
 
 def _includes(path: Path, root: Path, seen: set[Path]) -> list[Path]:
     """The files ``path`` includes, recursively (relative names from the main file's folder)."""
-    import xml.etree.ElementTree as ET
-
     out: list[Path] = []
     try:
         tree = ET.parse(path)

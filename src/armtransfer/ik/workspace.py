@@ -73,7 +73,7 @@ def wall_boxes(layout: Layout, cell: float = DEFAULT_CELL,
 def build_workspace(layout: Layout, cell: float = DEFAULT_CELL,
                     wall_height: float = WALL_HEIGHT):
     """The table scene as a ``mujoco.MjSpec`` (arms are attached to it)."""
-    import mujoco
+    import mujoco  # here: tasks import this module and load no MuJoCo
 
     if not cell > 0:
         raise ValueError(f"cell size must be positive, got {cell}")

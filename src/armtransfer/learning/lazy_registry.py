@@ -19,10 +19,16 @@ registered later.
 from __future__ import annotations
 
 import os
+import signal
 import threading
+import time
 import warnings
 from collections.abc import Callable, Iterator, MutableMapping, Sequence
+from importlib.metadata import entry_points
 from typing import Generic, TypeVar, overload
+
+from armtransfer.errors import InvalidParameterError, PluginError
+from armtransfer.learning.plugin_calls import fault
 
 V = TypeVar("V")
 
@@ -40,8 +46,6 @@ class PluginWarning(UserWarning):
 
 def plugins_skipped() -> bool:
     """Whether :data:`SKIP_ENV` says to read no installed plugin (a bad value: one line)."""
-    from armtransfer.errors import InvalidParameterError
-
     value = os.environ.get(SKIP_ENV, "").strip()
     if value not in ("", "0", "1"):
         raise InvalidParameterError(f"environment variable {SKIP_ENV} must be 1 (read no installed plugin) or 0, "
@@ -88,8 +92,6 @@ class Registry(MutableMapping[str, V], Generic[V]):
     def __getitem__(self, name: str) -> V:
         self.ensure_loaded()
         if name not in self._entries and isinstance(name, str) and name in self.broken:
-            from armtransfer.errors import PluginError
-
             raise PluginError(self.broken[name][0])
         return self._entries[name]
 
@@ -183,10 +185,6 @@ def read_entry_points(group: str, registry: Registry[V], kind: str, check: Calla
     entry point's name must be the entry's own, and no name may be taken twice. A fault is a
     :class:`~armtransfer.errors.PluginError` naming the plugin, and then nothing is returned, so
     nothing is added. ``kind`` ("method", "learner") names the entries in the errors."""
-    from importlib.metadata import entry_points
-
-    from armtransfer.errors import PluginError
-
     found: dict[str, V] = {}
     if plugins_skipped():
         return found
@@ -206,9 +204,6 @@ def read_entry_points(group: str, registry: Registry[V], kind: str, check: Calla
 
 def _read_one(ep: object, where: str, check: Callable[[object, str], V], registry: Registry[V], kind: str,
               named: Callable[[V], str], found: dict[str, V], claimed: dict[str, str]) -> V:
-    from armtransfer.errors import PluginError
-    from armtransfer.learning.plugin_calls import fault
-
     ep_name = str(getattr(ep, "name", "?"))
     first = claimed.setdefault(ep_name, where)
     if first != where:  # two plugins declare one name: neither is used
@@ -240,9 +235,6 @@ def _load_within(ep: object, seconds: float) -> object:
     """``ep.load()``, interrupted after ``seconds`` by a timer signal in the main thread (a
     Python-level wait or loop is interrupted; the import then fails and leaves nothing behind).
     Elsewhere, or under a timer of the caller's due sooner, without a limit."""
-    import signal
-    import time
-
     load = getattr(ep, "load")
     if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "setitimer"):
         return load()

@@ -26,6 +26,7 @@ benchmark runs it directly, not through ``make``.
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from dataclasses import replace as with_fields
@@ -36,6 +37,7 @@ import gymnasium
 from armtransfer.errors import InvalidParameterError, PluginError
 from armtransfer.learning.lazy_registry import Registry, read_entry_points
 from armtransfer.learning.learner_names import SARSA as SARSA  # the built-in learner's name
+from armtransfer.learning.plugins import NAME
 
 GROUP = "armtransfer.learners"
 """The entry-point group installed packages declare their learners under."""
@@ -106,8 +108,6 @@ _BUILTIN = {SARSA: Learner(SARSA, "SARSA(lambda), Algorithm 1, in the compiled k
 def check(learner: object, where: str) -> Learner:
     """``learner`` if it is a whole :class:`Learner`; else a one-line :class:`PluginError`
     beginning with ``where``."""
-    from armtransfer.learning.plugins import NAME
-
     if not isinstance(learner, Learner):
         raise PluginError(f"{where} is {type(learner).__name__}, not a learner; make it with "
                           "armtransfer.Learner(name, description, make)")
@@ -121,8 +121,6 @@ def check(learner: object, where: str) -> Learner:
         raise PluginError(f"{where}: learner {learner.name!r}: make must be a function (env, seed) -> model, "
                           f"got {learner.make!r}")
     if learner.options is not None:
-        import json
-
         try:
             if not isinstance(learner.options, Mapping) or not all(isinstance(k, str) for k in learner.options):
                 raise TypeError("not a mapping of names")

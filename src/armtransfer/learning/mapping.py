@@ -76,8 +76,9 @@ from pathlib import Path
 import numpy as np
 
 from armtransfer.errors import InvalidMappingError
-from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.io import read_json, write_text_atomic
 from armtransfer.learning.trajectory import Trajectory
+from armtransfer.tasks.robot import DiscreteRobot
 
 FORMAT = "armtransfer-mapping/1"
 
@@ -344,8 +345,6 @@ class ActionMapping:
 
     def save(self, path: str | os.PathLike) -> None:
         """Write the JSON form atomically, one entry per line (easy to read and diff)."""
-        from armtransfer.io import write_text_atomic
-
         data = self.to_json()
         entries = data.pop("entries")
         head = ",\n".join(f"  {json.dumps(k)}: {json.dumps(v)}" for k, v in data.items())
@@ -356,8 +355,6 @@ class ActionMapping:
 
     @staticmethod
     def load(path: str | os.PathLike) -> "ActionMapping":
-        from armtransfer.io import read_json
-
         data = read_json(path, "mapping file", InvalidMappingError)
         return ActionMapping.from_json(data, where=f"mapping file {str(Path(path))!r}")
 

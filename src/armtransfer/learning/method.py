@@ -5,6 +5,7 @@
 
 from __future__ import annotations
 
+import numbers
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -33,8 +34,6 @@ any useful shaping, and small enough that K times any bounded potential stays fi
 def check_k(K: object) -> float | str:
     """``K`` as a run takes it: 'auto', or a real number (numpy's too) in [0, :data:`MAX_K`];
     anything else is one line."""
-    import numbers
-
     if isinstance(K, str) and K == "auto":
         return K
     if isinstance(K, (bool, np.bool_)) or not isinstance(K, numbers.Real) or not np.isfinite(float(K)) \

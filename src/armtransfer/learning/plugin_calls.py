@@ -15,6 +15,7 @@ takes, the user reads one line naming the plugin and the call.
 
 from __future__ import annotations
 
+import numbers
 import os
 import select
 import signal
@@ -41,8 +42,6 @@ _stage_fd: int | None = None  # in a probe's child process: where it says which 
 
 def probe_seconds(value: object, what: str = "probe_timeout") -> float:
     """``value`` as a probe's time limit: a real number in (0, :data:`MAX_PROBE_SECONDS`]."""
-    import numbers
-
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise InvalidParameterError(f"{what} must be a number of seconds, got {value!r}")
     seconds = float(value)

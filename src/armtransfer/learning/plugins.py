@@ -31,6 +31,7 @@ from __future__ import annotations
 import numbers
 import re
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 
@@ -254,8 +255,6 @@ def _a_method(obj: object, where: str) -> Method:
 
 
 def _with_origin(method: Method, origin: str) -> Method:
-    from dataclasses import replace
-
     return replace(method, origin=origin)
 
 

@@ -86,13 +86,13 @@ def _require(name: str) -> None:
 
 
 def _global_states() -> tuple[Any, Any, Any]:
-    import torch
+    import torch  # the sb3 extra: only when its learners run
 
     return random.getstate(), np.random.get_state(), torch.get_rng_state()
 
 
 def _set_global_states(states: tuple[Any, Any, Any]) -> None:
-    import torch
+    import torch  # the sb3 extra: only when its learners run
 
     random.setstate(states[0])
     np.random.set_state(states[1])
@@ -110,7 +110,7 @@ class SB3Model:
 
     @contextmanager
     def _own_generators(self, fresh: bool = False) -> Iterator[None]:
-        import torch
+        import torch  # the sb3 extra: only when its learners run
 
         with _RNG_LOCK:
             outer = _global_states()
@@ -157,7 +157,7 @@ def make_dqn(env: Any, seed: int) -> SB3Model:
     _require("dqn")
 
     def build() -> Any:
-        from stable_baselines3 import DQN
+        from stable_baselines3 import DQN  # the sb3 extra
 
         algorithm = DQN("MlpPolicy", env, seed=int(seed), device="cpu", verbose=0, exploration_initial_eps=1.0,
                         exploration_final_eps=DQN_FINAL_EPS, **DQN_KWARGS)
@@ -172,7 +172,7 @@ def make_ppo(env: Any, seed: int) -> SB3Model:
     _require("ppo")
 
     def build() -> Any:
-        from stable_baselines3 import PPO
+        from stable_baselines3 import PPO  # the sb3 extra
 
         return PPO("MlpPolicy", env, seed=int(seed), device="cpu", verbose=0, **PPO_KWARGS)
 

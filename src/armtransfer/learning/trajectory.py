@@ -22,9 +22,10 @@ from pathlib import Path
 
 
 from armtransfer.errors import InvalidTrajectoryError
+from armtransfer.io import read_json, write_json_atomic
+from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.worlds.layout import ROOMS, Layout
 from armtransfer.worlds.voxels import LEVELS
-from armtransfer.tasks.robot import DiscreteRobot
 
 FORMAT = "armtransfer-trajectory/1"
 
@@ -76,8 +77,6 @@ class Trajectory:
         }
 
     def save(self, path: str | os.PathLike, layout: Layout = ROOMS) -> None:
-        from armtransfer.io import write_json_atomic
-
         write_json_atomic(path, self.to_json(layout))
 
 
@@ -173,8 +172,6 @@ def parse(data: object, layout: Layout = ROOMS, where: str = "trajectory") -> Tr
 
 
 def load(path: str | os.PathLike, layout: Layout = ROOMS) -> Trajectory:
-    from armtransfer.io import read_json
-
     data = read_json(path, "trajectory file", InvalidTrajectoryError)
     return parse(data, layout, where=f"trajectory file {str(Path(path))!r}")
 

@@ -14,6 +14,7 @@ with the driver whatever the moment; they ignore Ctrl-C, which is the driver's t
 
 from __future__ import annotations
 
+import ctypes
 import os
 import signal
 import threading
@@ -23,8 +24,8 @@ from dataclasses import dataclass, field
 from multiprocessing.connection import Connection, wait
 from multiprocessing.process import BaseProcess
 
-from armtransfer.errors import ArmTransferError
 from armtransfer.cpus import ENV as CPUS_ENV
+from armtransfer.errors import ArmTransferError
 from armtransfer.parallel.reaper import guarded_spawn_context
 
 Task = Callable[[dict, dict], object]
@@ -67,8 +68,6 @@ def watch_driver(driver: int) -> None:
     if os.getppid() != driver:
         os._exit(1)
     try:
-        import ctypes
-
         if ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGTERM), 0, 0, 0) == 0:  # 1: PR_SET_PDEATHSIG
             if os.getppid() != driver:  # the parent died before the call
                 os._exit(1)

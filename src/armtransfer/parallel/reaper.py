@@ -28,10 +28,12 @@ from __future__ import annotations
 import functools
 import multiprocessing.context
 import os
+import selectors
 import signal
 import subprocess
 import sys
 import threading
+from multiprocessing import popen_spawn_posix, spawn
 from typing import IO
 from pathlib import Path
 
@@ -173,8 +175,6 @@ def main() -> None:
     that still is the one listed, with everything below it and everything carrying its mark
     (:func:`stop_all`)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # a Ctrl-C to the sweep's group is the sweep's
-    import selectors
-
     sweep, me = os.getppid(), os.getpid()
     earlier = descendants({sweep})  # what the sweep ran before the watcher is not its to stop
     listed: dict[int, str] = {}
@@ -223,8 +223,6 @@ _LAUNCH = threading.Lock()
 def _guarded_popen():
     """The POSIX spawn launcher with :data:`GUARD` before its command (made on first use: the
     module it extends exists on POSIX only)."""
-    from multiprocessing import popen_spawn_posix, spawn
-
     class GuardedPopen(popen_spawn_posix.Popen):
         def _launch(self, process_obj) -> None:
             guard = GUARD.format(driver=os.getpid(), signal=int(signal.SIGTERM))

@@ -13,11 +13,13 @@ configuration of every state, to replay paths with the position servos), ``tip``
 
 from __future__ import annotations
 
+import hashlib
 import math
 import os
 import re
 import sys
 import time
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from typing import cast
 from pathlib import Path
@@ -25,17 +27,20 @@ from pathlib import Path
 import numpy as np
 
 import armtransfer.checks as checks
+from armtransfer.errors import (ArmModelError, ArmTransferError, InvalidCellError, OutputError, UnknownArmError,
+                                UnreachableTableError)
 from armtransfer.ik import cache as _cache
 from armtransfer.ik.actions import ACTION_MODELS, action_model
 from armtransfer.ik.description import ArmDescription
-from armtransfer.ik.tool import Tool, parse_held
-from armtransfer.errors import ArmModelError, UnknownArmError
 from armtransfer.ik.joint_ranges import check_joint_ranges
-from armtransfer.io import check_input, read_input
-from armtransfer.models import ARMS
-from armtransfer.worlds.layout import ROOMS, Layout
-from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.ik.tool import Tool, parse_held
 from armtransfer.ik.workspace import DEFAULT_CELL, WALL_HEIGHT, world_cell
+from armtransfer.io import check_input, check_writable, parse_json_bytes, read_input, write_json_atomic
+from armtransfer.models import ARMS
+from armtransfer.tasks.catalog import world_tasks
+from armtransfer.tasks.grid_robots import GRID_ROBOTS
+from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.worlds.layout import ROOMS, Layout
 
 SIDECAR_FORMAT = "armtransfer-generated-arm/1"
 """The JSON ``armtransfer arms generate`` writes beside an arm: its mount and tool."""
@@ -107,9 +112,6 @@ def _layout_data(layout: Layout) -> dict:
 def tasks_solvable(robot: DiscreteRobot, tasks=None) -> int:
     """How many of ``tasks`` (its world's tasks by default: Table I on the rooms) the robot can
     solve: both cells reached and the goal reachable from the start."""
-    from armtransfer.errors import InvalidCellError
-    from armtransfer.tasks.catalog import world_tasks
-
     solved = 0
     for task in (tasks if tasks is not None else world_tasks(robot.layout)):
         try:
@@ -148,8 +150,6 @@ def check_arm_name(name: object, what: str) -> str:
     """``name`` when a bring-your-own arm may go by it: :data:`ARM_NAME`'s form, and not the
     name of a built-in arm or grid robot (two different robots would share one name in tables,
     results and the cache); else ``ArmModelError``, one line naming the valid forms."""
-    from armtransfer.tasks.grid_robots import GRID_ROBOTS
-
     if not isinstance(name, str) or not ARM_NAME.fullmatch(name):
         shown = repr(name) if not isinstance(name, str) or len(name) <= 60 else f"{name[:40]!r}... ({len(name)} characters)"
         raise ArmModelError(f"{what} must be {ARM_NAME_FORM} (a robot is written NAME:ACTIONS), got {shown}; "
@@ -163,8 +163,6 @@ def check_arm_name(name: object, what: str) -> str:
 
 def file_arm_name(path: Path) -> str:
     """A bring-your-own arm's name: its MJCF ``model`` attribute, else the file's stem."""
-    import xml.etree.ElementTree as ET
-
     try:
         check_input(path, "arm MJCF", ArmModelError)  # a FIFO would hang the parser
     except ArmModelError:
@@ -260,7 +258,7 @@ def arm_robot(arm: str | None, actions: str, *, cell_size: float | None = None,
     spatial = model.kind == "joint" and kind != "planar" and not _is_planar_file(path, tool, mount, yaw, cell_size,
                                                                                  layout, kind)
     if spatial:  # over the 3D workspace: its own key (the 2D robots' keys are as they were)
-        from armtransfer.ik.voxels import LEVELS, MAX_STATES, MOVED, SPATIAL_STEPS, STEP_CELLS
+        from armtransfer.ik.voxels import LEVELS, MAX_STATES, MOVED, SPATIAL_STEPS, STEP_CELLS  # MuJoCo, only when an arm is built
 
         parts["workspace"] = {"levels": LEVELS, "moved": MOVED, "max_states": MAX_STATES,
                               "steps": list(SPATIAL_STEPS), "step_cells": STEP_CELLS, "version": 1}
@@ -331,7 +329,7 @@ def _robot_of(arrays: dict[str, np.ndarray], layout: Layout, model, facts: Descr
     label = arrays["label"]
     levels = int(arrays["levels"]) if "levels" in arrays else 0
     if levels:
-        from armtransfer.ik.voxels import workspace_voxels
+        from armtransfer.ik.voxels import workspace_voxels  # MuJoCo, only when an arm is built
 
         reach = float(len(np.unique(label)) / workspace_voxels(layout, facts.cell_size).free.sum())
     else:
@@ -372,7 +370,7 @@ def _is_planar_file(path, tool: Tool, mount, yaw: float, cell: float, layout: La
 
 
 def _levels(spatial: bool) -> int:
-    from armtransfer.ik.voxels import LEVELS
+    from armtransfer.ik.voxels import LEVELS  # MuJoCo, only when an arm is built
 
     return LEVELS if spatial else 0
 
@@ -446,9 +444,7 @@ def mount_search(path: Path, tool: Tool, *, cell_size: float | None = None, layo
     cell, the first ``RETRIES`` are estimated again with the full seeds, so that a search
     that cannot succeed ends soon.
     """
-    from armtransfer.ik import mount as _mount
-    from armtransfer.tasks.catalog import world_tasks
-
+    from armtransfer.ik import mount as _mount  # MuJoCo, only when an arm is built
     cell_size = world_cell(layout) if cell_size is None else cell_size
     origin = _scene(path, tool, (0.0, 0.0, 0.0), 0.0, cell_size, layout)
     must = sorted({c for t in world_tasks(layout) for c in t.cells(layout)})
@@ -515,8 +511,7 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float | None = None, l
     (``ik.diagnose``). The choice is cached under the arm file's content (meshes included),
     tool, cell size and layout, so it is made once.
     """
-    from armtransfer.errors import UnreachableTableError
-    from armtransfer.ik import mount as _mount
+    from armtransfer.ik import mount as _mount  # MuJoCo, only when an arm is built
 
     cell_size = world_cell(layout) if cell_size is None else cell_size
     parts = {"version": 11, "what": "mount", "compiles": COMPILES, "covers": COVERS,
@@ -543,7 +538,7 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float | None = None, l
 
     def unreachable(best) -> UnreachableTableError:
         """The error, with the cause measured at the best pose tried (``ik.diagnose``)."""
-        from armtransfer.ik.diagnose import why_unreachable
+        from armtransfer.ik.diagnose import why_unreachable  # MuJoCo, only when an arm is built
 
         cause, planar = "", False
         if best is not None:
@@ -575,8 +570,6 @@ def automatic_mount(path: Path, tool: Tool, *, cell_size: float | None = None, l
         raise unreachable(scored[0][2])
     pose = best[1]
     if cache:
-        from armtransfer.io import write_json_atomic
-
         _cache.clear(entry)
         write_json_atomic(entry, {"key": key, "pos": list(pose.pos), "yaw": pose.yaw,
                                   "solvable": best[0][0], "reach": round(best[0][1], 9)})
@@ -594,9 +587,6 @@ def _cached_pose(entry: Path, key: str) -> tuple[tuple[tuple[float, float, float
     """((position, yaw), (tasks solvable, reach)) of the mount choice cached in ``entry`` for
     ``key``, or None when there is none or it is not one (not a regular file, not JSON,
     another key, numbers of the wrong kind or out of range): it is then chosen again."""
-    from armtransfer.errors import ArmTransferError
-    from armtransfer.io import parse_json_bytes
-
     raw = _cache.read_regular(entry)
     try:
         data = parse_json_bytes(raw) if raw is not None else None
@@ -612,9 +602,6 @@ def _cached_pose(entry: Path, key: str) -> tuple[tuple[tuple[float, float, float
 
 def _check_cache_dir() -> None:
     """The arm cache must take files before any compiling starts (one line otherwise)."""
-    from armtransfer.errors import OutputError
-    from armtransfer.io import check_writable
-
     root = _cache.cache_dir()
     try:
         if root.exists() and not root.is_dir():
@@ -628,8 +615,6 @@ def _check_cache_dir() -> None:
 def read_sidecar(xml_path: str | os.PathLike) -> dict | None:
     """The generator's JSON beside an arm file, checked, or None when there is none (a file
     of the generator's format that is malformed is a one-line error naming it)."""
-    from armtransfer.io import parse_json_bytes
-
     path = Path(xml_path).with_suffix(".json")
     try:
         raw: bytes | None = read_input(path, "generated arm's file", ArmModelError)
@@ -658,8 +643,6 @@ def read_sidecar(xml_path: str | os.PathLike) -> dict | None:
 
 
 def _sha(data: bytes) -> str:
-    import hashlib
-
     return hashlib.sha256(data).hexdigest()
 
 
@@ -667,9 +650,7 @@ def _assets_sha(path: Path) -> str:
     """A hash of every file MuJoCo reads for the arm file but the file itself (its includes,
     meshes, textures: ``ik.scene.model_files``), names and contents; a missing one counts as
     missing. Only those files are read, never a whole folder."""
-    import hashlib
-
-    from armtransfer.ik.scene import model_files
+    from armtransfer.ik.scene import model_files  # MuJoCo, only when an arm is built
 
     h = hashlib.sha256()
     for f in model_files(path)[1:]:
@@ -700,7 +681,7 @@ def walls_cause(robot: DiscreteRobot) -> str:
     """Why an arm robot reaches less than ``ik.walls.REACH_OK`` of the free cells, when its
     geometry meets the walls: the geometry, its width against a door's, and the remedy (see
     ``ik.walls``); "" when it reaches enough, is no arm, or the walls are not the cause."""
-    from armtransfer.ik import walls as _walls
+    from armtransfer.ik import walls as _walls  # MuJoCo, only when an arm is built
 
     arm = robot.arm
     if arm is None or arm.reach >= _walls.REACH_OK:
@@ -712,16 +693,16 @@ def walls_cause(robot: DiscreteRobot) -> str:
 
 
 def _scene(path, tool: Tool, mount, yaw, cell, layout):
-    from armtransfer.ik.scene import build_scene
+    from armtransfer.ik.scene import build_scene  # MuJoCo, only when an arm is built
 
     return build_scene(Path(path), tool, mount, yaw, cell, layout=layout)
 
 
 def _compile(scene, model, tip_down, step, progress, spatial: bool = False) -> dict:
-    from armtransfer.ik.compile import compile_cartesian, compile_joint
+    from armtransfer.ik.compile import compile_cartesian, compile_joint  # MuJoCo, only when an arm is built
 
     if spatial:
-        from armtransfer.ik.voxels import compile_spatial_joint
+        from armtransfer.ik.voxels import compile_spatial_joint  # MuJoCo, only when an arm is built
 
         arrays = compile_spatial_joint(scene, step, progress)
     elif model.kind == "joint":

@@ -19,6 +19,8 @@ import numpy as np
 import armtransfer.checks as checks
 from armtransfer.errors import ArmModelError, UnknownArmError
 from armtransfer.models import ARMS
+from armtransfer.tasks.arms import arm_scene, automatic_mount, make_tool, read_sidecar
+from armtransfer.tasks.generated import generated_file
 from armtransfer.worlds.layout import ROOMS, Layout
 
 ACTIONS = ("joint",)
@@ -34,8 +36,6 @@ def parse_spec(spec: str) -> tuple[str | None, str | None]:
     if not isinstance(spec, str):
         raise UnknownArmError(f"a continuous arm is named by a string, got {spec!r}")
     if spec.startswith("gen:"):
-        from armtransfer.tasks.generated import generated_file
-
         xml, _, _ = generated_file(spec)
         parts = spec.split(":")
         path, name, actions = str(xml), None, parts[4] if len(parts) > 4 else ""
@@ -65,10 +65,8 @@ def continuous_arm(spec: str | None = None, *, xml_path=None, tip_site: str | No
     actuation noise sigma (``ik.continuous``; 0, the default: none). A planar arm is an
     ``ik.continuous.ContinuousArm``; a spatial one an ``ik.continuous3d.SpatialContinuousArm``
     over the 3D workspace (the moved joints, origin and default step of its ``joint`` robot)."""
-    from armtransfer.ik.continuous import MAX_NOISE, ContinuousArm
-    from armtransfer.ik.continuous3d import SpatialContinuousArm
-    from armtransfer.tasks.arms import arm_scene, automatic_mount, make_tool, read_sidecar
-
+    from armtransfer.ik.continuous import MAX_NOISE, ContinuousArm  # MuJoCo, only when an arm is built
+    from armtransfer.ik.continuous3d import SpatialContinuousArm  # MuJoCo, only when an arm is built
     name, path = parse_spec(spec) if spec is not None else (None, None)
     if xml_path is not None:
         path = str(checks.path(xml_path, "the arm file (xml_path)", error=ArmModelError))
@@ -103,7 +101,7 @@ def continuous_arm(spec: str | None = None, *, xml_path=None, tip_site: str | No
 def ladder_step(scene) -> float:
     """The step ``ik.compile.compile_joint`` picks for the arm when none is given, about its home
     (unlimited joints: pi either side of it)."""
-    from armtransfer.ik.compile import joint_box, ladder_step as pick
+    from armtransfer.ik.compile import joint_box, ladder_step as pick  # MuJoCo, only when an arm is built
 
     home = scene.home.astype(float)
     return pick(*joint_box(scene, home), home)

@@ -25,7 +25,7 @@ from gymnasium import spaces
 import armtransfer.checks as checks
 from armtransfer.errors import InvalidActionError, InvalidParameterError
 from armtransfer.tasks.catalog import Task
-from armtransfer.tasks.continuous import ARM_KEYWORDS
+from armtransfer.tasks.continuous import ARM_KEYWORDS, continuous_arm
 from armtransfer.tasks.envs import check_options, check_reset_options, rooms_task
 from armtransfer.tasks.robot import cell_robot
 from armtransfer.worlds.voxels import cell_of_label
@@ -158,8 +158,6 @@ def make_continuous_arm_rooms_env(arm: str | None = "planar3", task: int | str |
     ``"planar3"``, ``"planar3:joint"`` or, over the 3D workspace, ``"ur5e_like"``) or an arm file
     (``xml_path=``) on a Table I or
     custom task; ``world=`` as the other environments'."""
-    from armtransfer.tasks.continuous import continuous_arm
-
     check_options(kwargs, ARM_OPTIONS + ("actions",))
     the_task = rooms_task(task, start, goal, world)
     arm_kwargs = {k: kwargs.pop(k) for k in ARM_OPTIONS if k in kwargs}

@@ -19,9 +19,13 @@ from gymnasium import spaces
 
 import armtransfer.checks as checks
 from armtransfer.errors import InvalidParameterError, InvalidTaskError
-from armtransfer.tasks.catalog import Task, as_xy, custom_task, table_task, world_task
+from armtransfer.ik import offscreen
 from armtransfer.registration import register_envs  # noqa: F401  (kept importable from here)
+from armtransfer.tasks.arms import arm_robot, parse_robot_spec
+from armtransfer.tasks.catalog import Task, as_xy, custom_task, table_task, world_task
+from armtransfer.tasks.grid_robots import grid_robot
 from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.worlds.resolve import is_default, world as resolve_world
 
 
 RGB_WITHOUT = "make the environment with render_mode='ansi' or none"
@@ -82,8 +86,6 @@ class RobotRoomsEnv(RoomsRules, gym.Env):
                 f"unknown render_mode {render_mode!r}; valid: {', '.join(self.metadata['render_modes'])}")
         self.render_mode = render_mode
         if render_mode == "rgb_array" and robot.arm is not None:  # an arm is drawn by OpenGL: can it be here?
-            from armtransfer.ik import offscreen
-
             offscreen.require(RGB_WITHOUT)
         self.observation_space = spaces.Discrete(robot.n_states)
         self.action_space = spaces.Discrete(robot.n_actions)
@@ -119,8 +121,8 @@ class RobotRoomsEnv(RoomsRules, gym.Env):
             if self.robot.arm is None:
                 return grid_image(layout, label, self.goal_cell)
             if self._snapshot is None:
-                from armtransfer.ik.replay import robot_scene
-                from armtransfer.ik.snapshot import ArmSnapshot
+                from armtransfer.ik.replay import robot_scene  # MuJoCo: only when a frame is rendered
+                from armtransfer.ik.snapshot import ArmSnapshot  # MuJoCo: only when a frame is rendered
 
                 self._snapshot = ArmSnapshot(robot_scene(self.robot), without=RGB_WITHOUT)
             return self._snapshot.render(self.robot.arm.qpos[self.state], self.goal_cell, label)
@@ -165,8 +167,6 @@ def rooms_task(task: int | str | None = 1, start: tuple[int, int] | None = None,
                goal: tuple[int, int] | None = None, world: Any = None) -> Task:
     """A task of the world (``worlds.resolve.world``; Table I's on the paper's rooms, the
     default), or the custom task from ``start`` to ``goal`` (cells (x, y) or 'X,Y')."""
-    from armtransfer.worlds.resolve import is_default, world as resolve_world
-
     layout = resolve_world(world)
     if start is None and goal is None:
         if is_default(layout):
@@ -189,8 +189,6 @@ def make_rooms_env(
 ) -> RobotRoomsEnv:
     """Entry point of ``armtransfer/Rooms-v0``: a grid robot on a task of ``world`` (Table I's on
     the paper's rooms, the default) or a custom task."""
-    from armtransfer.tasks.grid_robots import grid_robot
-
     check_options(kwargs)
     the_task = rooms_task(task, start, goal, world)
     return RobotRoomsEnv(grid_robot(robot, the_task.layout), the_task, **kwargs)
@@ -230,8 +228,6 @@ def rooms_arm(arm: str | None, actions: str, options: dict[str, Any], layout: An
     file ``xml_path=`` with its options, on the world ``layout`` (the paper's rooms when None);
     the robot's keywords (:data:`ARM_OPTIONS`) are taken out of ``options``, the rest left for
     the task."""
-    from armtransfer.tasks.arms import arm_robot, parse_robot_spec
-
     robot_kwargs = {k: options.pop(k) for k in ARM_OPTIONS if k in options}
     if layout is not None:
         robot_kwargs["layout"] = layout

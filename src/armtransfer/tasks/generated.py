@@ -28,10 +28,11 @@ import numpy as np
 
 from armtransfer.checks import integer_text
 from armtransfer.errors import ArmModelError, ArmTransferError
-from armtransfer.io import check_output_dir, staged_directory, write_json_atomic, write_text_atomic
+from armtransfer.ik.cache import building, cache_dir
 from armtransfer.ik.workspace import DEFAULT_CELL
+from armtransfer.io import check_output_dir, staged_directory, write_json_atomic, write_text_atomic
 from armtransfer.models.generate import ArmDraw, check_family, draw_arm, planar_tip_cells, with_home
-from armtransfer.tasks.arms import SIDECAR_FORMAT, read_sidecar
+from armtransfer.tasks.arms import SIDECAR_FORMAT, arm_robot, read_sidecar
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.worlds.layout import ROOMS, Layout
 
@@ -83,7 +84,7 @@ def generate_arm(family: str, dof: int, seed: int, out_dir: str | os.PathLike, *
 
 def _try(draw: ArmDraw, work: Path, actions: str, progress: bool) -> tuple[str | None, ArmDraw, float]:
     """(why the draw is rejected or None, the draw with its solved home, reach)."""
-    from armtransfer.ik.contract import problems
+    from armtransfer.ik.contract import problems  # MuJoCo, only when an arm is built
 
     if draw.kind == "planar":  # cheap first: can the tip be over every Table I cell at all?
         reached = planar_tip_cells(draw, DEFAULT_CELL)
@@ -116,8 +117,8 @@ def _try(draw: ArmDraw, work: Path, actions: str, progress: bool) -> tuple[str |
 
 def _solve_home(path: Path, draw: ArmDraw) -> tuple[list[float] | None, str]:
     """A home with the tool down over the table's centre cell, by mink IK."""
-    from armtransfer.ik.scene import build_scene
-    from armtransfer.ik.solve import TipIK
+    from armtransfer.ik.scene import build_scene  # MuJoCo, only when an arm is built
+    from armtransfer.ik.solve import TipIK  # MuJoCo, only when an arm is built
 
     scene = build_scene(path, "tip", draw.mount_pos, draw.mount_yaw, layout=ROOMS)
     ik = TipIK(scene, tip_down=True, max_iters=200)
@@ -129,8 +130,6 @@ def _solve_home(path: Path, draw: ArmDraw) -> tuple[list[float] | None, str]:
 
 def robot_of(path: Path, draw: ArmDraw | dict, actions: str, **kwargs):
     """The discrete robot of a generated arm file (its mount from the draw or sidecar)."""
-    from armtransfer.tasks.arms import arm_robot
-
     d = draw if isinstance(draw, dict) else sidecar(draw, 0, 0, [], 0.0)
     return arm_robot(None, actions, xml_path=path, tip_site="tip", base_pos=tuple(d["mount_pos"]),
                      base_yaw=d["mount_yaw"], tip_down=d["tip_down"], joint_step=d["joint_step"], **kwargs)
@@ -175,8 +174,6 @@ def resolve_generated(spec: str, progress: bool = False, layout: Layout = ROOMS)
 def generated_file(spec: str, progress: bool = False) -> tuple[Path, dict, str]:
     """(the arm file, its sidecar, the action model named) of ``gen:FAMILY:DOF:SEED[:ACTIONS]``,
     generated into the cache directory at its first use."""
-    from armtransfer.ik.cache import building, cache_dir
-
     parts = spec.split(":")
     numbers = [integer_text(p, signed=False) for p in parts[2:4]]
     if len(parts) not in (4, 5) or None in numbers:

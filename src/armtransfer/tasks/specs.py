@@ -4,9 +4,13 @@ as ``PATH.xml[:ACTIONS]``, and ``custom[:ACTIONS]`` or ``NAME[:ACTIONS]`` (the f
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 from armtransfer.errors import InvalidWorldError, UnknownArmError, UnknownRobotError
+from armtransfer.models import ARMS
+from armtransfer.tasks.arms import arm_robot, file_arm_name, parse_robot_spec
+from armtransfer.tasks.generated import resolve_generated
 from armtransfer.tasks.grid_robots import GRID_ROBOTS, grid_robot
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.worlds.layout import ROOMS, Layout
@@ -33,37 +37,25 @@ def resolve(spec: str | DiscreteRobot, *, xml_path=None, progress: bool = False,
     if spec in GRID_ROBOTS:
         return grid_robot(spec, layout)
     if arms and spec.partition(":")[0] in arms:
-        from armtransfer.tasks.arms import arm_robot
-
         name, _, actions = spec.partition(":")
         arm = arms[name]
         options: dict[str, Any] = {k: (tuple(v) if isinstance(v, list) else v) for k, v in arm.items() if k != "xml"}
         return arm_robot(None, actions or "cartesian", xml_path=arm["xml"], arm_name=name, progress=progress,
                          layout=layout, **options)
-    from armtransfer.models import ARMS
-
     if ".xml" in spec:  # an arm file: PATH.xml or PATH.xml:ACTIONS
         path, _, actions = spec.rpartition(":") if not spec.endswith(".xml") else (spec, "", "")
-        from armtransfer.tasks.arms import arm_robot
-
         return arm_robot(None, actions or "cartesian", xml_path=path, progress=progress, layout=layout,
                          **arm_options)
     if spec.startswith("gen:"):
-        from armtransfer.tasks.generated import resolve_generated
-
         return resolve_generated(spec, progress=progress, layout=layout)
     name, _, actions = spec.partition(":")
     given = xml_arm_name(xml_path, arm_options.get("arm_name")) if xml_path is not None else None
     if name == CUSTOM or (name == given and name not in ARMS):
         if xml_path is None:
             raise UnknownRobotError(f"robot '{CUSTOM}' needs --arm-xml PATH (arm_xml= in the API)")
-        from armtransfer.tasks.arms import arm_robot
-
         return arm_robot(None, actions or "cartesian", xml_path=xml_path, progress=progress, layout=layout,
                          **arm_options)
     if name in ARMS:
-        from armtransfer.tasks.arms import arm_robot, parse_robot_spec
-
         arm, actions = parse_robot_spec(spec)
         sized = {k: arm_options[k] for k in ("cell_size", "cache") if arm_options.get(k) is not None}
         return arm_robot(arm, actions, progress=progress, layout=layout, **sized)
@@ -84,8 +76,4 @@ def xml_arm_name(xml_path, arm_name: str | None = None) -> str:
     prints them): ``arm_name`` when given, else the file's MJCF ``model`` attribute, else its
     stem. A spec may name the file's arm by it instead of ``custom``; a built-in arm of the
     same name keeps it."""
-    from pathlib import Path
-
-    from armtransfer.tasks.arms import file_arm_name
-
     return arm_name or file_arm_name(Path(xml_path))

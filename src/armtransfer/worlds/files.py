@@ -27,6 +27,7 @@ import os
 from pathlib import Path
 
 from armtransfer.errors import InvalidWorldError
+from armtransfer.io import parse_user_file_bytes
 from armtransfer.worlds.check import check_world
 from armtransfer.worlds.grid import grid_rows, layout_from_rows
 from armtransfer.worlds.layout import Layout, NamedTask
@@ -52,8 +53,6 @@ def load_layout(path: str | os.PathLike) -> Layout:
         raw = p.read_bytes()
     except (OSError, ValueError) as err:  # ValueError: a path with a NUL byte
         raise InvalidWorldError(f"{where}: cannot be read: {getattr(err, 'strerror', None) or err}") from None
-    from armtransfer.io import parse_user_file_bytes
-
     try:
         data = parse_user_file_bytes(raw, p.suffix)
     except ValueError as err:

@@ -10,7 +10,7 @@ from armtransfer.experiments import harness_terms as lt
 from armtransfer.experiments import suites
 from armtransfer.experiments.comparisons import baselines_of, registered_baseline
 from armtransfer.experiments.reports import figures
-from armtransfer.experiments.reports.report import markdown_table
+from armtransfer.experiments.tables import markdown_table
 from armtransfer.experiments.stats.hierarchical import MIN_UNITS
 from armtransfer.experiments.stats.learning_metrics import HORIZON
 from armtransfer.experiments.stats.multiplicity import ALPHA

@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 
 from armtransfer.experiments import paper
-from armtransfer.experiments.reports.report import fmt_ci, fmt_mean, fmt_num, markdown_table
+from armtransfer.experiments.tables import fmt_ci, fmt_mean, fmt_num, markdown_table
 
 TASKS = (1, 2, 3, 4)
 WITHIN = 0.20

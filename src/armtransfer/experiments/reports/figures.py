@@ -2,17 +2,17 @@
 
 from __future__ import annotations
 
+import io
 import os
 
 import numpy as np
 
 from armtransfer.experiments.lazy import pyplot
+from armtransfer.experiments.stats.learning_metrics import curve
 from armtransfer.io import write_bytes_atomic
 
 
 def _save(fig, path: str | os.PathLike) -> None:
-    import io
-
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
     pyplot().close(fig)
@@ -103,8 +103,6 @@ def curve_means(curves: dict[str, list[list[int]]], greedy: dict[str, list[int |
 def _matrix(trials: list[list[int]], greedy: list[int | None] | None, max_episodes: int) -> np.ndarray:
     """[trials, episodes]: every trial's ``learning_metrics.curve`` over the longest trial's
     episodes (at most ``max_episodes``)."""
-    from armtransfer.experiments.stats.learning_metrics import curve
-
     n = min(max_episodes, max(len(t) for t in trials))
     g = greedy or [None] * len(trials)
     return np.array([curve(t, gi, n) for t, gi in zip(trials, g)])

@@ -6,12 +6,13 @@ Every sentence that states a result is built from that run's numbers; the paper'
 
 from __future__ import annotations
 
+from armtransfer.experiments import beyond, paper
+from armtransfer.experiments.lazy import scipy_stats
+from armtransfer.experiments.reports import calibrated_report
+from armtransfer.experiments.tables import fmt_ci, fmt_mean, fmt_num, markdown_table
+from armtransfer.learning.mapping import ActionMapping
 from armtransfer.tasks.catalog import TABLE_I
 from armtransfer.worlds.layout import ROOMS
-from armtransfer.experiments import beyond, paper
-from armtransfer.learning.mapping import ActionMapping
-from armtransfer.experiments.reports import calibrated_report
-from armtransfer.experiments.reports.report import fmt_ci, fmt_mean, fmt_num, markdown_table
 
 TASKS = (1, 2, 3, 4)
 TOP_ENTRIES = 12
@@ -67,8 +68,7 @@ def detectable_difference(ci: list[float], power: float = 0.8) -> float:
     """The smallest difference from the paper's value that an estimate with this 95% interval
     detects with ``power`` (two-sided, 5%): (z_0.975 + z_power) standard errors, the standard
     error read off the interval's half-width."""
-    from scipy import stats
-
+    stats = scipy_stats()
     z = float(stats.norm.ppf(0.975))
     return (z + float(stats.norm.ppf(power))) * (ci[1] - ci[0]) / 2 / z
 

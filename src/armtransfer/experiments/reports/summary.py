@@ -12,11 +12,12 @@ trial i of seed s of a method with trial i of seed s of ``none`` (the same rando
 
 from __future__ import annotations
 
-from armtransfer.experiments.stats import metrics
-from armtransfer.learning.config import LearnerConfig
-from armtransfer.experiments.reports.report import (CAP_NOTE, fmt_ci, fmt_improvement, fmt_mean, fmt_num, markdown_table,
+from armtransfer.experiments.reports.figures import bar_chart
+from armtransfer.experiments.tables import (CAP_NOTE, fmt_ci, fmt_improvement, fmt_mean, fmt_num, markdown_table,
                                           median_column)
+from armtransfer.experiments.stats import metrics
 from armtransfer.experiments.sweep import group_key
+from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.learner_names import SARSA, label, parse_label
 
 
@@ -138,8 +139,6 @@ def summary_markdown(rows: list[dict]) -> str:
 
 
 def plot(rows: list[dict], path) -> None:
-    from armtransfer.experiments.reports.figures import bar_chart
-
     groups: list[str] = []
     series: dict[str, dict[str, tuple]] = {}
     for r in rows:

@@ -16,6 +16,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from armtransfer.experiments.lazy import scipy_stats
+from armtransfer.experiments.stats.survival import bootstrap_ci
 
 PAIRED_DESIGN = "paired: methods share random streams trial by trial (common random numbers)"
 INDEPENDENT_DESIGN = "independent samples"
@@ -34,8 +35,6 @@ def mean_ci(values: Sequence[float | None]) -> tuple[float | None, list[float] |
 
     For quantities defined only for some trials (e.g. greedy path lengths of converged
     trials). Exploration steps are censored: use :func:`exploration_stats`."""
-    from armtransfer.experiments.stats.survival import bootstrap_ci
-
     xs = np.array([v for v in values if v is not None], dtype=np.float64)
     if len(xs) == 0:
         return None, None
@@ -102,8 +101,6 @@ def exploration_stats(values: Sequence[int | None], cap: int) -> dict:
         "median_is_lower_bound": False, "cap_dominated": False}
     if n == 0:
         return out
-    from armtransfer.experiments.stats.survival import bootstrap_ci
-
     xs = censor(values, cap)
     mean = float(xs.mean())
     ci = [mean, mean] if n == 1 else bootstrap_ci(xs)

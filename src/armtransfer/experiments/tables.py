@@ -1,4 +1,6 @@
-"""Text tables of experiment summaries (Table II style), for terminals and report.md."""
+"""Text tables of experiment summaries (Table II style) and their numbers, for terminals, a
+result's repr and report.md. Nothing of the project is imported here: the results, the commands
+and the reports all print with it."""
 
 from __future__ import annotations
 
