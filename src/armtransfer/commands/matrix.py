@@ -171,7 +171,7 @@ def write_summary(store: ResultStore, out: Path) -> str:
     return header + text
 
 
-def store_runs(spec: dict) -> list[dict]:
+def store_runs(spec: dict) -> list:
     from armtransfer.experiments import sweep as sweeps
 
     return sweeps.expand(spec)
