@@ -40,6 +40,8 @@ def test_no_driver_makes_its_own_choice_of_engine():
     for path in ("experiments/benchmark_runs.py", "experiments/execute.py"):
         text = (src / path).read_text()
         assert ".trials(work_of(run)" in text and "run_method(" not in text, path
+    api = (src / "api.py").read_text()  # the outside and continuous paths; the kernel's adds controls and mapping
+    assert api.count("req.engine.trials(engines.Work(") == 2 and "run_method(" not in api
 
 
 def test_each_engine_is_an_engine_and_a_learner_this_build_lacks_is_one_line():

@@ -43,9 +43,10 @@ class Engine(ABC):
         does not run (``subject`` says what has that target); nothing when it runs it."""
 
     @abstractmethod
-    def trials(self, work: Work, target: DiscreteRobot, trajectories: Sequence[Trajectory] | None) -> MethodResult:
-        """``work``'s trials on ``target`` (its table robot: its world and cells), paid for
-        ``trajectories`` when the method reads them (None: it reads none)."""
+    def trials(self, work: Work, target: DiscreteRobot | None,
+               trajectories: Sequence[Trajectory] | None) -> MethodResult:
+        """``work``'s trials on ``target`` (its table robot: its world and cells; None only with a
+        continuous arm in the work), paid for ``trajectories`` when the method reads them."""
 
 
 class Tabular(Engine):
@@ -53,9 +54,11 @@ class Tabular(Engine):
 
     name = TABULAR
 
-    def trials(self, work: Work, target: DiscreteRobot, trajectories: Sequence[Trajectory] | None) -> MethodResult:
+    def trials(self, work: Work, target: DiscreteRobot | None,
+               trajectories: Sequence[Trajectory] | None) -> MethodResult:
         from armtransfer.experiments import experiment
 
+        assert target is not None
         start, goal = target.layout.cell(*work.start), target.layout.cell(*work.goal)
         given = None if trajectories is None else list(trajectories)
         return experiment.run_method(work.method, target, start, goal, given, work.trials, work.seed, work.config,
@@ -71,13 +74,17 @@ class Continuous(Engine):
 
     name = CONTINUOUS
 
-    def trials(self, work: Work, target: DiscreteRobot, trajectories: Sequence[Trajectory] | None) -> MethodResult:
+    def trials(self, work: Work, target: DiscreteRobot | None,
+               trajectories: Sequence[Trajectory] | None) -> MethodResult:
         from armtransfer.experiments import continuous
         from armtransfer.tasks.continuous import continuous_arm
 
-        start, goal = target.layout.cell(*work.start), target.layout.cell(*work.goal)
-        arm = continuous_arm(work.target, layout=target.layout, noise=work.noise)
-        arm.place(start)
+        arm = work.arm
+        if arm is None:
+            assert target is not None
+            arm = continuous_arm(work.target, layout=target.layout, noise=work.noise)
+            arm.place(target.layout.cell(*work.start))
+        goal = arm.layout.cell(*work.goal)
         return continuous.run_method(work.method, arm, goal, trajectories, work.trials, work.seed, work.config,
                                      K="auto" if work.K is None else work.K,
                                      approx=continuous.approximation_for(arm), first_trial=work.first_trial,
@@ -95,10 +102,12 @@ class Outside(Engine):
             raise InvalidParameterError(f"learner {learner!r} learns on a discrete target; {subject} a continuous "
                                         f"one; valid learners for it: {SARSA}")
 
-    def trials(self, work: Work, target: DiscreteRobot, trajectories: Sequence[Trajectory] | None) -> MethodResult:
+    def trials(self, work: Work, target: DiscreteRobot | None,
+               trajectories: Sequence[Trajectory] | None) -> MethodResult:
         from armtransfer.experiments import learner_transfer
         from armtransfer.learning.learners import get
 
+        assert target is not None
         return learner_transfer.run_method(get(work.learner), work.method, target, list(work.start),
                                            list(work.goal), trajectories, work.trials, work.seed, work.config,
                                            wind=work.wind, K=work.K, beta=work.beta, on_trial=work.on_trial,

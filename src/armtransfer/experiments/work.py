@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.learner_names import SARSA
@@ -33,3 +34,6 @@ class Work:
     threads: int | None = None
     on_trial: Callable[[], None] | None = None
     heartbeat: bool = False
+    arm: Any = None
+    """A continuous arm made and placed over the start already (``armtransfer.transfer``'s, with
+    its arm options); None: the continuous engine makes ``target``'s."""
