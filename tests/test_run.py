@@ -9,7 +9,8 @@ import pytest
 
 from armtransfer.errors import ArmTransferError
 from armtransfer.experiments import benchmark_runs, sweep as sweeps
-from armtransfer.experiments.run import SCHEMA, Run, RunError, SourceRun, SweepRun, TrialRun, content_key, migrate
+from armtransfer.experiments.run import (SCHEMA, Run, RunError, SourceRun, SweepRun, TrialRun, content_key, key_of,
+                                         migrate)
 from armtransfer.learning.config import LearnerConfig
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -62,8 +63,9 @@ def test_sweep_runs_keep_the_keys_of_the_dict_runs(name):
 
 def test_benchmark_runs_keep_the_keys_of_the_dict_runs():
     for name, (run, key) in benchmark_runs_pinned().items():
-        assert run.key() == key, name
+        assert run.key() == key == key_of(run.to_dict(), 1), name
         assert "schema" not in run.to_dict() and SCHEMA == 1
+        assert key_of(run.to_dict(), 2) != key  # a later schema keys the same fields apart
 
 
 def test_defaults_stay_out_of_the_stored_form_and_values_go_in():

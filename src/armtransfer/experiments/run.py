@@ -10,7 +10,7 @@ the learner and the world):
 - :class:`TrialRun` (``armtransfer benchmark``): one trial of one method on robot 2.
 
 A run is stored as :meth:`Run.to_dict` and read back with :meth:`Run.from_dict`; its store key
-is :meth:`Run.key`, a hash of that dict. **Schema version 1** is the form every store written
+is :meth:`Run.key` (:func:`key_of`), a hash of that dict. **Schema version 1** is the form every store written
 so far holds, and the key form by definition: a field at its default (:attr:`Run.DEFAULTS`) is
 left out of the stored dict, so a run of a field's default keeps the key it had before the field
 existed, and the version itself is implied: it is neither written nor hashed. A later schema
@@ -48,6 +48,13 @@ DEFAULT_WORLD = "rooms"
 
 class RunError(ArmTransferError):
     """A run's configuration is malformed (an unknown format, state or field, a bad value)."""
+
+
+def key_of(stored: dict, schema: int = SCHEMA) -> str:
+    """The store key of a run stored as ``stored`` under schema ``schema``: schema 1 hashes the
+    stored dict as it is (the key every store written so far holds); a later schema hashes it with
+    its version, ``"schema": N``, so no two schemas share a key."""
+    return content_key(stored if schema == 1 else {**stored, "schema": schema})
 
 
 def content_key(obj: object) -> str:
@@ -117,7 +124,7 @@ class Run:
         _whole(self.seed, "seed")
         _name(self.learner, "learner")
         self.check()
-        self._set("_key", content_key(self.to_dict()))
+        self._set("_key", key_of(self.to_dict()))
 
     def _set(self, name: str, value: object) -> None:
         object.__setattr__(self, name, value)
@@ -126,7 +133,7 @@ class Run:
         """The kind's own fields checked (a one-line :class:`RunError`)."""
 
     def key(self) -> str:
-        """The run's store key: :func:`content_key` of :meth:`to_dict` (schema 1: no version in it)."""
+        """The run's store key: :func:`key_of` its :meth:`to_dict` under :data:`SCHEMA`."""
         return self._key
 
     def to_dict(self) -> dict:
