@@ -40,6 +40,7 @@ import numpy as np
 
 from armtransfer import script
 from armtransfer.experiments import learner_trial
+from armtransfer.experiments.work import Work
 from armtransfer.learning import sarsa
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.registration import MAX_EPISODE_STEPS
@@ -91,12 +92,11 @@ def bare(robot, start: list[int], goal: list[int], steps: int, seed: int) -> int
 
 def harness(robot, start: list[int], goal: list[int], steps: int, seed: int, budget: int) -> int:
     learner = example_learner()
-    config = LearnerConfig(max_total_steps=budget).to_dict()
+    work = Work("none", robot.name, (start[0], start[1]), (goal[0], goal[1]), 1, seed,
+                LearnerConfig(max_total_steps=budget))
     done, trial = 0, 0
     while done < steps:
-        run = {"method": "none", "trial": trial, "seed": seed, "start": start, "goal": goal, "wind": 0.0,
-               "config": config}
-        _, stream = learner_trial.trial(learner, run, robot, None)
+        _, stream = learner_trial.trial(learner, work, trial, robot, None)
         done += sum(abs(s) for s in stream)
         trial += 1
     return done

@@ -141,9 +141,9 @@ def test_a_sweep_file_names_its_own_arms(tmp_path, scara_xml):
     spec = sweeps.normalise(raw, base=scara_xml.parent)
     assert spec["arms"]["scara"]["xml"] == str(scara_xml.resolve())
     run = sweeps.expand(spec)[0]
-    assert run["arms"] == spec["arms"]
+    assert run.arms == spec["arms"]
     other = dict(raw, arms={"scara": dict(raw["arms"]["scara"], base_pos=[-0.12, 0, 0])})
-    assert sweeps.expand(sweeps.normalise(other, base=scara_xml.parent))[0]["key"] != run["key"]
+    assert sweeps.expand(sweeps.normalise(other, base=scara_xml.parent))[0].key() != run.key()
     from armtransfer.commands.sweep import check_runs
 
     robots = check_runs([run])

@@ -351,8 +351,14 @@ def test_a_source_that_does_not_converge_is_counted_not_dropped(monkeypatch):
 def test_a_run_written_before_told_nothing_keeps_its_error():
     """A stored trial run from before the rule (no ``told_nothing``) is an error, as it was."""
     from armtransfer.experiments import benchmark_runs
+    from armtransfer.experiments.run import Run
+    from armtransfer.learning.config import LearnerConfig
 
-    run = {"method": "pseudo", "trajectory": None, "source_failure": "robot 1 did not converge"}
+    nothing = {"trajectory": None, "failure": "robot 1 did not converge"}
+    stored = benchmark_runs.trial_run("pseudo", 0, "coarse", "fine", [0, 0], [-8, 12], 0.0, 1, LearnerConfig(),
+                                      nothing).to_dict()
+    del stored["told_nothing"]  # as a run written before the rule was stored
+    run = Run.from_dict(stored)
     assert benchmark_runs.trial_result(run, None) == {"error": "no trajectory: robot 1 did not converge"}
 
 

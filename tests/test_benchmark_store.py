@@ -56,12 +56,12 @@ def test_a_crash_mid_run_resumes_to_the_same_bytes(whole, tmp_path, monkeypatch,
         if len(written) == 7:
             raise KeyboardInterrupt  # the driver stops here, its workers with it
         real_write(self, run, result, elapsed)
-        written.append(run["format"])
-        keys.append(run["key"])
+        written.append(run.FORMAT)
+        keys.append(run.key())
 
     def counted(self, run, result, elapsed):
         real_write(self, run, result, elapsed)
-        keys.append(run["key"])
+        keys.append(run.key())
 
     out = tmp_path / "store"
     monkeypatch.setattr(ResultStore, "write_run", crash_after_seven)
@@ -151,27 +151,36 @@ def test_a_trial_run_alone_is_that_trial_of_the_whole_method(method, episodes):
 
 
 def test_a_run_names_its_learner_and_another_learner_runs_through_the_store(monkeypatch):
-    """A learner added to the registry runs its trial runs as the built-in one does: the same
-    configuration but for ``learner``, another key, and its result goes into the record."""
+    """A learner given an engine of its own (``engines.BY_LEARNER``) runs its trial runs as the
+    built-in one does: the same configuration but for ``learner``, another key, and its result
+    goes into the record."""
+    from armtransfer.experiments import engines
+    from armtransfer.learning.trial_result import TrialResult
+
     fine = grid_robot("fine")
     args = ("none", 1, "coarse", "fine", [0, 0], [-8, 12], 0.0, 7, LearnerConfig(max_episodes=30), None)
     ours = benchmark_runs.trial_run(*args)
-    assert ours["learner"] == benchmark_runs.LEARNER
+    assert ours.learner == benchmark_runs.LEARNER
     seen = []
 
-    def other(run, target):
-        seen.append((run["method"], run["trial"], target.name))
-        return {"error": None, "first_exposure": 12, "converged": False, "convergence_steps": None,
-                "greedy_steps": None, "episodes": 3, "area": 36.0, "curve": [12.0] * 3}
+    class Other(engines.Engine):
+        name = "other"
 
-    monkeypatch.setitem(benchmark_runs.LEARNERS, "other", other)
+        def trials(self, work, target, trajectories):
+            seen.append((work.method, work.first_trial, work.trials, target.name))
+            steps = np.array([12, -12, -12])
+            none = np.zeros(0, dtype=np.int64)
+            return experiment.MethodResult(work.method, [TrialResult(12, False, None, None, 3, steps, none, none)])
+
+    monkeypatch.setitem(engines.BY_LEARNER, "other", Other())
     theirs = benchmark_runs.trial_run(*args, learner="other")
-    assert theirs["key"] != ours["key"] and {k: v for k, v in theirs.items() if k not in ("key", "learner")} == \
-        {k: v for k, v in ours.items() if k not in ("key", "learner")}
+    assert theirs.key() != ours.key() and {k: v for k, v in theirs.to_dict().items() if k != "learner"} == \
+        {k: v for k, v in ours.to_dict().items() if k != "learner"}
     result, _ = benchmark_runs.execute(theirs, {"fine": fine})
-    assert seen == [("none", 1, "fine")] and benchmark_runs.result_problem(theirs, result) is None
+    assert seen == [("none", 1, 1, "fine")] and benchmark_runs.result_problem(theirs.to_dict(), result) is None
+    assert result["first_exposure"] == 12 and result["episodes"] == 3
     built_in, _ = benchmark_runs.execute(ours, {"fine": fine})
-    assert benchmark_runs.result_problem(ours, built_in) is None and built_in["first_exposure"] != 12
+    assert benchmark_runs.result_problem(ours.to_dict(), built_in) is None and built_in["first_exposure"] != 12
     with pytest.raises(ArmTransferError, match="unknown learner 'gone'; valid learners: sarsa, other"):
         benchmark_runs.execute(benchmark_runs.trial_run(*args, learner="gone"), {"fine": fine})
 
@@ -309,7 +318,7 @@ def test_ray_tasks_get_the_robots_of_a_case_in_another_world(monkeypatch):
     monkeypatch.setattr(executors, "_import_ray", lambda: _InlineRay())
     robots = {"coarse in rooms11": grid_robot("coarse"), "fine in rooms11": grid_robot("fine"),
               "fine": grid_robot("fine")}
-    runs = [{"source": "coarse", "target": "fine", "world": "rooms11", "n": 0}]
+    runs = [types.SimpleNamespace(source="coarse", target="fine", world="rooms11", key=lambda: "k0")]
     seen, failed = [], []
 
     def fn(run, handed):

@@ -1,4 +1,4 @@
-"""The one place that chooses who learns a run: ``experiments.engines.engine_of``."""
+"""Who learns a run: the ``Engine`` interface and the one place that chooses it (``experiments.engines``)."""
 
 from pathlib import Path
 
@@ -27,13 +27,48 @@ def test_a_pairing_no_engine_runs_is_one_line_naming_the_valid_ones():
 
 
 def test_no_driver_makes_its_own_choice_of_engine():
-    """The refusal of an outside learner on a continuous target is written once, in engines.py, and
-    the transfer call, the benchmark and sweeps ask engine_of."""
+    """The refusal of an outside learner on a continuous target is written once, in engines.py;
+    the transfer call, the benchmark's plan and trial runs and sweep runs ask engines.py for the
+    engine, and the trial runs and sweep runs learn through its ``trials`` (no driver calls a
+    learner's own run_method)."""
     src = ROOT / "src" / "armtransfer"
     holders = [p.relative_to(src).as_posix() for p in src.rglob("*.py") if "learns on a discrete target" in p.read_text()]
     assert holders == ["experiments/engines.py"]
     for path in ("api.py", "experiments/benchmark.py", "experiments/benchmark_runs.py", "experiments/execute.py"):
-        assert "engines.engine_of(" in (src / path).read_text(), path
+        text = (src / path).read_text()
+        assert "engines.engine_of(" in text or "engines.engine_for(" in text, path
+    for path in ("experiments/benchmark_runs.py", "experiments/execute.py"):
+        text = (src / path).read_text()
+        assert ".trials(work_of(run)" in text and "run_method(" not in text, path
+    api = (src / "api.py").read_text()  # the outside and continuous paths; the kernel's adds controls and mapping
+    assert api.count("req.engine.trials(engines.Work(") == 2 and "run_method(" not in api
+
+
+def test_each_engine_is_an_engine_and_a_learner_this_build_lacks_is_one_line():
+    from armtransfer.errors import ArmTransferError
+
+    chosen = {engines.engine_for("sarsa"), engines.engine_for("sarsa", "continuous"), engines.engine_for("dqn")}
+    assert {e.name for e in chosen} == set(engines.ENGINES) and all(isinstance(e, engines.Engine) for e in chosen)
+    with pytest.raises(ArmTransferError, match="unknown learner 'gone'; valid learners: sarsa, "):
+        engines.engine_for("gone")
+
+
+def test_the_tabular_engine_learns_what_the_kernel_learns_trial_k_alone_as_trial_k_of_all():
+    """An engine's trials are the learner's own: trial 1 asked alone is trial 1 of two."""
+    from armtransfer.experiments import experiment
+    from armtransfer.learning.config import LearnerConfig
+    from armtransfer.tasks.grid_robots import grid_robot
+
+    fine, config = grid_robot("fine"), LearnerConfig(max_episodes=40)
+    work = engines.Work("none", "fine", (0, 0), (-8, 12), 2, 3, config)
+    both = engines.engine_for("sarsa").trials(work, fine, None)
+    start, goal = fine.layout.cell(0, 0), fine.layout.cell(-8, 12)
+    direct = experiment.run_method("none", fine, start, goal, None, 2, 3, config)
+    assert [t.episode_steps.tolist() for t in both.trials] == [t.episode_steps.tolist() for t in direct.trials]
+    alone = engines.engine_for("sarsa").trials(engines.Work("none", "fine", (0, 0), (-8, 12), 1, 3, config,
+                                                            first_trial=1), fine, None)
+    assert alone.trials[0].episode_steps.tolist() == both.trials[1].episode_steps.tolist()
+    assert both.trials[0].episode_steps.tolist() != both.trials[1].episode_steps.tolist()
 
 
 def test_the_transfer_call_refuses_an_outside_learner_on_a_continuous_target_before_anything_runs():

@@ -177,41 +177,49 @@ def test_the_reaper_stops_what_starts_while_it_kills():
         assert left == [], f"{len(left)} processes outlived the sweep"
 
 
+def _runs(n: int, robot: str = "fine") -> list:
+    """``n`` sweep runs of ``robot``, told apart by their seed."""
+    from armtransfer.experiments import sweep as sweeps
+
+    return sweeps.expand(sweeps.normalise({"sweep": {"tasks": [1], "pairs": [[robot, robot]], "methods": ["none"],
+                                                     "seeds": list(range(n))}}))
+
+
 def _dies_on_first(run, robots):
     """A worker that dies at once the first time it runs (a marker file says it did)."""
     marker = Path(os.environ["HOSTILE_MARKER"])
     if not marker.exists():
         marker.write_text("died")
         os._exit(9)
-    return {"ok": run["key"]}, 0.0
+    return {"ok": run.key()}, 0.0
 
 
 def test_a_worker_dying_while_work_is_handed_out_costs_a_retry(tmp_path, monkeypatch):
     monkeypatch.setenv("HOSTILE_MARKER", str(tmp_path / "marker"))
-    runs = [{"key": f"r{i}", "source": "coarse", "target": "fine"} for i in range(12)]
+    runs = _runs(12)
     done, failed = [], []
-    executors.run_local(runs, {}, 3, lambda run, result, secs: done.append(run["key"]),
-                        lambda run, error, attempts: failed.append(run["key"]), retries=2, fn=_dies_on_first)
-    assert sorted(done) == sorted(r["key"] for r in runs) and failed == []
+    executors.run_local(runs, {}, 3, lambda run, result, secs: done.append(run.key()),
+                        lambda run, error, attempts: failed.append(run.key()), retries=2, fn=_dies_on_first)
+    assert sorted(done) == sorted(r.key() for r in runs) and len(done) == 12 and failed == []
 
 
 def _raises_or_unsendable(run, robots):
-    if run["key"] == "raises":
+    if run.seed == 0:
         raise ValueError("no such thing")
-    if run["key"] == "unsendable":
+    if run.seed == 1:
         return {"f": lambda: 0}, 0.0  # a lambda cannot be pickled back to the driver
     return {"ok": True}, 0.0
 
 
 def test_a_run_that_raises_or_cannot_answer_is_a_failure_and_its_worker_goes_on():
-    runs = [{"key": k, "source": "coarse", "target": "fine"} for k in ("raises", "unsendable", "fine1", "fine2")]
+    runs = _runs(4)  # seed 0 raises, seed 1 cannot answer, seeds 2 and 3 are fine
     done, failed = [], {}
-    executors.run_local(runs, {}, 1, lambda run, result, secs: done.append(run["key"]),
-                        lambda run, error, attempts: failed.update({run["key"]: (error, attempts)}),
+    executors.run_local(runs, {}, 1, lambda run, result, secs: done.append(run.seed),
+                        lambda run, error, attempts: failed.update({run.seed: (error, attempts)}),
                         retries=2, fn=_raises_or_unsendable)
-    assert sorted(done) == ["fine1", "fine2"]
-    assert failed["raises"] == ("ValueError: no such thing", 1)
-    assert failed["unsendable"][0].startswith("its result cannot be sent back") and failed["unsendable"][1] == 1
+    assert sorted(done) == [2, 3]
+    assert failed[0] == ("ValueError: no such thing", 1)
+    assert failed[1][0].startswith("its result cannot be sent back") and failed[1][1] == 1
 
 
 FAULTS = """
@@ -225,11 +233,13 @@ def answer(run, robots):
 DRIVER = """
 import sys
 sys.path.insert(0, sys.argv[1])
+from armtransfer.experiments import sweep as sweeps
 from armtransfer.parallel.executors import run_local
 import faults
 
 if __name__ == "__main__":
-    runs = [{"key": f"r{i}", "source": "big", "target": "big"} for i in range(8)]
+    runs = sweeps.expand(sweeps.normalise({"sweep": {"tasks": [1], "pairs": [["big", "big"]], "methods": ["none"],
+                                                     "seeds": list(range(8))}}))
     done, failed = [], []
     run_local(runs, {"big": bytes(16_000_000)}, 2, lambda run, result, secs: done.append(result),
               lambda run, error, attempts: failed.append(error), retries=2, fn=faults.answer)

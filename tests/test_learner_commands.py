@@ -176,15 +176,15 @@ def test_a_sweep_without_learner_keeps_its_spec_and_keys():
     plain = sweeps.normalise(raw)
     assert "learner" not in plain and "max_total_steps" not in plain
     assert sweeps.normalise({"sweep": {**raw["sweep"], "learner": "sarsa"}}) == plain
-    assert all("learner" not in run and "max_total_steps" not in run for run in sweeps.expand(plain))
+    assert all("learner" not in run.to_dict() and "max_total_steps" not in run.to_dict() for run in sweeps.expand(plain))
 
 
 def test_a_sweeps_learner_axis_keys_its_runs_apart(tiny):
     spec = sweeps.normalise({"sweep": {"name": "s", "tasks": [1], "methods": ["none", "pseudo"],
                                        "learner": ["sarsa", "tiny-q"], "max_total_steps": 500}})
     runs = sweeps.expand(spec)
-    assert [r.get("learner", "sarsa") for r in runs] == ["sarsa", "sarsa", "tiny-q", "tiny-q"]
-    assert len({r["key"] for r in runs}) == 4 and all(r["max_total_steps"] == 500 for r in runs)
+    assert [r.learner for r in runs] == ["sarsa", "sarsa", "tiny-q", "tiny-q"]
+    assert len({r.key() for r in runs}) == 4 and all(r.max_total_steps == 500 for r in runs)
     assert sweeps.check_stored(json.loads(json.dumps(spec)), "store") == spec
 
 

@@ -9,6 +9,7 @@ The installed example plugin's learner (``tabular-q``) is in ``test_example_plug
 from __future__ import annotations
 
 import dataclasses
+import types
 import json
 import os
 import re
@@ -25,6 +26,7 @@ import armtransfer
 from armtransfer.cli import main
 from armtransfer.errors import InvalidParameterError, PluginError
 from armtransfer.experiments import benchmark, benchmark_runs, learner_trial, suites
+from armtransfer.experiments.run import TrialRun
 from armtransfer.learning import learners
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.tasks.grid_robots import grid_robot
@@ -85,7 +87,7 @@ SMALL = suites.Section("small", "coarse -> fine task 1, one source seed, a short
 SMALL_SUITE = suites.Suite("small", 1, False, SMALL.description, (SMALL,))
 
 
-def _run(method: str, trial: int, budget: int, seed: int = 5, wind: float = 0.0) -> dict:
+def _run(method: str, trial: int, budget: int, seed: int = 5, wind: float = 0.0) -> TrialRun:
     cfg = LearnerConfig(max_total_steps=budget)
     return benchmark_runs.trial_run(method, trial, "coarse", "fine", [0, 0], [-8, 12], wind, seed, cfg, None,
                                     learner="oracle")
@@ -173,7 +175,7 @@ def test_a_method_and_its_baseline_get_the_same_seeds_and_the_same_seed_the_same
         ("goal-dense@oracle", "oracle", ["none@oracle"])]  # the goal-only baseline of the reward terms
     runs = plan.all_trial_runs(plan.pairs[0], {"trajectory": {"cells": [0], "actions": [0], "goal": 1,
                                                               "source": "x"}, "failure": None})
-    assert [(r["method"], r["trial"]) for r in runs] == [("none", 0), ("none", 1), ("pseudo", 0), ("pseudo", 1)]
+    assert [(r.method, r.trial) for r in runs] == [("none", 0), ("none", 1), ("pseudo", 0), ("pseudo", 1)]
     # none's trial k and pseudo's trial k: the same model seed and the same environment stream
     assert len(seen) == 8 and [s[1:] for s in seen[:2]] == [s[1:] for s in seen[2:4]] == [s[1:] for s in seen[4:6]] \
         == [s[1:] for s in seen[6:]]  # none, pseudo, dense, goal-dense
@@ -413,7 +415,7 @@ def test_a_case_of_the_default_world_keeps_its_bytes_and_label():
     assert case.world == "rooms" and case.label == "coarse -> fine, task 1"
     assert "world" not in suites.FAST.to_dict()["cases"][0]
     run = benchmark_runs.trial_run("none", 0, "coarse", "fine", [0, 0], [-8, 12], 0.0, 1, LearnerConfig(), None)
-    assert "world" not in run and benchmark_runs.robot_key("fine") == benchmark_runs.robot_key("fine", "rooms") == "fine"
+    assert "world" not in run.to_dict() and benchmark_runs.robot_key("fine") == benchmark_runs.robot_key("fine", "rooms") == "fine"
 
 
 def test_a_suite_runs_on_a_small_world_with_its_tasks(registered):
@@ -427,7 +429,7 @@ def test_a_suite_runs_on_a_small_world_with_its_tasks(registered):
     plan = benchmark.plan(suite, 0, robots, ran=["none", "pseudo"])
     pair = plan.pairs[0]
     assert (pair.start, pair.goal) == ((0, 0), (-4, 4)) and pair.case.label.endswith(", in rooms11")
-    assert pair.source_run()["world"] == "rooms11" and set(robots.resolved) == {"coarse in rooms11", "fine in rooms11"}
+    assert pair.source_run().world == "rooms11" and set(robots.resolved) == {"coarse in rooms11", "fine in rooms11"}
     records, _ = benchmark.run_suite(suite, 0, threads=1)
     assert [r["method"] for r in records] == ["none@oracle", "pseudo@oracle", "dense@oracle", "goal-dense@oracle"]
     assert all(r["world"] == "rooms11" and r["optimal"] == pair.optimal for r in records)
@@ -436,7 +438,7 @@ def test_a_suite_runs_on_a_small_world_with_its_tasks(registered):
     source, _ = benchmark_runs.execute(pair.source_run(), robots.resolved)
     sarsa = pair.trial_runs(["none"], source)[0]
     result, _ = benchmark_runs.execute(sarsa, robots.resolved)
-    assert sarsa["world"] == "rooms11" and benchmark_runs.result_problem(sarsa, result) is None
+    assert sarsa.world == "rooms11" and benchmark_runs.result_problem(sarsa.to_dict(), result) is None
     with pytest.raises(armtransfer.ArmTransferError, match="unknown task '9' in world rooms11"):
         benchmark.plan(suites.Suite("x", 1, False, "x", (dataclasses.replace(
             small, cases=(suites.Case("coarse", "fine", 9, world="rooms11"),)),)), 0)
@@ -449,7 +451,8 @@ def test_workers_are_sent_the_robots_of_a_cases_world():
 
     robots = {"coarse": object(), robot_key("coarse", "rooms11"): object(), robot_key("fine", "rooms11"): object(),
               robot_key("fine", "rooms15"): object()}
-    runs = [{"source": "coarse", "target": "fine", "world": "rooms11"}, {"source": "coarse", "target": "coarse"}]
+    runs = [types.SimpleNamespace(source="coarse", target="fine", world="rooms11"),
+            types.SimpleNamespace(source="coarse", target="coarse", world=None)]
     assert set(_robots_for(runs, robots)) == {"coarse", "coarse in rooms11", "fine in rooms11"}
     sweep = {"coarse": object(), "fine": object()}  # a sweep's robots, resolved in its one world
     assert set(_robots_for(runs, sweep)) == {"coarse", "fine"}

@@ -8,7 +8,7 @@ import pytest
 import armtransfer
 from armtransfer.cli import main
 from armtransfer.errors import InvalidParameterError
-from armtransfer.experiments import execute, matrix, sweep
+from armtransfer.experiments import matrix, sweep
 from armtransfer.learning import presets
 from armtransfer.learning.config import LearnerConfig
 
@@ -72,14 +72,14 @@ def test_every_command_refuses_an_unknown_preset_in_one_line(command, tmp_path, 
 
 def test_a_sweep_preset_sets_its_runs_learner_and_the_default_keeps_its_keys():
     plain = sweep.normalise({"sweep": {"tasks": [1]}})
-    assert "preset" not in plain and all("preset" not in r for r in sweep.expand(plain))
+    assert "preset" not in plain and all("preset" not in r.to_dict() for r in sweep.expand(plain))
     spec = sweep.normalise({"sweep": {"tasks": [1], "preset": "paper-calibrated", "epsilon": [0.3]}})
     runs = sweep.expand(spec)
-    assert runs and all(r["preset"] == "paper-calibrated" for r in runs)
-    cfg = execute.learner_config(runs[0])
+    assert runs and all(r.preset == "paper-calibrated" for r in runs)
+    cfg = runs[0].learner_config()
     assert (cfg.alpha, cfg.gamma, cfg.lam) == (CALIBRATED["alpha"], CALIBRATED["gamma"], CALIBRATED["lam"])
     assert cfg.epsilon == 0.3  # the sweep's own value wins over the preset's
-    assert {r["key"] for r in runs}.isdisjoint({r["key"] for r in sweep.expand(plain)})
+    assert {r.key() for r in runs}.isdisjoint({r.key() for r in sweep.expand(plain)})
 
 
 def test_a_matrix_carries_its_preset():

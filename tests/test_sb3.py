@@ -194,9 +194,9 @@ def test_the_small_suite_runs_its_cases_in_their_worlds_and_the_rooms_cases_name
         start, goal = world_task(resolve_world(world), pair.case.task).cells()
         layout = robots(pair.case.target, world).layout
         assert layout.name == world and (layout.cell(*pair.start), layout.cell(*pair.goal)) == (start, goal)
-        assert pair.source_run()["world"] == world
+        assert pair.source_run().world == world
         assert pair.base({"trajectory": None, "failure": "x"})["world"] == world
-    keys = {p.source_run()["key"] for p in plan.pairs}
+    keys = {p.source_run().key() for p in plan.pairs}
     assert len(keys) == len(plan.pairs)  # the two worlds' runs never share a key
     in_rooms = suites.get("fast").sections[0]
     assert "world" not in in_rooms.to_dict()["cases"][0]

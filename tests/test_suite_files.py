@@ -130,7 +130,7 @@ def test_a_failed_run_keeps_its_traceback_and_the_report_lists_it(tmp_path):
         result, secs = benchmark_runs.execute(src, robots.resolved)
         store.write_run(src, result, secs)
         for run in plan.all_trial_runs(pair, result):
-            if pair.source_seed == 1 and run["method"] == "pseudo":
+            if pair.source_seed == 1 and run.method == "pseudo":
                 with pytest.raises(benchmark_runs.RunFailed) as caught:
                     benchmark_runs.execute_recorded(run, {})  # no robots: a KeyError in the worker
                 broken = run
@@ -138,7 +138,7 @@ def test_a_failed_run_keeps_its_traceback_and_the_report_lists_it(tmp_path):
             else:
                 store.write_run(run, *benchmark_runs.execute(run, robots.resolved))
     store.unlock()
-    failed = json.loads((store.failed_dir / f"{broken['key']}.json").read_text())
+    failed = json.loads((store.failed_dir / f"{broken.key()}.json").read_text())
     assert failed["error"].startswith("KeyError") and "Traceback" in failed["traceback"]
     assert "in execute" in failed["traceback"]
     from armtransfer.commands.benchmark import write_report
@@ -164,8 +164,8 @@ def test_a_learners_options_are_in_its_runs_keys():
     plain = benchmark_runs.trial_run(**run)
     a = benchmark_runs.trial_run(**run, learner_options={"alpha": 0.5})
     b = benchmark_runs.trial_run(**run, learner_options={"alpha": 0.25})
-    assert len({plain["key"], a["key"], b["key"]}) == 3 and a["learner_options"] == {"alpha": 0.5}
-    assert "learner_options" not in plain  # a learner without options keeps the keys it had
+    assert len({plain.key(), a.key(), b.key()}) == 3 and a.learner_options == {"alpha": 0.5}
+    assert "learner_options" not in plain.to_dict()  # a learner without options keeps the keys it had
 
 
 def test_a_potential_of_ones_own_says_what_the_bound_did_to_it():
@@ -273,7 +273,7 @@ def test_a_learner_receives_the_transfer_and_its_options_key_its_runs(seen_learn
                                "cases": [{"source": "coarse", "target": "fine", "task": 2}]}, "test")
     plan = benchmark.plan(suite, 0, None, *benchmark.methods_to_run(suite.methods))
     runs = plan.all_trial_runs(plan.pairs[0], None)  # those that wait for no trajectory: none's
-    assert [r["method"] for r in runs] == ["none"] and runs[0]["learner_options"] == {"alpha": 0.5}
+    assert [r.method for r in runs] == ["none"] and runs[0].learner_options == {"alpha": 0.5}
     records, _ = benchmark.run_suite(suite, 0, learners=["seen"])
     assert {r["method"] for r in records} == {"none@seen", "pseudo@seen", "goal-dense@seen"}
     shaped = [t for t in _Seen.seen if t.method == "pseudo"]
@@ -297,13 +297,13 @@ def test_a_sweeps_learner_options_key_its_runs_and_its_store(seen_learner):
     spec = sweep.normalise(raw)
     assert spec["learner_options"] == {"seen": {"alpha": 0.5}}
     runs = sweep.expand(spec)
-    assert [r.get("learner_options") for r in runs] == [None, {"alpha": 0.5}]  # sarsa's run keeps its key
+    assert [r.learner_options for r in runs] == [None, {"alpha": 0.5}]  # sarsa's run keeps its key
     stored = json.loads(json.dumps(spec))
     assert sweep.check_stored(stored, "store") == stored
     LEARNERS["seen"] = replace(LEARNERS["seen"], options={"alpha": 0.25})
     with pytest.raises(sweep.SweepFileError, match=r"had the options \{'seen': \{'alpha': 0.5\}\}"):
         sweep.check_stored(stored, "store")
-    assert [r.get("learner_options") for r in sweep.expand(sweep.normalise(raw))] == [None, {"alpha": 0.25}]
+    assert [r.learner_options for r in sweep.expand(sweep.normalise(raw))] == [None, {"alpha": 0.25}]
 
 
 def test_an_unreachable_goal_behind_a_door_on_an_odd_cell_names_the_even_cell_rule(tmp_path, monkeypatch, capsys):

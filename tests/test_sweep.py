@@ -47,7 +47,7 @@ def test_grid_expands_to_every_combination_and_none_ignores_k(tmp_path):
     sw = sweeps.load(path)
     # 2 tasks x 2 pairs x 2 seeds x (none + pseudo x 2 K)
     assert len(sw.runs) == 2 * 2 * 2 * 3
-    assert len({r["key"] for r in sw.runs}) == len(sw.runs)
+    assert len({r.key() for r in sw.runs}) == len(sw.runs)
 
 
 def test_sweep_runs_then_rerun_is_idempotent(sweep_file, tmp_path, capsys):
@@ -92,7 +92,7 @@ def test_kill_9_mid_sweep_then_resume_gives_the_uninterrupted_summary(sweep_file
 
 def crash_once(run, robots):
     """A worker that dies (SIGKILL) the first time it meets a run, then works."""
-    marker = Path(os.environ["CRASH_DIR"]) / run["key"]
+    marker = Path(os.environ["CRASH_DIR"]) / run.key()
     if not marker.exists():
         marker.write_text("x")
         os.kill(os.getpid(), signal.SIGKILL)
@@ -114,8 +114,8 @@ def test_killed_workers_are_retried_or_reported_never_lost(tmp_path, monkeypatch
     runs = list(sweeps.load(sw_path).runs)
     robots = {"coarse": grid_robot("coarse"), "fine": grid_robot("fine")}
     done, failed = [], []
-    run_local(runs, robots, 2, lambda r, res, s: done.append(r["key"]),
-              lambda r, err, n: failed.append((r["key"], err, n)), retries=1, fn=fn)
+    run_local(runs, robots, 2, lambda r, res, s: done.append(r.key()),
+              lambda r, err, n: failed.append((r.key(), err, n)), retries=1, fn=fn)
     assert len(done) + len(failed) == len(runs) == 2
     assert len(failed) == expect_failed
     for _, err, attempts in failed:
@@ -187,8 +187,8 @@ def test_ray_executor_without_ray_says_how_to_install_it(sweep_file, tmp_path, c
                          ids=lambda p: p.name)
 def test_every_example_sweep_file_is_valid(path):
     sw = sweeps.load(path)
-    assert sw.runs and len({r["key"] for r in sw.runs}) == len(sw.runs)
+    assert sw.runs and len({r.key() for r in sw.runs}) == len(sw.runs)
     if path.name == "paper.toml":  # the paper's whole protocol: 4 tasks x 2 directions x 2 winds
-        assert {r["task"] for r in sw.runs} == {1, 2, 3, 4}
-        assert {(r["source"], r["target"]) for r in sw.runs} == {("coarse", "fine"), ("fine", "coarse")}
-        assert {r["wind"] for r in sw.runs} == {0.0, 0.01}
+        assert {r.task for r in sw.runs} == {1, 2, 3, 4}
+        assert {(r.source, r.target) for r in sw.runs} == {("coarse", "fine"), ("fine", "coarse")}
+        assert {r.wind for r in sw.runs} == {0.0, 0.01}

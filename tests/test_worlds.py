@@ -240,8 +240,8 @@ def test_a_sweeps_world_goes_into_its_runs_keys(tmp_path):
     plain = sweeps.expand(sweeps.normalise({"sweep": base}))
     assert sweeps.expand(sweeps.normalise({"sweep": dict(base, world="rooms")})) == plain  # rooms: keys as before
     small = sweeps.expand(sweeps.normalise({"sweep": dict(base, world="rooms11")}))
-    assert small[0]["key"] != plain[0]["key"] and small[0]["world"]["name"] == "rooms11"
-    assert small[0]["start"] == [0, 0] and small[0]["goal"] == [-4, 4]
+    assert small[0].key() != plain[0].key() and small[0].world["name"] == "rooms11"
+    assert small[0].start == (0, 0) and small[0].goal == (-4, 4)
     assert sweeps.sweep_world(small[0]) is world("rooms11")
     with pytest.raises(sweeps.SweepFileError, match="unknown task 5 in world rooms11; valid tasks: 1, 2, 3"):
         sweeps.normalise({"sweep": dict(base, world="rooms11", tasks=[5])})

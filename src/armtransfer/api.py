@@ -132,10 +132,10 @@ def transfer(
     outside learner's trial that runs longer than 30 s says how far it has got on stderr every 30 s.
     """
     req = _checked(dict(locals()))
-    if req.engine == engines.CONTINUOUS:
+    if req.engine.name == engines.CONTINUOUS:
         return _transfer_continuous(req)
     src, tgt, distance = _discrete_pair(req)
-    if req.engine == engines.OUTSIDE:
+    if req.engine.name == engines.OUTSIDE:
         return _transfer_outside(req, src, tgt, distance)
     return _transfer_tabular(req, src, tgt, distance)
 
@@ -167,7 +167,7 @@ class _Request:
     noise: float
     outside: Any
     probe_timeout: float
-    engine: str
+    engine: engines.Engine
     """Who learns (``experiments.engines``): the kernel, the continuous learner or the outside one."""
 
 
@@ -182,8 +182,8 @@ def _checked(a: dict[str, Any]) -> _Request:
     if not method_names:
         raise InvalidParameterError(f"give at least one method; valid methods: {', '.join(registry.METHODS)}")
     outside = _outside_learner(a["learner"])
-    engine = engines.engine_of(SARSA if outside is None else outside.name, state)
-    if engine == engines.OUTSIDE:
+    engine = engines.engine_for(SARSA if outside is None else outside.name, state)
+    if engine.name == engines.OUTSIDE:
         refuse_methods(outside, method_names)
     if state == "continuous":  # the methods asked for, before their baselines join them
         for m in method_names:
@@ -341,9 +341,12 @@ def _transfer_outside(req: _Request, src: DiscreteRobot, tgt: DiscreteRobot, dis
                                          req.wind, potentials.DENSE_BETA if req.beta is None else req.beta)
         if made is not None:
             verified[m] = made.K
-    runs = learner_transfer.run_all(learner, src, tgt, start, goal, req.methods, trajs, req.trials, req.seed,
-                                    req.config, wind=req.wind, K=verified, beta=req.beta, tick=req.progress,
-                                    heartbeat=req.progress is not None)  # a long trial says how far it has got
+    learner_trial.refuse_methods(learner, req.methods)  # the baselines too, before any is learned
+    runs = [req.engine.trials(engines.Work(m, tgt.name, the_task.start, the_task.goal, req.trials, req.seed, req.config,
+                                           wind=req.wind, K=verified.get(m, "auto"), beta=req.beta,
+                                           learner=learner.name, on_trial=req.progress,
+                                           heartbeat=req.progress is not None),  # a long trial says how far it has got
+                              tgt, trajs) for m in req.methods]
     by_method, by_control = _by_method_and_control(runs)
     return TransferResult(task=the_task, source=src, target=tgt, distance=distance, trajectories=trajs, seed=req.seed,
                           trials=req.trials, wind=req.wind, config=req.config, methods=by_method, controls=by_control,
@@ -378,8 +381,9 @@ def _transfer_continuous(req: _Request) -> ContinuousResult:
         src.start_state(cell, what=what)
     shaped = any(registry.get(m).shaped for m in method_names)
     trajs = resolve_trajectories(specs, src, the_task, config, seed) if shaped else []
-    # the arm is placed over the start already (above): run_all would solve the same IK again
-    results = [runs.run_method(m, arm, goal_cell, trajs, trials, seed, config, K, approx, on_trial=progress)
+    # the arm is placed over the start already (above), handed to the engine with the work
+    results = [req.engine.trials(engines.Work(m, target, the_task.start, the_task.goal, trials, seed, config, K=K,
+                                              state="continuous", noise=noise, on_trial=progress, arm=arm), None, trajs)
                for m in method_names]
     return runs.ContinuousResult(task=the_task, source=src.name, target=f"{target} (continuous)", trajectories=trajs,
                                  seed=seed, trials=trials, config=config, approximation=approx,

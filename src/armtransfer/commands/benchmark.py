@@ -27,6 +27,7 @@ from armtransfer.commands.sweep import add_executor_arguments, check_executor_op
 from armtransfer.errors import InvalidParameterError, PluginError
 from armtransfer.experiments import benchmark, learner_trial, suite_files, suites
 from armtransfer.experiments.benchmark_runs import execute_recorded as execute
+from armtransfer.experiments.run import SourceRun, TrialRun
 from armtransfer.experiments.reports import benchmark_report
 from armtransfer.experiments.stats import benchmark_stats
 from armtransfer.experiments.store import ResultStore, StoreError
@@ -172,12 +173,12 @@ def _run_into(store: ResultStore, plan: benchmark.Plan, robots: dict, args: argp
     todo, waiting, done = [], {}, 0
     for pair in plan.pairs:
         src = pair.source_run()
-        found = store.load_run(src["key"])
+        found = store.load_run(src.key())
         if found is None:
             todo.append(src)
-            waiting[src["key"]] = pair
+            waiting[src.key()] = pair
         runs = plan.all_trial_runs(pair, None if found is None else found["result"])
-        left = [r for r in runs if not store.is_done(r["key"])]
+        left = [r for r in runs if not store.is_done(r.key())]
         todo += left
         done += (found is not None) + len(runs) - len(left)
     to_run = plan.size() - done
@@ -185,24 +186,24 @@ def _run_into(store: ResultStore, plan: benchmark.Plan, robots: dict, args: argp
           f"run ({args.executor})")
     if not to_run:
         return 0
-    todo.sort(key=lambda r: r["key"] not in waiting)  # source runs first: trial runs wait for them
+    todo.sort(key=lambda r: r.key() not in waiting)  # source runs first: trial runs wait for them
     failed: list[str] = []
     with common.progress_bar(to_run, f"benchmark {plan.suite.name}") as bar:
-        def on_done(run: dict, result: dict, secs: float) -> list[dict]:
+        def on_done(run: SourceRun, result: dict, secs: float) -> list[TrialRun]:
             store.write_run(run, result, secs)
             bar.update()
-            pair = waiting.pop(run["key"], None)
+            pair = waiting.pop(run.key(), None)
             if pair is None:
                 return []
             released = plan.waiting_runs(pair, result)
-            more = [r for r in released if not store.is_done(r["key"])]
+            more = [r for r in released if not store.is_done(r.key())]
             bar.update(len(released) - len(more))  # a run done before its source's file was set aside
             return more
 
-        def on_failed(run: dict, error: str, attempts: int) -> None:
+        def on_failed(run: SourceRun, error: str, attempts: int) -> None:
             store.write_failure(run, error, attempts)
-            failed.append(f"{run['key']}: {error.splitlines()[0] if error else error}")
-            bar.update(1 + (plan.waiting(waiting[run["key"]]) if run["key"] in waiting else 0))
+            failed.append(f"{run.key()}: {error.splitlines()[0] if error else error}")
+            bar.update(1 + (plan.waiting(waiting[run.key()]) if run.key() in waiting else 0))
 
         if args.executor == "ray":
             run_ray(todo, robots, args.workers, args.address, on_done, on_failed, retries=args.retries, fn=execute)
@@ -220,13 +221,13 @@ def write_report(store: ResultStore, plan: benchmark.Plan) -> dict:
     """The report of a store whose runs are all in, written into it (report.md last: it is
     there only when the rest is); returns the statistics. :class:`~armtransfer.experiments.
     benchmark.IncompleteError` when a run is missing."""
-    def result(run: dict) -> dict | None:
-        rec = store.load_run(run["key"])
+    def result(run: SourceRun) -> dict | None:
+        rec = store.load_run(run.key())
         return None if rec is None else rec["result"]
 
-    def seconds(run: dict) -> float | None:
+    def seconds(run: SourceRun) -> float | None:
         try:
-            return float(json.loads((store.timings_dir / f"{run['key']}.json").read_text())["elapsed_seconds"])
+            return float(json.loads((store.timings_dir / f"{run.key()}.json").read_text())["elapsed_seconds"])
         except (OSError, ValueError, KeyError, TypeError):
             return None
 

@@ -166,5 +166,5 @@ def write_summary(store: ResultStore, out: Path) -> str:
     return header + text
 
 
-def store_runs(spec: dict) -> list[dict]:
+def store_runs(spec: dict) -> list:
     return sweeps.expand(spec)

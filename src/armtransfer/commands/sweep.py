@@ -6,12 +6,14 @@ import argparse
 import os
 
 from armtransfer.commands import common
-from armtransfer.experiments.execute import learner_config, robot_specs
+from armtransfer.experiments.execute import robot_specs
+from armtransfer.experiments.run import SweepRun
 from armtransfer.tasks.catalog import custom_task
 from armtransfer.parallel.executors import ExecutorError, _check_reachable, check_address, _import_ray, run_local, run_ray
 from armtransfer.tasks.specs import resolve
 from armtransfer.experiments import sweep as sweeps
 from armtransfer.experiments.store import ResultStore
+from armtransfer.learning.learner_names import SARSA
 
 HELP = "Run a grid of tasks, robots, methods and settings from a TOML file into a resumable result store."
 EXAMPLE = "armtransfer sweep examples/sweeps/quick.toml --out runs/quick"
@@ -69,7 +71,7 @@ def run_sweep(sweep: sweeps.Sweep, args: argparse.Namespace) -> int:
         store.unlock()
 
 
-def check_runs(runs: list[dict], probe_timeout: float = 60.0) -> dict:
+def check_runs(runs: list[SweepRun], probe_timeout: float = 60.0) -> dict:
     """Every robot the runs name, built once (arms come from the on-disk cache) to be shared
     with the workers; a robot that cannot be built, or a task cell it cannot start or end
     at, is a one-line error naming the run's robot and task."""
@@ -77,25 +79,24 @@ def check_runs(runs: list[dict], probe_timeout: float = 60.0) -> dict:
         raise sweeps.SweepFileError("the sweep has no runs")
     from armtransfer.learning.methods import probe_on, refuse_run_time
 
-    refuse_run_time((run["method"] for run in runs), "a sweep's runs")
-    outside = list(dict.fromkeys(run["learner"] for run in runs if "learner" in run))
+    refuse_run_time((run.method for run in runs), "a sweep's runs")
+    outside = list(dict.fromkeys(run.learner for run in runs if run.learner != SARSA))
     refuse_run_time_learners(outside)
-    arms = {name: arm for run in runs for name, arm in run.get("arms", {}).items()}
+    arms = {name: arm for run in runs for name, arm in (run.arms or {}).items()}
     layout = sweeps.sweep_world(runs[0])  # one world a sweep
     robots = {spec: resolve(spec, arms=arms, layout=layout) for spec in robot_specs(runs)}
     seen = set()
     for run in runs:
-        key = (run["source"], run["target"], tuple(run["start"]), tuple(run["goal"]))
+        key = (run.source, run.target, run.start, run.goal)
         if key in seen:
             continue
         seen.add(key)
-        task = custom_task(tuple(run["start"]), tuple(run["goal"]), layout)
-        start, goal = task.cells()
-        for spec in (run["source"], run["target"]):
+        start, goal = custom_task(run.start, run.goal, layout).cells()
+        for spec in (run.source, run.target):
             robots[spec].start_state(start)
             robots[spec].start_state(goal, what="goal")
     _check_farming_bounds(runs, robots)
-    probe_on((run["method"] for run in runs), [robots[s] for s in dict.fromkeys(run["target"] for run in runs)],
+    probe_on((run.method for run in runs), [robots[s] for s in dict.fromkeys(run.target for run in runs)],
              probe_timeout)
     probe_learners(outside, runs, robots, probe_timeout)
     return robots
@@ -116,7 +117,7 @@ def refuse_run_time_learners(names: list[str]) -> None:
                               "armtransfer.transfer(..., learner=...)")
 
 
-def probe_learners(names: list[str], runs: list[dict], robots: dict, seconds: float = 60.0) -> None:
+def probe_learners(names: list[str], runs: list[SweepRun], robots: dict, seconds: float = 60.0) -> None:
     """Every outside learner made, learning a few steps and predicting on each target robot's
     first task (``learner_trial.probe``): a learner's fault is one line now, before the store
     is opened."""
@@ -126,12 +127,12 @@ def probe_learners(names: list[str], runs: list[dict], robots: dict, seconds: fl
     for name in names:
         seen: set[str] = set()
         for run in runs:
-            if run.get("learner") == name and run["target"] not in seen:
-                seen.add(run["target"])
-                learner_trial.probe(get(name), robots[run["target"]], list(run["start"]), list(run["goal"]), seconds)
+            if run.learner == name and run.target not in seen:
+                seen.add(run.target)
+                learner_trial.probe(get(name), robots[run.target], list(run.start), list(run.goal), seconds)
 
 
-def _check_farming_bounds(runs: list[dict], robots: dict) -> None:
+def _check_farming_bounds(runs: list[SweepRun], robots: dict) -> None:
     """A numeric K of a farmable method that is farmable whatever trajectory the source hands
     over: any trajectory is at least as long as the source's shortest path, n, and K >= the
     bound -step_reward/n already pays more than a step. (The exact check, by value iteration on
@@ -140,23 +141,23 @@ def _check_farming_bounds(runs: list[dict], robots: dict) -> None:
 
     shortest: dict[tuple, int] = {}
     for run in runs:
-        if run["K"] in (None, "auto") or not methods.get(run["method"]).farmable:
+        if run.K is None or run.K == "auto" or not methods.get(run.method).farmable:
             continue
-        key = (run["source"], tuple(run["start"]), tuple(run["goal"]))
+        key = (run.source, run.start, run.goal)
         if key not in shortest:
-            start, goal = custom_task(tuple(run["start"]), tuple(run["goal"]), robots[run["source"]].layout).cells()
-            shortest[key] = trajectory.shortest(robots[run["source"]], start, goal).n
+            start, goal = custom_task(run.start, run.goal, robots[run.source].layout).cells()
+            shortest[key] = trajectory.shortest(robots[run.source], start, goal).n
         n = max(shortest[key], 1)
-        step = learner_config(run).step_reward
-        if step + n * float(run["K"]) >= 0:
+        step = run.learner_config().step_reward
+        if step + n * float(run.K) >= 0:
             raise sweeps.SweepFileError(
-                f"K={run['K']:g} can be farmed for {run['method']} on {run['source']} -> {run['target']} "
-                f"(task {run['task'] or run['start']}): any trajectory has n >= {n}, so K must stay below "
+                f"K={run.K:g} can be farmed for {run.method} on {run.source} -> {run.target} "
+                f"(task {run.task or list(run.start)}): any trajectory has n >= {n}, so K must stay below "
                 f"{-step / n:.6g}")
 
 
 def _run_into(store: ResultStore, sweep: sweeps.Sweep, robots: dict, args: argparse.Namespace) -> int:
-    todo = [r for r in sweep.runs if not store.is_done(r["key"])]
+    todo = [r for r in sweep.runs if not store.is_done(r.key())]
     print(f"sweep {sweep.name!r}: {len(sweep.runs)} runs, {len(sweep.runs) - len(todo)} already done, "
           f"{len(todo)} to run ({args.executor})")
     if not todo:
@@ -169,7 +170,7 @@ def _run_into(store: ResultStore, sweep: sweeps.Sweep, robots: dict, args: argpa
 
         def on_failed(run, error, attempts):
             store.write_failure(run, error, attempts)
-            failed.append(f"{run['key']}: {error}")
+            failed.append(f"{run.key()}: {error}")
             bar.update()
 
         workers = args.workers or os.cpu_count() or 1

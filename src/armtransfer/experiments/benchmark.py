@@ -31,6 +31,7 @@ from armtransfer.errors import ArmTransferError, InvalidParameterError, InvalidT
 from armtransfer.experiments import benchmark_runs, engines, experiment, suites
 from armtransfer.learning import methods
 from armtransfer.learning import presets
+from armtransfer.experiments.run import SourceRun, TrialRun
 from armtransfer.experiments.comparisons import GOAL_ONLY as GOAL_ONLY, baseline_of as baseline_of
 from armtransfer.experiments.comparisons import baselines_of as baselines_of
 from armtransfer.experiments.comparisons import registered_baseline as registered_baseline
@@ -182,7 +183,7 @@ class IncompleteError(ArmTransferError):
         self.missing = missing
 
 
-Lookup = Callable[[dict], "dict | None"]
+Lookup = Callable[[SourceRun], "dict | None"]
 """A finished run's result by its run (None: not finished)."""
 
 
@@ -211,12 +212,12 @@ class Pair:
         """Robot 2's learner: :attr:`learner`, with the section's step cap."""
         return replace(self.learner, max_total_steps=self.section.max_total_steps)
 
-    def source_run(self) -> dict:
+    def source_run(self) -> SourceRun:
         return benchmark_runs.source_run(self.case.source, self.case.target, list(self.start), list(self.goal),
                                          self.seed, SOURCE_CONFIG, world=self.case.world)
 
     def trial_runs(self, names: Sequence[str], source_result: dict | None,
-                   learner: str = benchmark_runs.LEARNER) -> list[dict]:
+                   learner: str = benchmark_runs.LEARNER) -> list[TrialRun]:
         """Every trial run of the methods ``names`` by ``learner``, in (method, trial) order;
         without the source run's result, only those of the methods that read no trajectory."""
         options = None
@@ -232,11 +233,11 @@ class Pair:
                 for k in range(self.section.trials)]
 
     def waiting_runs(self, names: Sequence[str], source_result: dict,
-                     learner: str = benchmark_runs.LEARNER) -> list[dict]:
+                     learner: str = benchmark_runs.LEARNER) -> list[TrialRun]:
         """The trial runs that wait for the source run: those of the methods that read the
         trajectory (the others are in :meth:`trial_runs` without it)."""
         return [run for run in self.trial_runs(names, source_result, learner)
-                if benchmark_runs.needs_trajectory(run["method"])]
+                if benchmark_runs.needs_trajectory(run.method)]
 
     def base(self, source_result: dict) -> dict:
         """What every record of this pair holds, before its method's."""
@@ -330,11 +331,11 @@ class Plan:
         pairs = self.pairs if pair is None else (pair,)
         return list(dict.fromkeys(label(m, lr) for p in pairs for lr, ms in self.entries(p) for m in ms))
 
-    def all_trial_runs(self, pair: Pair, source_result: dict | None) -> list[dict]:
+    def all_trial_runs(self, pair: Pair, source_result: dict | None) -> list[TrialRun]:
         """Every trial run of ``pair``: per learner, :meth:`Pair.trial_runs` of its methods."""
         return [run for lr, ms in self.entries(pair) for run in pair.trial_runs(ms, source_result, lr)]
 
-    def waiting_runs(self, pair: Pair, source_result: dict) -> list[dict]:
+    def waiting_runs(self, pair: Pair, source_result: dict) -> list[TrialRun]:
         """The trial runs of ``pair`` that wait for its source run, every learner's."""
         return [run for lr, ms in self.entries(pair) for run in pair.waiting_runs(ms, source_result, lr)]
 
@@ -392,26 +393,26 @@ class Plan:
             src = pair.source_run()
             source = result(src)
             if source is None:
-                if src["key"] in failed:  # the pair is left out: robot 1's run failed, and any that ran without it
-                    lose(pair, "source", [src["key"], *(run["key"] for run in self.all_trial_runs(pair, None)
-                                                        if run["key"] in failed)])
+                if src.key() in failed:  # the pair is left out: robot 1's run failed, and any that ran without it
+                    lose(pair, "source", [src.key(), *(run.key() for run in self.all_trial_runs(pair, None)
+                                                        if run.key() in failed)])
                 else:
                     missing += 1 + self.trials_of(pair)
                 continue
             trials = [(run, result(run)) for run in self.all_trial_runs(pair, source)]
-            missing += sum(r is None and run["key"] not in failed for run, r in trials)
+            missing += sum(r is None and run.key() not in failed for run, r in trials)
             names = self.labels(pair)
             for name in names:
-                mine = [(run, r) for run, r in trials if label(run["method"], run["learner"]) == name]
+                mine = [(run, r) for run, r in trials if label(run.method, run.learner) == name]
                 if all(r is not None for _, r in mine):
                     out.append(record(pair, name, source, [r for _, r in mine if r is not None], names))
-                elif keys := [run["key"] for run, r in mine if r is None and run["key"] in failed]:
+                elif keys := [run.key() for run, r in mine if r is None and run.key() in failed]:
                     lose(pair, name, keys)
         if missing:
             raise IncompleteError(f"{missing} of {self.size()} runs are not in yet", missing)
         return out, lost
 
-    def timings(self, result: Lookup, seconds: Callable[[dict], float | None]) -> dict:
+    def timings(self, result: Lookup, seconds: Callable[[SourceRun], float | None]) -> dict:
         """Each pair's seconds: its source run's and, per method, its trial runs' summed;
         ``total_seconds``: every run's, summed (the work, whichever workers did it)."""
         rows, total = [], 0.0
@@ -420,7 +421,7 @@ class Plan:
             source_seconds = seconds(src) or 0.0
             per_method: dict[str, float] = {}
             for run in self.all_trial_runs(pair, result(src)):
-                name = label(run["method"], run["learner"])
+                name = label(run.method, run.learner)
                 per_method[name] = per_method.get(name, 0.0) + (seconds(run) or 0.0)
             total += source_seconds + sum(per_method.values())
             rows.append({"section": pair.section.name, "case": pair.index, "source_seed": pair.source_seed,
@@ -499,11 +500,11 @@ def run_suite(suite: suites.Suite, seed: int = 0, tick: Callable[[], None] | Non
     seconds: dict[str, float] = {}
     for pair in p.pairs:
         src = pair.source_run()
-        results[src["key"]], seconds[src["key"]] = benchmark_runs.execute(src, robots.resolved)
-        runs = p.all_trial_runs(pair, results[src["key"]])
+        results[src.key()], seconds[src.key()] = benchmark_runs.execute(src, robots.resolved)
+        runs = p.all_trial_runs(pair, results[src.key()])
         done = experiment.map_trials(lambda i: benchmark_runs.execute(runs[i], robots.resolved), len(runs), threads,
                                      on_trial=tick)
         for run, (result, secs) in zip(runs, done):
-            results[run["key"]], seconds[run["key"]] = result, secs
-    found = lambda run: results.get(run["key"])  # noqa: E731
-    return p.records(found), p.timings(found, lambda run: seconds.get(run["key"]))
+            results[run.key()], seconds[run.key()] = result, secs
+    found = lambda run: results.get(run.key())  # noqa: E731
+    return p.records(found), p.timings(found, lambda run: seconds.get(run.key()))

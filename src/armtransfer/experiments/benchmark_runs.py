@@ -1,7 +1,8 @@
 """The benchmark's runs, as the result store holds them: what one run is, how it is run, and
 what a whole result of it looks like.
 
-There are two kinds, each keyed by a hash of its full configuration (its content):
+There are two kinds (``run.SourceRun``, ``run.TrialRun``), each keyed by a hash of its full
+configuration (its content):
 
 - a **source run**: robot 1 learns one (case, source seed)'s task without transfer; its
   result is the converged greedy path it hands over (as cell ids and action indices), or
@@ -11,14 +12,11 @@ There are two kinds, each keyed by a hash of its full configuration (its content
   keyed by what it was handed, and can run anywhere, on any worker or cluster node, from
   its configuration alone); the other methods do not depend on robot 1 at all.
 
-Every run names its ``learner``: the learner that runs a trial run's trial. ``sarsa`` (the
-learner of Algorithm 1, :func:`armtransfer.experiments.experiment.run_method`) is the one
-this build has; :data:`LEARNERS` maps a name to the function that runs one trial, so a learner
-added later runs through the same store, its runs keyed apart from the built-in one's.
-
-A trial run of a case with a continuous target (``suites.Case.state``) names ``state`` and
-``noise``: its trial runs the linear learner on the target's continuous arm
-(:func:`_continuous_trial`); robot 1's source run is the same table-based one.
+Every run names its ``learner``: the learner that runs a trial run's trial. The engine that
+runs it is chosen from the learner and the target's state (``engines.engine_for``): ``sarsa``
+(Algorithm 1) by the compiled kernel, or on a continuous target (``suites.Case.state``, the run
+names ``state`` and ``noise``) by the linear learner on the target's continuous arm; a learner of
+the outside registry through the harness; robot 1's source run is always the table-based one.
 
 A trial's random stream is ``SeedSequence([seed, 0, trial])``, the stream of trial ``trial``
 of the whole method, so running the trials one by one, in any order and on any worker, gives
@@ -29,12 +27,11 @@ from __future__ import annotations
 
 import time
 import traceback
-from collections.abc import Callable
 
 from armtransfer.errors import ArmTransferError, PluginError
 from armtransfer.experiments import engines, experiment
 from armtransfer.experiments.stats import learning_metrics
-from armtransfer.experiments.sweep import content_key
+from armtransfer.experiments.run import DEFAULT_WORLD, SOURCE_FORMAT, TRIAL_FORMAT, SourceRun, TrialRun
 from armtransfer.learning import methods
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.learner_names import SARSA
@@ -42,16 +39,10 @@ from armtransfer.learning.trial_result import TrialResult
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.robot import DiscreteRobot
 
-SOURCE_FORMAT = "armtransfer-benchmark-source/1"
-TRIAL_FORMAT = "armtransfer-benchmark-trial/1"
 FORMATS = (SOURCE_FORMAT, TRIAL_FORMAT)
 
 LEARNER = SARSA
 """The built-in learner: SARSA(lambda), Algorithm 1 with the method's shaping."""
-
-
-def _key(run: dict) -> dict:
-    return dict(run, key=content_key(run))
 
 
 def needs_trajectory(method: str) -> bool:
@@ -60,67 +51,49 @@ def needs_trajectory(method: str) -> bool:
     return m.shaped and getattr(m, "uses_trajectory", True)
 
 
-DEFAULT_WORLD = "rooms"
-
-
 def robot_key(spec: str, world: str | None = None) -> str:
     """The key of robot ``spec`` in the world ``world`` in the robots handed to :func:`execute`:
     the spec alone in the paper's rooms."""
     return spec if world in (None, DEFAULT_WORLD) else f"{spec} in {world}"
 
 
-def _in_world(run: dict, world: str) -> dict:
-    if world != DEFAULT_WORLD:  # a run of the paper's rooms keeps the key it had before worlds
-        run["world"] = world
-    return run
-
-
 def source_run(source: str, target: str, start: list[int], goal: list[int], seed: int,
-               config: LearnerConfig, world: str = DEFAULT_WORLD) -> dict:
+               config: LearnerConfig, world: str = DEFAULT_WORLD) -> SourceRun:
     """Robot 1 (``source``) learning the task from ``start`` to ``goal`` (x, y) with ``seed``;
     ``target`` names the case's robot 2 (a random task is drawn for both); ``world``: the
     world they move in."""
-    return _key(_in_world({"format": SOURCE_FORMAT, "learner": LEARNER, "source": source, "target": target,
-                           "start": list(start), "goal": list(goal), "seed": int(seed), "config": config.to_dict()},
-                          world))
+    return SourceRun(learner=LEARNER, source=source, target=target, start=(start[0], start[1]), goal=(goal[0], goal[1]),
+                     seed=int(seed), config=config.to_dict(), world=world)
 
 
 CONTINUOUS = "continuous"
-"""A trial run's ``state`` when robot 2 is a continuous arm; a run without ``state`` is on the
-target's compiled table (every run written before continuous targets, with its key)."""
+"""A trial run's ``state`` when robot 2 is a continuous arm (``run.TrialRun``)."""
 
 
 def trial_run(method: str, trial: int, source: str, target: str, start: list[int], goal: list[int], wind: float,
               seed: int, config: LearnerConfig, source_result: dict | None, learner: str = LEARNER,
               world: str = DEFAULT_WORLD, state: str = "discrete", noise: float = 0.0,
-              learner_options: dict | None = None) -> dict:
+              learner_options: dict | None = None) -> TrialRun:
     """Trial ``trial`` of ``method`` on robot 2 (``target``). A method that reads the trajectory
     is handed ``source_result``'s (the result of the case's source run: its path, or why there
     is none); the others carry neither. Where robot 1 handed nothing over, the run also names
     ``told_nothing``: the method's baseline, which the trial then runs (:func:`trial_result`).
     ``state`` ``continuous``: robot 2 is ``target``'s continuous arm with actuation noise
-    ``noise`` (the run names both; a discrete run names neither, keeping its key).
-    ``learner_options``: an outside learner's own settings (``Learner.options``), in the run's
-    configuration and so its key (none: the key it had before learners had options)."""
-    run = {"format": TRIAL_FORMAT, "learner": learner, "method": method, "trial": int(trial), "source": source,
-           "target": target, "start": list(start), "goal": list(goal), "wind": wind, "seed": int(seed),
-           "config": config.to_dict()}
-    if learner_options:
-        run["learner_options"] = dict(learner_options)
-    _in_world(run, world)
-    if state == CONTINUOUS:
-        run["state"], run["noise"] = CONTINUOUS, float(noise)
-    elif state != "discrete" or noise:
-        raise ValueError(f"a trial run's state is discrete or continuous (noise with continuous only), got "
-                         f"{state!r} with noise {noise!r}")
+    ``noise``. ``learner_options``: an outside learner's own settings (``Learner.options``), in
+    the run's configuration and so its key."""
+    if state != CONTINUOUS and noise:
+        raise ValueError(f"a trial run's noise goes with a continuous state, got {state!r} with noise {noise!r}")
+    handed = {}
     if needs_trajectory(method):
         if source_result is None:
             raise ValueError(f"a trial of {method} needs its source run's result")
-        run["trajectory"] = source_result["trajectory"]
-        run["source_failure"] = source_result["failure"]
-        if source_result["trajectory"] is None:
-            run["told_nothing"] = told_nothing(method)
-    return _key(run)
+        handed = {"handed": True, "trajectory": source_result["trajectory"],
+                  "source_failure": source_result["failure"],
+                  "told_nothing": told_nothing(method) if source_result["trajectory"] is None else None}
+    return TrialRun(learner=learner, method=method, trial=int(trial), source=source, target=target,
+                    start=(start[0], start[1]), goal=(goal[0], goal[1]), wind=wind, seed=int(seed), config=config.to_dict(),
+                    learner_options=learner_options, world=world, state=state,
+                    noise=float(noise) if state == CONTINUOUS else None, **handed)
 
 
 def told_nothing(method: str) -> str:
@@ -152,19 +125,11 @@ def learn_source(source: DiscreteRobot, start: int, goal: int, seed: int,
                       f"{config.max_episodes:,} episodes and {config.max_total_steps:,} steps")
 
 
-def _cells(run: dict, robot: DiscreteRobot) -> tuple[int, int]:
-    return robot.layout.cell(*run["start"]), robot.layout.cell(*run["goal"])
-
-
-def _sarsa_trial(run: dict, target: DiscreteRobot) -> dict:
-    """One trial of the built-in learner: the fields of :func:`trial_result`."""
-    start, goal = _cells(run, target)
-    traj = run.get("trajectory")
-    given = [trajectory_of(traj)] if traj is not None else None
-    res = experiment.run_method(run["method"], target, start, goal, given, 1, run["seed"],
-                                LearnerConfig(**run["config"]), wind=run["wind"], threads=1,
-                                first_trial=run["trial"])
-    return _fields(res)
+def work_of(run: TrialRun) -> engines.Work:
+    """What a trial run's engine learns: its one trial, on one thread (a pair's trials share the threads)."""
+    return engines.Work(run.method, run.target, run.start, run.goal, 1, run.seed, run.learner_config(), wind=run.wind,
+                        first_trial=run.trial, learner=run.learner, state=run.state, noise=run.noise or 0.0,
+                        threads=1)
 
 
 def _fields(res: experiment.MethodResult) -> dict:
@@ -174,8 +139,8 @@ def _fields(res: experiment.MethodResult) -> dict:
     return {"error": None, "first_exposure": t.exploration_steps, "converged": bool(t.converged),
             "convergence_steps": t.total_steps if t.converged else None, "greedy_steps": t.greedy_steps,
             "episodes": int(t.episodes), "area": float(curve.sum()), "curve": [float(v) for v in curve],
-            "K": res.extra.get("K"), **clock_fields(t),
-            **({"warnings": res.extra["warnings"]} if res.extra.get("warnings") else {})}
+            "K": res.extra.get("K"), **({} if res.evaluations is None else {"evaluations": res.evaluations[0]}),
+            **clock_fields(t), **({"warnings": res.extra["warnings"]} if res.extra.get("warnings") else {})}
 
 
 CLOCK_FIELDS = ("good_path_steps", "shortest_path_steps", "settled_ratio", "final_ratio", "steps_run")
@@ -189,41 +154,6 @@ def clock_fields(t: TrialResult) -> dict:
     if note:
         out["clock_note"] = note
     return out
-
-
-def _continuous_trial(run: dict, target: DiscreteRobot) -> dict:
-    """One trial on ``target``'s continuous arm (in ``target``'s world, with the run's actuation
-    noise), placed over the start: the linear learner of ``armtransfer.transfer(...,
-    state="continuous")`` (``experiments.continuous.run_method``, its tile coding), trial
-    ``run["trial"]``'s streams; the fields of :func:`trial_result`. The arm is made for the trial
-    (a few ms once its scene is cached), so trials on threads share no MuJoCo data."""
-    from armtransfer.experiments import continuous
-    from armtransfer.tasks.continuous import continuous_arm
-
-    start, goal = _cells(run, target)
-    arm = continuous_arm(run["target"], layout=target.layout, noise=run["noise"])
-    arm.place(start)
-    traj = run.get("trajectory")
-    given = [trajectory_of(traj)] if traj is not None else None
-    res = continuous.run_method(run["method"], arm, goal, given, 1, run["seed"], LearnerConfig(**run["config"]),
-                                approx=continuous.approximation_for(arm), first_trial=run["trial"])
-    return _fields(res)
-
-
-def _outside_trial(run: dict, target: DiscreteRobot) -> dict:
-    """One trial of a learner of ``armtransfer.learning.learners`` (``learner_trial``'s harness)."""
-    from armtransfer.experiments import learner_trial
-
-    traj = run.get("trajectory")
-    return learner_trial.run_trial(learner_trial.known(run["learner"]), run, target,
-                                   None if traj is None else trajectory_of(traj))
-
-
-LEARNERS: dict[str, Callable[[dict, DiscreteRobot], dict]] = {LEARNER: _sarsa_trial}
-"""Learner name -> the function running one trial run on robot 2: ``(run, target) -> result``
-with the fields :func:`trial_problem` checks. It may raise an ``ArmTransferError`` (the method
-refuses the case: recorded as the run's ``error``). A learner not here, of
-``armtransfer.learning.learners.LEARNERS`` (a plugin's), runs through ``learner_trial``."""
 
 
 class RunFailed(ArmTransferError):
@@ -241,7 +171,7 @@ def with_traceback(err: BaseException) -> str:
     return (first[0] if first else type(err).__name__) + "\n" + "".join(parts)
 
 
-def execute_recorded(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
+def execute_recorded(run: SourceRun, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
     """:func:`execute` as a benchmark's workers run it: a run that raises is :class:`RunFailed`,
     its message carrying the traceback, which the store keeps beside the failure."""
     try:
@@ -250,46 +180,37 @@ def execute_recorded(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict,
         raise RunFailed(with_traceback(err)) from None
 
 
-def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
-    """(result, seconds) of one benchmark run (``robots``: by spec); what it raises propagates."""
+def execute(run: SourceRun, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
+    """(result, seconds) of one benchmark run, a source or trial run (``robots``: by
+    :func:`robot_key`); what it raises propagates."""
     t0 = time.perf_counter()
-    if run["format"] == SOURCE_FORMAT:
-        source = robots[robot_key(run["source"], run.get("world"))]
-        start, goal = _cells(run, source)
-        traj, why = learn_source(source, start, goal, run["seed"], LearnerConfig(**run["config"]))
-        result: dict = {"trajectory": None if traj is None else trajectory_json(traj), "failure": why}
-    elif run["format"] == TRIAL_FORMAT:
-        result = trial_result(run, robots[robot_key(run["target"], run.get("world"))])
+    if isinstance(run, TrialRun):
+        result = trial_result(run, robots[robot_key(run.target, run.world)])
+    elif isinstance(run, SourceRun):
+        source = robots[robot_key(run.source, run.world)]
+        start, goal = source.layout.cell(*run.start), source.layout.cell(*run.goal)
+        traj, why = learn_source(source, start, goal, run.seed, run.learner_config())
+        result = {"trajectory": None if traj is None else trajectory_json(traj), "failure": why}
     else:
-        raise ValueError(f"not a benchmark run: format {run.get('format')!r}")
+        raise ValueError(f"not a benchmark run: {type(run).__name__}")
     return result, time.perf_counter() - t0
 
 
-def trial_result(run: dict, target: DiscreteRobot) -> dict:
-    """A trial run's result: its learner's numbers, or ``error`` (and nothing else) when the
-    method cannot run: a refusal of the case. With no trajectory to hand over, the trial is its
-    baseline's (``told_nothing``): the same learner, seeds and case, byte for byte. A run written
-    before that rule (no ``told_nothing``) keeps its result: an error."""
-    if needs_trajectory(run["method"]) and run.get("trajectory") is None:
-        if "told_nothing" not in run:
-            return {"error": f"no trajectory: {run.get('source_failure')}"}
-        skip = ("key", "trajectory", "source_failure", "told_nothing")
-        return trial_result(dict({k: v for k, v in run.items() if k not in skip}, method=run["told_nothing"]), target)
-    learner = LEARNERS.get(run["learner"])
-    engine = engines.engine_of(run["learner"], run.get("state", "discrete"), "its case has")
-    if engine == engines.CONTINUOUS:
-        learner = _continuous_trial
-    elif learner is None:
-        from armtransfer.learning.learners import LEARNERS as OUTSIDE
-
-        if run["learner"] not in OUTSIDE:  # a run of a learner this build does not have fails; it is no result
-            valid = dict.fromkeys([*LEARNERS, *OUTSIDE])
-            raise ArmTransferError(f"unknown learner {run['learner']!r}; valid learners: {', '.join(valid)}")
-        learner = _outside_trial
+def trial_result(run: TrialRun, target: DiscreteRobot) -> dict:
+    """A trial run's result: its engine's numbers (``engines.engine_for``), or ``error`` (and
+    nothing else) when the method cannot run: a refusal of the case. With no trajectory to hand
+    over, the trial is its baseline's (``told_nothing``): the same learner, seeds and case, byte
+    for byte. A run written before that rule (no ``told_nothing``) keeps its result: an error."""
+    if run.handed and run.trajectory is None:
+        if run.told_nothing is None:
+            return {"error": f"no trajectory: {run.source_failure}"}
+        return trial_result(run.as_baseline(), target)
+    engine = engines.engine_for(run.learner, run.state, "its case has")
+    given = None if run.trajectory is None else [trajectory_of(run.trajectory)]
     try:
-        return learner(run, target)
+        return _fields(engine.trials(work_of(run), target, given))
     except PluginError as err:  # an outside learner's fault is no refusal of the case: its run fails
-        if run["learner"] not in LEARNERS:
+        if run.learner != LEARNER:
             raise
         return {"error": str(err)}
     except ArmTransferError as err:

@@ -1,4 +1,4 @@
-"""Run one sweep run: build its task, trajectory and learner, return a JSON-able result.
+"""Run one sweep run: build its task and trajectory, learn it with its engine, return a JSON-able result.
 
 Robots come in already built (``robots`` maps a spec like ``"fine"`` or
 ``"planar2:joint"`` to a ``DiscreteRobot``), so an executor can build each robot once
@@ -11,52 +11,40 @@ import time
 
 from armtransfer.tasks.catalog import custom_task
 from armtransfer.tasks.robot import DiscreteRobot
-from armtransfer.learning import methods, presets
+from armtransfer.learning import methods
 from armtransfer.experiments import engines, experiment
-from armtransfer.learning.config import LearnerConfig
-from armtransfer.learning.learner_names import SARSA
+from armtransfer.experiments.run import SweepRun
 
 
-def learner_config(run: dict) -> LearnerConfig:
-    """The learner settings a sweep run carries (every LearnerConfig field it names, over its preset)."""
-    return presets.config(run.get("preset", presets.DEFAULT),
-                          {k: run[k] for k in LearnerConfig.options() if k in run})
-
-
-def robot_specs(runs: list[dict]) -> list[str]:
+def robot_specs(runs: list[SweepRun]) -> list[str]:
     """The distinct robots a list of runs needs, in first-seen order."""
     seen: dict[str, None] = {}
     for run in runs:
-        seen.setdefault(run["source"], None)
-        seen.setdefault(run["target"], None)
+        seen.setdefault(run.source, None)
+        seen.setdefault(run.target, None)
     return list(seen)
 
 
-def execute(run: dict, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
+def work_of(run: SweepRun) -> engines.Work:
+    """What the run's engine learns: all its trials, from trial 0."""
+    return engines.Work(run.method, run.target, run.start, run.goal, run.trials, run.seed, run.learner_config(),
+                        wind=run.wind, K=run.K, learner=run.learner)
+
+
+def execute(run: SweepRun, robots: dict[str, DiscreteRobot]) -> tuple[dict, float]:
     """(result, seconds) of one run."""
     t0 = time.perf_counter()
-    source, target = robots[run["source"]], robots[run["target"]]
-    task = custom_task(tuple(run["start"]), tuple(run["goal"]), target.layout)  # the robots' world
-    start, goal = task.cells()
-    config = learner_config(run)
+    source, target = robots[run.source], robots[run.target]
+    start, goal = custom_task(run.start, run.goal, target.layout).cells()  # the robots' world
     traj = None
-    if methods.get(run["method"]).shaped and methods.get(run["method"]).uses_trajectory:
+    method = methods.get(run.method)
+    if method.shaped and method.uses_trajectory:
         # robot 1 learns with its own step cap, whatever max_total_steps caps robot 2's trials at (as the
-        # benchmark's source runs); a run without max_total_steps has one config for both, as before
-        own = learner_config({k: v for k, v in run.items() if k != "max_total_steps"})
-        traj = experiment.source_trajectory(run["trajectory"], source, start, goal, own, run["seed"])
-    if engines.engine_of(run.get("learner", SARSA)) == engines.OUTSIDE:  # through the benchmark's harness
-        from armtransfer.experiments import learner_transfer
-        from armtransfer.learning.learners import get
-
-        res = learner_transfer.run_method(get(run["learner"]), run["method"], target, list(run["start"]),
-                                          list(run["goal"]), None if traj is None else [traj], run["trials"],
-                                          run["seed"], config, wind=run["wind"], K=run["K"])
-    else:
-        res = experiment.run_method(
-            run["method"], target, start, goal, traj, run["trials"], run["seed"], config,
-            wind=run["wind"], K=run["K"],
-        )
+        # benchmark's source runs)
+        traj = experiment.source_trajectory(run.trajectory, source, start, goal, run.learner_config(own_cap=True),
+                                            run.seed)
+    engine = engines.engine_for(run.learner)
+    res = engine.trials(work_of(run), target, None if traj is None else [traj])
     result = {
         "exploration_steps": res.column("exploration_steps"),
         "total_steps": res.column("total_steps"),

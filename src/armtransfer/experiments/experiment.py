@@ -110,6 +110,9 @@ class MethodResult:
     trials: list[TrialResult] = field(default_factory=list)
     extra: dict = field(default_factory=dict)
     control: str | None = None
+    evaluations: list[list] | None = None
+    """An outside learner's greedy evaluations, per trial (``learner_trial.trial``); None for the
+    built-in learner's."""
 
     @property
     def label(self) -> str:

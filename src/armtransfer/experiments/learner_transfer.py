@@ -25,6 +25,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from armtransfer.experiments import learner_trial
+from armtransfer.experiments.work import Work
 from armtransfer.experiments.experiment import MethodResult
 from armtransfer.learning import methods
 from armtransfer.learning.config import LearnerConfig
@@ -53,21 +54,25 @@ def trial_result(result: dict, stream: list[int]) -> TrialResult:
 def run_method(learner: Learner, method: str, target: DiscreteRobot, start: list[int], goal: list[int],
                trajs: Sequence[Trajectory] | None, trials: int, seed: int, config: LearnerConfig,
                wind: float = 0.0, K: float | str | None = "auto", beta: float | None = None,
-               on_trial: Callable[[], None] | None = None, heartbeat: bool = False) -> MethodResult:
+               on_trial: Callable[[], None] | None = None, heartbeat: bool = False,
+               first_trial: int = 0) -> MethodResult:
     """``trials`` trials of ``method`` by ``learner`` on ``target`` from ``start`` to ``goal``
     (x, y), one after the other (a Python learner holds the GIL), a shaped method paid for
-    ``trajs``. A learner's fault is a one-line ``PluginError`` naming it."""
+    ``trajs``, numbered from ``first_trial`` (their seeds); ``evaluations``: each trial's
+    greedy evaluations (``learner_trial.trial``). A learner's fault is a one-line ``PluginError``
+    naming it."""
     learner_trial.refuse_methods(learner, [method])
     shaped = methods.get(method).shaped
     out = MethodResult(method)
     ks: list[float | None] = []
-    for trial in range(trials):
-        given = trajs if shaped else None
-        run = {"method": method, "trial": trial, "seed": int(seed), "start": list(start), "goal": list(goal),
-               "wind": float(wind), "config": config.to_dict(), "K": "auto" if K is None else K, "beta": beta}
-        result, stream = learner_trial.trial(learner, run, target, None if given is None else list(given),
-                                             heartbeat=heartbeat)
+    out.evaluations = []
+    work = Work(method, target.name, (start[0], start[1]), (goal[0], goal[1]), trials, int(seed), config,
+                wind=float(wind), K="auto" if K is None else K, beta=beta, first_trial=first_trial, learner=learner.name)
+    given = list(trajs) if shaped and trajs is not None else None
+    for trial in range(first_trial, first_trial + trials):
+        result, stream = learner_trial.trial(learner, work, trial, target, given, heartbeat=heartbeat)
         out.trials.append(trial_result(result, stream))
+        out.evaluations.append(result["evaluations"])
         ks.append(result["K"])
         if on_trial is not None:
             on_trial()

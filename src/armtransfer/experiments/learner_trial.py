@@ -52,6 +52,7 @@ from armtransfer.tasks.catalog import custom_task
 from armtransfer.tasks.envs import RobotRoomsEnv
 from armtransfer.tasks.robot import DiscreteRobot
 from armtransfer.experiments.harness_terms import CHUNKS, EVAL_CAP, EVALS, TOLERANCE
+from armtransfer.experiments.work import Work
 
 HEARTBEAT_SECONDS = 30.0
 """A trial running longer says how far it has got on stderr every this many seconds (when asked
@@ -166,21 +167,21 @@ def case_env(target: DiscreteRobot, start: list[int], goal: list[int], wind: flo
     return RobotRoomsEnv(target, task, wind=wind, step_reward=config.step_reward, goal_reward=config.goal_reward)
 
 
-def training_env(target: DiscreteRobot, run: dict, config: LearnerConfig,
+def training_env(target: DiscreteRobot, work: Work,
                  trajectory: Trajectory | list[Trajectory] | None) -> tuple[gym.Env, TransferReward | None]:
     """The case's training environment: the time limit of the registered ids, and the method's
-    reward term when it has one (its ``K`` and ``beta`` the run's, when it names them: a
-    benchmark run names neither and has 'auto' and the method's default)."""
-    env: gym.Env = gym.wrappers.TimeLimit(case_env(target, run["start"], run["goal"], run["wind"], config),
+    reward term when it has one (its ``K`` and ``beta`` the work's: a benchmark trial names
+    neither, 'auto' and the method's default)."""
+    env: gym.Env = gym.wrappers.TimeLimit(case_env(target, list(work.start), list(work.goal), work.wind, work.config),
                                           max_episode_steps=MAX_EPISODE_STEPS)
-    if run["method"] == "none":
+    if work.method == "none":
         return env, None
-    if run["method"] not in methods.REWARD_ONLY:
-        raise ArmTransferError(f"method {run['method']!r} changes how the kernel chooses actions; an outside learner "
+    if work.method not in methods.REWARD_ONLY:
+        raise ArmTransferError(f"method {work.method!r} changes how the kernel chooses actions; an outside learner "
                                f"runs only none and the reward-term methods ({', '.join(methods.REWARD_ONLY)})")
     assert trajectory is not None
-    wrapped = TransferReward(env, trajectory, method=run["method"], K=run.get("K", "auto"), gamma=config.gamma,
-                             beta=run.get("beta"))
+    wrapped = TransferReward(env, trajectory, method=work.method, K="auto" if work.K is None else work.K,
+                             gamma=work.config.gamma, beta=work.beta)
     return wrapped, wrapped
 
 
@@ -206,24 +207,20 @@ def greedy_episode(model: Any, env: RobotRoomsEnv, cap: int, said: str) -> int |
     return None
 
 
-def run_trial(learner: Learner, run: dict, target: DiscreteRobot, trajectory: Trajectory | None) -> dict:
-    """One trial run of ``learner``: the fields of ``benchmark_runs.trial_problem`` (and the
-    greedy evaluations, as ``[training steps, greedy steps or None]``)."""
-    return trial(learner, run, target, trajectory)[0]
-
-
-def trial(learner: Learner, run: dict, target: DiscreteRobot,
+def trial(learner: Learner, work: Work, trial: int, target: DiscreteRobot,
           trajectory: Trajectory | list[Trajectory] | None, heartbeat: bool = False) -> tuple[dict, list[int]]:
-    """:func:`run_trial`'s result and the monitored stream of every training episode's steps
-    (an unfinished one negative, as the kernel's ``episode_steps``)."""
+    """Trial ``trial`` of ``work`` by ``learner``: (the fields of ``benchmark_runs.trial_problem``
+    and the greedy evaluations, as ``[training steps, greedy steps or None]``; the monitored
+    stream of every training episode's steps, an unfinished one negative, as the kernel's
+    ``episode_steps``)."""
     said = where(learner)
-    config = LearnerConfig(**run["config"])
+    config = work.config
     budget = int(config.max_total_steps)
-    model_seed, env_seed, eval_seed = seeds(run["seed"], run["trial"])
-    inner, term = training_env(target, run, config, trajectory)
+    model_seed, env_seed, eval_seed = seeds(work.seed, trial)
+    inner, term = training_env(target, work, trajectory)
     env = Monitor(inner, said)
     env.reset(seed=env_seed)
-    ev = case_env(target, run["start"], run["goal"], run["wind"], config)
+    ev = case_env(target, list(work.start), list(work.goal), work.wind, config)
     ev.reset(seed=eval_seed)
     path = target.shortest_path(ev.start_state, ev.goal_cell)
     if path is None:
@@ -231,7 +228,7 @@ def trial(learner: Learner, run: dict, target: DiscreteRobot,
     optimal = max(len(path) - 1, 1)
     cap, good = EVAL_CAP * optimal, (1 + TOLERANCE) * optimal
     good_len = clock.good_length(config.quality, optimal)
-    model = _call(said, "make", learner.make, env, model_seed, *handed(learner, run["method"], target, trajectory, term))
+    model = _call(said, "make", learner.make, env, model_seed, *handed(learner, work.method, target, trajectory, term))
     chunk = max(budget // CHUNKS, 1)
     evals: list[list[int | None]] = []
     converged_at: int | None = None
@@ -240,7 +237,7 @@ def trial(learner: Learner, run: dict, target: DiscreteRobot,
     while env.total < budget:
         if heartbeat and time.monotonic() - last_said >= HEARTBEAT_SECONDS:
             last_said = time.monotonic()
-            _say(f"armtransfer: {said}: method {run['method']}, trial {int(run['trial']) + 1}: {env.total:,} of "
+            _say(f"armtransfer: {said}: method {work.method}, trial {trial + 1}: {env.total:,} of "
                  f"{budget:,} steps learned in {last_said - t0:.0f} s")
         before = env.total
         _call_method(said, model, "learn", min(chunk, budget - env.total))

@@ -27,7 +27,10 @@ from typing import TYPE_CHECKING, cast
 
 from armtransfer.errors import ArmTransferError
 from armtransfer.io import OutputError, check_writable, parse_json_bytes, read_input, write_json_atomic
-from armtransfer.experiments.sweep import Sweep, SweepFileError, check_stored, content_key
+from armtransfer.experiments import frames
+from armtransfer.experiments.run import Run
+from armtransfer.experiments.sweep import Sweep, SweepFileError, check_stored, content_key, expand
+from armtransfer.learning.config import LearnerConfig
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -223,20 +226,20 @@ class ResultStore:
     def is_done(self, key: str) -> bool:
         return self.load_run(key) is not None
 
-    def write_run(self, run: dict, result: dict, elapsed: float) -> None:
-        key = run["key"]
-        write_json_atomic(self.run_path(key), {"key": key, "config": run, "result": result})
+    def write_run(self, run: Run, result: dict, elapsed: float) -> None:
+        key = run.key()
+        write_json_atomic(self.run_path(key), {"key": key, "config": run.stored(), "result": result})
         write_json_atomic(self.timings_dir / f"{key}.json", {"key": key, "elapsed_seconds": round(elapsed, 3)})
         (self.failed_dir / f"{key}.json").unlink(missing_ok=True)
 
-    def write_failure(self, run: dict, error: str, attempts: int) -> None:
+    def write_failure(self, run: Run, error: str, attempts: int) -> None:
         """Record that ``run`` failed: ``error``'s first line, and the rest (a traceback, when the
         worker sent one) under ``traceback``."""
         first, _, rest = error.partition("\n")
-        record = {"key": run["key"], "config": run, "error": first, "attempts": attempts}
+        record = {"key": run.key(), "config": run.stored(), "error": first, "attempts": attempts}
         if rest.strip():
             record["traceback"] = rest
-        write_json_atomic(self.failed_dir / f"{run['key']}.json", record)
+        write_json_atomic(self.failed_dir / f"{run.key()}.json", record)
 
     def records(self) -> list[dict]:
         """Every finished run, sorted by key (so summaries do not depend on finishing order)."""
@@ -256,27 +259,23 @@ class ResultStore:
         runs that failed or are not done yet are named in ``df.attrs`` (``failed``, ``missing``),
         so a partial store is never mistaken for a whole one. Needs pandas
         (``pip install 'armtransfer[frames]'``)."""
-        from armtransfer.experiments.reports import frames
-        from armtransfer.experiments.sweep import expand
-        from armtransfer.learning.config import LearnerConfig
-
         if is_benchmark(self.meta["spec"]):
             raise StoreError(f"{str(self.root)!r} holds a benchmark, whose trials are in its results.json "
                              "(armtransfer summarize DIR writes it)")
         frames.pandas()
         rows, done = [], set()
         for rec in self.records():
-            run, result = rec["config"], rec["result"]
-            done.add(run["key"])
-            settings = {("run" if k == "key" else k): v for k, v in run.items() if k != "format"}
+            config, result = rec["config"], rec["result"]  # a stored run, read as the store holds it
+            done.add(config["key"])
+            settings = {("run" if k == "key" else k): v for k, v in config.items() if k != "format"}
             per_trial = {name: result[name] for name in (*RESULT_LISTS, "episodes") if name in result}
             per_trial["K_used"] = result.get("K")
             per_trial["trajectory_length"] = result.get("trajectory_length")
-            per_trial["step_cap"] = int(run.get("max_total_steps", LearnerConfig.max_total_steps))
-            rows += frames.trial_rows(run["method"], None, per_trial, settings)
+            per_trial["step_cap"] = int(config.get("max_total_steps", LearnerConfig.max_total_steps))
+            rows += frames.trial_rows(config["method"], None, per_trial, settings)
         df = frames.frame(rows)
         failed = sorted(f["key"] for f in self.failures() if f.get("key") not in done)
-        every = [run["key"] for run in expand(self.meta["spec"])]
+        every = [run.key() for run in expand(self.meta["spec"])]
         df.attrs.update(runs=len(every), failed=failed,
                         missing=[k for k in every if k not in done and k not in failed])
         return df

@@ -49,7 +49,6 @@ twice (``none`` ignores K, so its runs are shared by every K).
 
 from __future__ import annotations
 
-import hashlib
 import itertools
 import json
 import os
@@ -69,8 +68,9 @@ from armtransfer.learning import presets as _presets
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.lazy_registry import Names
 from armtransfer.learning.learner_names import SARSA
+from armtransfer.experiments.run import SWEEP_FORMAT, SweepRun, content_key as content_key
 
-RUN_FORMAT = "armtransfer-run/1"
+RUN_FORMAT = SWEEP_FORMAT
 METHODS = Names(_methods.METHODS, lambda name, m: not m.macros)
 """Every method (a plugin's too) but `mapping`, whose protocol (tasks in order, one mapping carried from task
 to task) is not a grid of independent runs: use `armtransfer rooms --method mapping --mapping PATH`."""
@@ -104,16 +104,11 @@ class Sweep:
     name: str
     spec: dict
     """The normalised sweep (every key present, lists everywhere)."""
-    runs: tuple[dict, ...]
+    runs: tuple[SweepRun, ...]
 
     @property
     def key(self) -> str:
         return content_key(self.spec)
-
-
-def content_key(obj: object) -> str:
-    text = json.dumps(obj, sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode()).hexdigest()[:20]
 
 
 def _as_list(name: str, value: object) -> list:
@@ -390,16 +385,16 @@ def _world(given: object, where: str, base: Path | None):
     return None if is_default(layout) else layout
 
 
-def sweep_world(spec_or_run: dict):
+def sweep_world(spec_or_run: dict | SweepRun):
     """The world of a normalised spec or one of its runs (the paper's rooms when it names none)."""
     from armtransfer.worlds.layout import ROOMS
 
-    data = spec_or_run.get("world")
+    data = spec_or_run.world if isinstance(spec_or_run, SweepRun) else spec_or_run.get("world")
     return ROOMS if data is None else layout_of_data(data, "the sweep's world")
 
 
-def expand(spec: dict) -> list[dict]:
-    """Every run of the sweep, in a fixed order, each a flat configuration."""
+def expand(spec: dict) -> list[SweepRun]:
+    """Every run of the sweep, in a fixed order (a run ``none`` shares with every K once)."""
     if spec.get("world") is None:
         tasks = [{"task": t, "start": list(TABLE_I[t].start), "goal": list(TABLE_I[t].goal)} for t in spec["tasks"]]
     else:
@@ -407,43 +402,23 @@ def expand(spec: dict) -> list[dict]:
         found = [world_task(layout, t) for t in spec["tasks"]]
         tasks = [{"task": t, "start": list(f.start), "goal": list(f.goal)} for t, f in zip(spec["tasks"], found)]
     tasks += [{"task": None, "start": s, "goal": g} for s, g in spec["start_goal"]]
-    runs: dict[str, dict] = {}
+    runs: dict[str, SweepRun] = {}
     for learner, task, pair, method, seed, K, eps, lam, alpha, gamma, wind in itertools.product(
         learners_of(spec), tasks, spec["pairs"], spec["methods"], spec["seeds"], spec["K"], spec["epsilon"],
         spec["lam"], spec["alpha"], spec["gamma"], spec["wind"],
     ):
-        run = {
-            "format": RUN_FORMAT,
-            **({"world": spec["world"]} if spec.get("world") is not None else {}),
-            **task,
-            "source": pair[0],
-            "target": pair[1],
-            "method": method,
-            "seed": seed,
-            "trials": spec["trials"],
-            "trajectory": spec["trajectory"],
-            "K": None if method == "none" else K,
-            "epsilon": eps,
-            "lam": lam,
-            "alpha": alpha,
-            "gamma": gamma,
-            "wind": wind,
-            "patience": spec["patience"],
-            "max_episodes": spec["max_episodes"],
-        }
-        if "preset" in spec:  # its other settings (rewards, caps) come from the preset (execute.learner_config)
-            run["preset"] = spec["preset"]
-        if "max_total_steps" in spec:
-            run["max_total_steps"] = spec["max_total_steps"]
-        if learner != SARSA:  # sarsa's runs keep the keys they had before learners
-            run["learner"] = learner
-            if spec.get("learner_options", {}).get(learner):
-                run["learner_options"] = spec["learner_options"][learner]
         used = {p.partition(":")[0] for p in pair} & set(spec.get("arms", {}))
-        if used:  # a named arm's definition is part of the run (and of its key)
-            run["arms"] = {name: spec["arms"][name] for name in sorted(used)}
-        runs.setdefault(content_key(run), run)
-    return [dict(r, key=k) for k, r in runs.items()]
+        run = SweepRun(
+            world=spec.get("world"), **task, source=pair[0], target=pair[1], method=method, seed=seed,
+            trials=spec["trials"], trajectory=spec["trajectory"], K=None if method == "none" else K, epsilon=eps,
+            lam=lam, alpha=alpha, gamma=gamma, wind=wind, patience=spec["patience"],
+            max_episodes=spec["max_episodes"], preset=spec.get("preset", _presets.DEFAULT),
+            max_total_steps=spec.get("max_total_steps"), learner=learner,
+            learner_options=spec.get("learner_options", {}).get(learner),
+            arms={name: spec["arms"][name] for name in sorted(used)},  # a named arm's definition keys the run
+        )
+        runs.setdefault(run.key(), run)
+    return list(runs.values())
 
 
 def load(path: str | os.PathLike, max_runs: int = MAX_RUNS) -> Sweep:

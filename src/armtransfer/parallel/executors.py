@@ -12,25 +12,26 @@ from __future__ import annotations
 import re
 import os
 from collections import deque
-from collections.abc import Callable
-from typing import cast
+from collections.abc import Callable, Sequence
+from typing import Any, cast
 
 from armtransfer.experiments.execute import execute
+from armtransfer.experiments.run import Run
 from armtransfer.checks import integer_text
 from armtransfer.errors import ArmTransferError
 from armtransfer.cpus import ENV as CPUS_ENV
 from armtransfer.parallel.pool import DONE, Pool
 from armtransfer.tasks.robot import DiscreteRobot
 
-Done = Callable[[dict, dict, float], "list[dict] | None"]  # (run, result, seconds) -> runs it releases
-Failed = Callable[[dict, str, int], None]  # (run, error, attempts)
+Done = Callable[[Any, dict, float], "list | None"]  # (run, result, seconds) -> runs it releases
+Failed = Callable[[Any, str, int], None]  # (run, error, attempts)
 
 
 class ExecutorError(ArmTransferError):
     """An executor cannot start (e.g. Ray is not installed or unreachable)."""
 
 
-def _execute_in_ray(run: dict, robots, fn: Callable = execute):
+def _execute_in_ray(run: Run, robots, fn: Callable = execute):
     """``fn`` (a sweep's ``execute``) in a Ray worker, its trials on one thread: Ray's tasks are
     the parallelism."""
     os.environ.setdefault(CPUS_ENV, "1")
@@ -38,7 +39,7 @@ def _execute_in_ray(run: dict, robots, fn: Callable = execute):
 
 
 def run_local(
-    runs: list[dict], robots: dict[str, DiscreteRobot], workers: int, on_done: Done, on_failed: Failed,
+    runs: Sequence[Run], robots: dict[str, DiscreteRobot], workers: int, on_done: Done, on_failed: Failed,
     retries: int = 2, fn: Callable = execute,
 ) -> None:
     """A process pool over this machine's cores (:class:`~armtransfer.parallel.pool.Pool`).
@@ -51,7 +52,7 @@ def run_local(
     out, so no more than the runs need ever start.
     """
     queue = deque(runs)
-    attempts = {r["key"]: 0 for r in runs}
+    attempts = {r.key(): 0 for r in runs}
     with Pool(max(1, workers), _robots_for(runs, robots), fn) as pool:
         while queue or pool.busy():
             while queue and (worker := pool.idle()) is not None:
@@ -60,9 +61,9 @@ def run_local(
             if run is None:  # an idle worker died: a new one starts when there is work
                 continue
             if answer is None:
-                attempts[run["key"]] += 1
-                if attempts[run["key"]] > retries:
-                    on_failed(run, "worker process died", attempts[run["key"]])
+                attempts[run.key()] += 1
+                if attempts[run.key()] > retries:
+                    on_failed(run, "worker process died", attempts[run.key()])
                 else:
                     queue.appendleft(run)
             elif answer[0] == DONE:
@@ -70,20 +71,27 @@ def run_local(
                 while queue and (worker := pool.idle()) is not None:  # it works while the store is written
                     pool.give(worker, queue.popleft())
                 for more in on_done(run, result, secs) or ():
-                    attempts[more["key"]] = 0
+                    attempts[more.key()] = 0
                     queue.append(more)
             else:
-                on_failed(run, str(answer[1]), attempts[run["key"]] + 1)
+                on_failed(run, str(answer[1]), attempts[run.key()] + 1)
 
 
-def _robots_for(runs: list[dict], robots: dict[str, DiscreteRobot]) -> dict[str, DiscreteRobot]:
+def _robots_for(runs: Sequence[Run], robots: dict[str, DiscreteRobot]) -> dict[str, DiscreteRobot]:
     """The robots ``runs`` read, by either key a worker may look them up by: the spec (a sweep's
     robots, resolved in the sweep's one world) and the spec in the run's world (a benchmark's,
     whose cases may each name a world)."""
     from armtransfer.experiments.benchmark_runs import robot_key
 
-    needed = {key for r in runs for side in ("source", "target") for key in (r[side], robot_key(r[side], r.get("world")))}
+    needed = {key for r in runs for spec in (r.source, r.target)
+              for key in (spec, robot_key(spec, _world_name(r)))}
     return {k: v for k, v in robots.items() if k in needed}
+
+
+def _world_name(run: Run) -> str | None:
+    """A benchmark run's world name (a sweep's robots are all in its one world: None)."""
+    world = getattr(run, "world", None)
+    return world if isinstance(world, str) else None
 
 
 def _import_ray():
@@ -191,7 +199,7 @@ RAY_ANSWER_TIMEOUT = 5.0
 
 
 def run_ray(
-    runs: list[dict], robots: dict[str, DiscreteRobot], workers: int | None, address: str | None,
+    runs: Sequence[Run], robots: dict[str, DiscreteRobot], workers: int | None, address: str | None,
     on_done: Done, on_failed: Failed, retries: int = 2, fn: Callable = execute,
 ) -> None:
     """Ray tasks on the cluster at ``address``, or on a local instance with ``workers`` CPUs,
@@ -225,7 +233,7 @@ def run_ray(
         refs = {spec: ray.put(robot) for spec, robot in robots.items()}
         futures = {}
 
-        def submit(run: dict):
+        def submit(run: Run):
             needed = {key: refs[key] for key in _robots_for([run], robots)}
             ref = remote_execute.remote(run, _RobotRefs(needed), fn)
             futures[ref] = run

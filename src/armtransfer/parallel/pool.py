@@ -23,12 +23,13 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from multiprocessing.connection import Connection, wait
 from multiprocessing.process import BaseProcess
+from typing import Any
 
 from armtransfer.cpus import ENV as CPUS_ENV
 from armtransfer.errors import ArmTransferError
 from armtransfer.parallel.reaper import guarded_spawn_context
 
-Task = Callable[[dict, dict], object]
+Task = Callable[[Any, dict], object]  # (run, robots) -> answer
 """What a worker runs: ``fn(run, robots)``, its answer sent back to the driver."""
 
 DONE, FAILED = "done", "failed"
@@ -89,7 +90,7 @@ class Worker:
 
     process: BaseProcess
     conn: Connection
-    run: dict | None = None
+    run: Any = None
     handover: threading.Thread | None = field(default=None, repr=False)
 
 
@@ -128,7 +129,7 @@ class Pool:
         self.workers.append(worker)
         return worker
 
-    def give(self, worker: Worker, run: dict) -> None:
+    def give(self, worker: Worker, run: Any) -> None:
         """Hand ``run`` to ``worker``. A new worker is sent the robots first, from a thread that
         a death of the worker ends (the robots may be larger than the pipe holds, and the worker
         reads them only once it has started)."""
@@ -143,7 +144,7 @@ class Pool:
     def busy(self) -> bool:
         return any(w.run is not None for w in self.workers)
 
-    def next_event(self) -> tuple[Worker, dict | None, tuple[str, object] | None]:
+    def next_event(self) -> tuple[Worker, Any, tuple[str, object] | None]:
         """Wait for the next worker that answers or dies: ``(worker, run, answer)``, with the run
         it held and its answer, or None as the answer when it died (it has then left the pool;
         ``run`` is None when it died idle)."""
