@@ -112,6 +112,7 @@ def test_planar5_straight_cartesian_from_its_singular_qpos0(files):
 
 
 @pytest.mark.slow
+@pytest.mark.hours  # a 5-joint lattice, every move swept: over 40 minutes on 2 loaded cores
 def test_planar5_straight_joint_model_automatic_mount(files):
     r = arm_robot(None, "joint", xml_path=files["planar5"], tip_body="stylus")
     assert r.name == "planar5:joint" and r.arm.dof == 5 and r.n_actions == 10
