@@ -17,12 +17,12 @@ FAST = dict(methods=["none"], trials=1, max_episodes=2, controls=False)
 
 def _no_learning(monkeypatch):
     """Any trial started fails the test: the error must come before the first one."""
-    from armtransfer.experiments import experiment
+    from armtransfer.experiments import engines
 
     def boom(*a, **k):
         raise AssertionError("learning started before the bad input was refused")
 
-    monkeypatch.setattr(experiment, "run_all", boom)
+    monkeypatch.setattr(engines.Tabular, "trials", boom)
 
 
 @pytest.mark.parametrize("kwargs,names", [
@@ -55,13 +55,13 @@ def test_transfer_misuse_is_one_named_error_before_learning(kwargs, names, monke
 
 def test_numpy_scalars_are_numbers(monkeypatch):
     seen = {}
-    from armtransfer.experiments import experiment
+    from armtransfer.experiments import engines
 
-    def capture(src, tgt, start, goal, methods, trajs, trials, seed, config, **kw):
-        seen.update(trials=trials, seed=seed, config=config, wind=kw["wind"])
+    def capture(engine, work, target, trajs):
+        seen.update(trials=work.trials, seed=work.seed, config=work.config, wind=work.wind)
         raise StopIteration
 
-    monkeypatch.setattr(experiment, "run_all", capture)
+    monkeypatch.setattr(engines.Tabular, "trials", capture)
     with pytest.raises(StopIteration):
         armtransfer.transfer(methods=["none"], trials=np.int64(3), seed=np.uint8(4), wind=np.float32(0.25),
                              alpha=np.float32(0.5), max_episodes=np.int32(7), controls=np.bool_(False))

@@ -285,7 +285,7 @@ def test_an_ascii_stdout_gets_non_ascii_names_escaped(tmp_path):
 # ---- 7. a refusal before the work, nothing left ---------------------------------------
 
 def test_a_store_whose_runs_take_no_files_is_refused_before_any_run(store, capsys, monkeypatch):
-    from armtransfer.experiments import experiment
+    from armtransfer.experiments import engines
 
     for run in (store / "runs").glob("*.json"):
         run.unlink()
@@ -293,7 +293,7 @@ def test_a_store_whose_runs_take_no_files_is_refused_before_any_run(store, capsy
     os.symlink("/sys", store / "runs")  # root cannot write there either
     (store.parent / "s.toml").write_text(SWEEP)
     timing = next((store / "timings").glob("*.json")).read_bytes()
-    monkeypatch.setattr(experiment, "run_all", lambda *a, **k: pytest.fail("a run started"))
+    monkeypatch.setattr(engines.Tabular, "trials", lambda *a, **k: pytest.fail("a run started"))
     monkeypatch.chdir(store.parent)
     assert main(["sweep", "s.toml", "--out", "store", "--workers", "1"]) == 2
     one_line(capsys, "runs", "does not take new files")

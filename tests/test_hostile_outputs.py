@@ -48,14 +48,14 @@ def test_a_symlinked_out_to_an_empty_folder_is_written_through(tmp_path, monkeyp
 
 def test_a_second_run_into_the_same_out_is_refused_before_its_work(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
-    from armtransfer.experiments import experiment
+    from armtransfer.experiments import engines
 
     def boom(*a, **k):
         raise AssertionError("the second run started learning")
 
     with staged_directory(tmp_path / "D") as tmp:  # the first run, still working
         (tmp / "partial.json").write_text("{}")
-        monkeypatch.setattr(experiment, "run_all", boom)
+        monkeypatch.setattr(engines.Tabular, "trials", boom)
         assert main([*FAST_ARMS, "--out", "D"]) == 2
         err = capsys.readouterr().err
         assert "another run is writing into" in err and len(err.strip().splitlines()) == 1

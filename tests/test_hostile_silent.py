@@ -92,12 +92,12 @@ def _jumping_trajectory(tmp_path):
 
 def test_a_trajectory_that_jumps_is_refused_before_learning(tmp_path, monkeypatch, capsys):
     path = _jumping_trajectory(tmp_path)
-    from armtransfer.experiments import experiment
+    from armtransfer.experiments import engines
 
     def boom(*a, **k):
         raise AssertionError("learning started")
 
-    monkeypatch.setattr(experiment, "run_all", boom)
+    monkeypatch.setattr(engines.Tabular, "trials", boom)
     err = refused(["rooms", "--method", "pseudo", "--trajectory", str(path), "--json", "o.json"], tmp_path,
                   monkeypatch, capsys)
     assert "step 3" in err and "not a path of coarse" in err

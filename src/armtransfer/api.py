@@ -21,7 +21,7 @@ from typing import Any
 
 import armtransfer.checks as checks
 from armtransfer.errors import InvalidCellError, InvalidParameterError, InvalidTaskError
-from armtransfer.experiments import continuous as runs, engines, experiment, learner_transfer, learner_trial
+from armtransfer.experiments import continuous as runs, engines, experiment, learner_trial
 from armtransfer.experiments.continuous import ContinuousResult
 from armtransfer.experiments.learner_trial import refuse_methods
 from armtransfer.experiments.results import MappingInfo, TransferResult
@@ -31,6 +31,7 @@ from armtransfer.learning import methods as registry
 from armtransfer.learning import trajectory as trajectories
 from armtransfer.learning.cells import CELL_METHODS, check_method
 from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning.controls import CONTROLS
 from armtransfer.learning.learner_names import SARSA
 from armtransfer.learning.mapping import DEFAULT_MAX_SPAN, ActionMapping
 from armtransfer.learning.mapping import load_for as load_mapping
@@ -258,8 +259,9 @@ def _discrete_pair(req: _Request) -> tuple[DiscreteRobot, DiscreteRobot, int]:
 
 
 def _transfer_tabular(req: _Request, src: DiscreteRobot, tgt: DiscreteRobot, distance: int) -> TransferResult:
-    """``transfer`` by the compiled SARSA(lambda) kernel: every method, its controls and the
-    action sequence mapping."""
+    """``transfer`` by the compiled SARSA(lambda) kernel: every method, then (``controls``) every
+    reward-only method with each control's stand-ins, then the action sequence mapping saved;
+    each a :class:`~armtransfer.experiments.work.Work` for the engine."""
     start_cell, goal_cell = req.task.cells()
     mapping_obj, mapping_path = None, None
     if req.uses_mapping:
@@ -284,16 +286,28 @@ def _transfer_tabular(req: _Request, src: DiscreteRobot, tgt: DiscreteRobot, dis
                                          req.wind, beta)
         if made is not None:
             shapings[m] = made
+    experiment.check_trajectories(req.methods, trajs)
     entries_before = 0 if mapping_obj is None else len(mapping_obj)
-    runs, learned = experiment.run_all(
-        src, tgt, start_cell, goal_cell, req.methods, trajs, req.trials, req.seed, req.config,
-        wind=req.wind, K={m: sh.K for m, sh in shapings.items()}, beta=beta,
-        mapping=mapping_obj, max_span=req.max_span, controls=req.controls, tick=req.progress, shapings=shapings,
-    )
+    if req.uses_mapping and mapping_obj is None:
+        mapping_obj = ActionMapping.for_robots(src, tgt)
+
+    def work(m: str, control: str | None = None) -> engines.Work:
+        return engines.Work(m, tgt.name, req.task.start, req.task.goal, req.trials, req.seed, req.config,
+                            wind=req.wind, K=shapings[m].K if m in shapings else "auto", beta=beta,
+                            on_trial=req.progress, control=control, source=src,
+                            shaping=None if control else shapings.get(m),
+                            mapping=mapping_obj if registry.get(m).macros and not control else None,
+                            max_span=req.max_span)
+
+    works = [work(m) for m in req.methods]
+    if req.controls:  # the same K as the real trajectory's
+        works += [work(m, kind) for kind in CONTROLS for m in req.methods if m in experiment.SHAPING_METHODS]
+    runs = [req.engine.trials(w, tgt, trajs if registry.get(w.method).shaped else None) for w in works]
     by_method, by_control = _by_method_and_control(runs)
+    learned = next((r.learned_mapping for r in reversed(runs) if r.learned_mapping is not None), None)
     info = None
     if req.uses_mapping:
-        assert learned is not None  # run_all returns the learned mapping whenever a method uses one
+        assert learned is not None  # a method given a mapping returns it updated
         info = MappingInfo(path=mapping_path, entries_before=entries_before, entries_after=len(learned),
                            macro_states=int(by_method["mapping"].extra["macro_states"]),
                            saved=bool(req.save_mapping))

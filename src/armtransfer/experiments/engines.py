@@ -50,20 +50,35 @@ class Engine(ABC):
 
 
 class Tabular(Engine):
-    """The compiled SARSA(lambda) kernel on the target's table of states (``experiment.run_method``)."""
+    """The compiled SARSA(lambda) kernel on the target's table of states: a method
+    (``experiment.run_method``), a method paid for a control's stand-ins (``work.control``,
+    ``experiment.run_control``) or method ``mapping`` with the macros of ``work.mapping``
+    (``experiment.run_mapping``; the result carries the mapping it updated)."""
 
     name = TABULAR
 
     def trials(self, work: Work, target: DiscreteRobot | None,
                trajectories: Sequence[Trajectory] | None) -> MethodResult:
         from armtransfer.experiments import experiment
+        from armtransfer.learning.potentials import DENSE_BETA
 
         assert target is not None
         start, goal = target.layout.cell(*work.start), target.layout.cell(*work.goal)
         given = None if trajectories is None else list(trajectories)
+        beta = DENSE_BETA if work.beta is None else work.beta
+        if work.control is not None:
+            return experiment.run_control(work.method, work.control, work.source, target, start, goal, given or [],
+                                          work.trials, work.seed, work.config, beta=beta, wind=work.wind, K=work.K,
+                                          threads=work.threads, first_trial=work.first_trial, on_trial=work.on_trial)
+        if work.mapping is not None:
+            experiment.check_trajectories([work.method], given or [])
+            assert given is not None
+            return experiment.run_mapping(target, start, goal, given[0], work.mapping, work.trials, work.seed,
+                                          work.config, wind=work.wind, K=work.K, on_trial=work.on_trial,
+                                          max_span=work.max_span, shaping=work.shaping)[0]
         return experiment.run_method(work.method, target, start, goal, given, work.trials, work.seed, work.config,
                                      wind=work.wind, K=work.K, threads=work.threads, first_trial=work.first_trial,
-                                     on_trial=work.on_trial)
+                                     on_trial=work.on_trial, beta=beta, shaping=work.shaping)
 
 
 class Continuous(Engine):

@@ -113,6 +113,9 @@ class MethodResult:
     evaluations: list[list] | None = None
     """An outside learner's greedy evaluations, per trial (``learner_trial.trial``); None for the
     built-in learner's."""
+    learned_mapping: ActionMapping | None = None
+    """Method ``mapping`` given a mapping (:func:`run_mapping`): that mapping updated from these
+    trials' converged paths (not in the JSON); None otherwise."""
 
     @property
     def label(self) -> str:
@@ -281,8 +284,9 @@ def run_mapping(
 
     Every trial uses ``mapping`` as given (the mappings of earlier tasks only), so trials
     stay independent and deterministic. Returns the result, with ``mapped_fraction`` per
-    trial in ``extra``, and a new mapping: ``mapping`` plus what each converged trial's
-    greedy path teaches, added in trial order. ``shaping``: see :func:`run_method`.
+    trial in ``extra``, and a new mapping (the result's ``learned_mapping`` too): ``mapping``
+    plus what each converged trial's greedy path teaches, added in trial order. ``shaping``:
+    see :func:`run_method`.
     """
     table = MacroTable(mapping, traj, target)
     res = run_method(
@@ -302,6 +306,7 @@ def run_mapping(
         macro_steps_first_episode=[int(t.macro_steps[0]) if len(t.macro_steps) else 0 for t in res.trials],
         mapping_entries_used=len(mapping),
     )
+    res.learned_mapping = learned
     return res, learned
 
 
@@ -471,6 +476,16 @@ def add_transfer_metrics(summary: dict, optimal: int, baseline: str = "none") ->
         entry["transfer_metrics"] = block
 
 
+def check_trajectories(method_names: Sequence[str], trajs: Sequence[Trajectory]) -> None:
+    """Refuse, in one line, trajectories the methods cannot be given: none for a method paid
+    for a trajectory, or other than one for ``mapping``."""
+    chosen = [methods.get(m) for m in method_names]
+    if any(m.shaped and m.uses_trajectory for m in chosen) and not trajs:
+        raise InvalidParameterError("the transfer methods need a trajectory")
+    if any(m.macros for m in chosen) and len(trajs) != 1:
+        raise InvalidParameterError("method 'mapping' takes exactly one trajectory")
+
+
 def run_all(
     source: DiscreteRobot,
     target: DiscreteRobot,
@@ -496,10 +511,7 @@ def run_all(
     ``trajs`` (its K is not checked again). Returns the results in that order and, for
     ``mapping``, the mapping updated from this task's converged trials."""
     chosen = [methods.get(m) for m in method_names]
-    if any(m.shaped and m.uses_trajectory for m in chosen) and not trajs:
-        raise InvalidParameterError("the transfer methods need a trajectory")
-    if any(m.macros for m in chosen) and len(trajs) != 1:
-        raise InvalidParameterError("method 'mapping' takes exactly one trajectory")
+    check_trajectories(method_names, trajs)
     results: list[MethodResult] = []
     learned = None
 
