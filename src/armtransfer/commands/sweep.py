@@ -6,6 +6,8 @@ import argparse
 import os
 
 from armtransfer.commands import common
+from armtransfer.errors import PluginError
+from armtransfer.experiments import learner_trial
 from armtransfer.experiments.execute import robot_specs
 from armtransfer.experiments.run import SweepRun
 from armtransfer.tasks.catalog import custom_task
@@ -13,7 +15,10 @@ from armtransfer.parallel.executors import ExecutorError, _check_reachable, chec
 from armtransfer.tasks.specs import resolve
 from armtransfer.experiments import sweep as sweeps
 from armtransfer.experiments.store import ResultStore
+from armtransfer.learning import learners, methods, trajectory
 from armtransfer.learning.learner_names import SARSA
+from armtransfer.learning.learners import GROUP, RUN_TIME
+from armtransfer.learning.methods import probe_on, refuse_run_time
 
 HELP = "Run a grid of tasks, robots, methods and settings from a TOML file into a resumable result store."
 EXAMPLE = "armtransfer sweep examples/sweeps/quick.toml --out runs/quick"
@@ -77,8 +82,6 @@ def check_runs(runs: list[SweepRun], probe_timeout: float = 60.0) -> dict:
     at, is a one-line error naming the run's robot and task."""
     if not runs:
         raise sweeps.SweepFileError("the sweep has no runs")
-    from armtransfer.learning.methods import probe_on, refuse_run_time
-
     refuse_run_time((run.method for run in runs), "a sweep's runs")
     outside = list(dict.fromkeys(run.learner for run in runs if run.learner != SARSA))
     refuse_run_time_learners(outside)
@@ -106,11 +109,8 @@ def refuse_run_time_learners(names: list[str]) -> None:
     """A learner registered in this process only (``register_learner``) cannot run in the
     sweep's worker processes, which import the package afresh: one line, before anything is
     written."""
-    from armtransfer.errors import PluginError
-    from armtransfer.learning.learners import GROUP, RUN_TIME, get
-
     for name in names:
-        if get(name).origin == RUN_TIME:
+        if learners.get(name).origin == RUN_TIME:
             raise PluginError(f"learner {name!r} was registered in this process (register_learner) and a sweep's "
                               "runs run in other processes, which cannot see it; install it as a package declaring "
                               f"it under the entry-point group {GROUP} (docs/extending.md), or run it with "
@@ -121,15 +121,12 @@ def probe_learners(names: list[str], runs: list[SweepRun], robots: dict, seconds
     """Every outside learner made, learning a few steps and predicting on each target robot's
     first task (``learner_trial.probe``): a learner's fault is one line now, before the store
     is opened."""
-    from armtransfer.experiments import learner_trial
-    from armtransfer.learning.learners import get
-
     for name in names:
         seen: set[str] = set()
         for run in runs:
             if run.learner == name and run.target not in seen:
                 seen.add(run.target)
-                learner_trial.probe(get(name), robots[run.target], list(run.start), list(run.goal), seconds)
+                learner_trial.probe(learners.get(name), robots[run.target], list(run.start), list(run.goal), seconds)
 
 
 def _check_farming_bounds(runs: list[SweepRun], robots: dict) -> None:
@@ -137,8 +134,6 @@ def _check_farming_bounds(runs: list[SweepRun], robots: dict) -> None:
     over: any trajectory is at least as long as the source's shortest path, n, and K >= the
     bound -step_reward/n already pays more than a step. (The exact check, by value iteration on
     the trajectory actually handed over, runs with each run.)"""
-    from armtransfer.learning import methods, trajectory
-
     shortest: dict[tuple, int] = {}
     for run in runs:
         if run.K is None or run.K == "auto" or not methods.get(run.method).farmable:

@@ -31,14 +31,21 @@ from armtransfer.errors import ArmTransferError, InvalidParameterError, InvalidT
 from armtransfer.experiments import benchmark_runs, engines, experiment, suites
 from armtransfer.learning import methods
 from armtransfer.learning import presets
+from armtransfer.experiments.learner_trial import reward_methods
 from armtransfer.experiments.run import SourceRun, TrialRun
 from armtransfer.experiments.comparisons import GOAL_ONLY as GOAL_ONLY, baseline_of as baseline_of
 from armtransfer.experiments.comparisons import baselines_of as baselines_of
 from armtransfer.experiments.comparisons import registered_baseline as registered_baseline
 from armtransfer.learning.learner_names import AT as AT, label as label, parse_label as parse_label
+from armtransfer.learning.cells import CELL_METHODS
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.tasks.catalog import table_task
+from armtransfer.learning.learners import options_of
+from armtransfer.tasks.catalog import custom_task, table_task, world_task
+from armtransfer.tasks.continuous import continuous_arm
 from armtransfer.tasks.robot import DiscreteRobot
+from armtransfer.tasks.specs import resolve
+from armtransfer.tasks.unreachable import hint
+from armtransfer.worlds.resolve import world as layout_of
 
 MIN_DISTANCE = 10
 """A drawn task's goal lies at least this many cells (shortest path of the finer robot) from
@@ -57,8 +64,6 @@ def learner_methods(learner: str, ran: Sequence[str]) -> list[str]:
     reward-term methods for an outside learner (``learner_trial.reward_methods``)."""
     if learner == benchmark_runs.LEARNER:
         return list(ran)
-    from armtransfer.experiments.learner_trial import reward_methods
-
     return reward_methods(list(ran))
 
 
@@ -143,15 +148,11 @@ class Robots:
     def __call__(self, spec: str, world: str = suites.DEFAULT_WORLD) -> DiscreteRobot:
         key = benchmark_runs.robot_key(spec, world)
         if key not in self.resolved:
-            from armtransfer.tasks.specs import resolve
-
             if world == suites.DEFAULT_WORLD:
                 self.resolved[key] = resolve(spec)
             elif world in self.worlds:
                 self.resolved[key] = resolve(spec, layout=self.worlds[world])
             else:
-                from armtransfer.worlds.resolve import world as layout_of
-
                 self.resolved[key] = resolve(spec, layout=layout_of(world))
         return self.resolved[key]
 
@@ -159,16 +160,12 @@ class Robots:
 def case_cells(case: suites.Case, source: DiscreteRobot, target: DiscreteRobot, seed: int, section: str,
                index: int, source_seed: int) -> tuple[int, int]:
     if case.start is not None and case.goal is not None:
-        from armtransfer.tasks.catalog import custom_task
-
         return custom_task(case.start, case.goal, target.layout).cells(target.layout)
     if case.task is not None:
         if case.world == suites.DEFAULT_WORLD:
             if isinstance(case.task, bool) or not isinstance(case.task, int):
                 raise InvalidTaskError(f"{case.label}: a task of the rooms is a Table I task number")
             return table_task(case.task).cells()
-        from armtransfer.tasks.catalog import world_task
-
         return world_task(target.layout, case.task).cells()
     rng = np.random.default_rng(np.random.SeedSequence(
         [int(seed), section_key(section), int(index), int(source_seed), 1]))
@@ -222,8 +219,6 @@ class Pair:
         without the source run's result, only those of the methods that read no trajectory."""
         options = None
         if learner != benchmark_runs.LEARNER:
-            from armtransfer.learning.learners import options_of
-
             options = options_of(learner)
         return [benchmark_runs.trial_run(name, k, self.case.source, self.case.target, list(self.start),
                                          list(self.goal), self.case.wind, self.seed, self.config, source_result,
@@ -320,8 +315,6 @@ class Plan:
             keep = methods_to_run(pair.section.methods)[0]
             ran = [m for m in ran if m in keep]
         if pair.case.state != "discrete":  # a continuous target runs the methods paid on labels alone
-            from armtransfer.learning.cells import CELL_METHODS
-
             ran = [m for m in ran if m == "none" or m in CELL_METHODS]
         return [(lr, learner_methods(lr, ran)) for lr in self.learners_of(pair)]
 
@@ -458,8 +451,6 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
             source, target = robots(case.source, case.world), robots(case.target, case.world)
             arm, placed = None, set()
             if case.state != "discrete":  # a continuous target: its arm, placed over every start before anything runs
-                from armtransfer.tasks.continuous import continuous_arm
-
                 try:  # a bad noise or an arm with no continuous counterpart: the case named
                     arm = continuous_arm(case.target, layout=target.layout, noise=case.noise)
                 except ArmTransferError as err:
@@ -478,8 +469,6 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
                     placed.add(start)
                 path = target.shortest_path(target.start_state(start), goal)
                 if path is None:
-                    from armtransfer.tasks.unreachable import hint
-
                     raise InvalidTaskError(f"{case.label}: {target.name} cannot reach the goal{hint(target)}")
                 pairs.append(Pair(section, ci, case, j, run_seed(seed, section.name, ci, j), target.layout.xy(start),
                                   target.layout.xy(goal), len(path) - 1, learner))

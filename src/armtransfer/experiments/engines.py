@@ -18,9 +18,11 @@ from abc import ABC, abstractmethod
 from collections.abc import Sequence
 
 from armtransfer.errors import ArmTransferError, InvalidParameterError
+from armtransfer.experiments import experiment
 from armtransfer.experiments.experiment import MethodResult
 from armtransfer.experiments.work import Work as Work
 from armtransfer.learning.learner_names import SARSA
+from armtransfer.learning.potentials import DENSE_BETA
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.tasks.robot import DiscreteRobot
 
@@ -59,9 +61,6 @@ class Tabular(Engine):
 
     def trials(self, work: Work, target: DiscreteRobot | None,
                trajectories: Sequence[Trajectory] | None) -> MethodResult:
-        from armtransfer.experiments import experiment
-        from armtransfer.learning.potentials import DENSE_BETA
-
         assert target is not None
         start, goal = target.layout.cell(*work.start), target.layout.cell(*work.goal)
         given = None if trajectories is None else list(trajectories)
@@ -91,8 +90,8 @@ class Continuous(Engine):
 
     def trials(self, work: Work, target: DiscreteRobot | None,
                trajectories: Sequence[Trajectory] | None) -> MethodResult:
-        from armtransfer.experiments import continuous
-        from armtransfer.tasks.continuous import continuous_arm
+        from armtransfer.experiments import continuous  # start-up: a table's runs load no continuous learner
+        from armtransfer.tasks.continuous import continuous_arm  # start-up: only a continuous run builds one
 
         arm = work.arm
         if arm is None:
@@ -119,8 +118,8 @@ class Outside(Engine):
 
     def trials(self, work: Work, target: DiscreteRobot | None,
                trajectories: Sequence[Trajectory] | None) -> MethodResult:
-        from armtransfer.experiments import learner_transfer
-        from armtransfer.learning.learners import get
+        from armtransfer.experiments import learner_transfer  # start-up: Gymnasium, for outside learners
+        from armtransfer.learning.learners import get  # start-up: the registry loads Gymnasium
 
         assert target is not None
         return learner_transfer.run_method(get(work.learner), work.method, target, list(work.start),
@@ -148,7 +147,7 @@ def engine_for(learner: str, state: str = "discrete", subject: str = "the target
         return _BY_NAME[CONTINUOUS if state == "continuous" else TABULAR]
     engine = BY_LEARNER.get(learner)
     if engine is None:
-        from armtransfer.learning.learners import LEARNERS
+        from armtransfer.learning.learners import LEARNERS  # start-up: the registry loads Gymnasium
 
         if learner not in LEARNERS:  # a run of a learner this build does not have fails; it is no result
             valid = dict.fromkeys([SARSA, *BY_LEARNER, *LEARNERS])

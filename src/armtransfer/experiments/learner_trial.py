@@ -38,13 +38,14 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from armtransfer.errors import ArmTransferError, PluginError
+from armtransfer.errors import ArmTransferError, InvalidParameterError, PluginError
 from armtransfer.experiments.stats import learning_metrics
 from armtransfer.learning import clock
 from armtransfer.learning import learners as registry
 from armtransfer.learning import methods, plugin_calls
 from armtransfer.learning.config import LearnerConfig
-from armtransfer.learning.learners import Learner
+from armtransfer.learning.learners import Learner, Transfer
+from armtransfer.learning.plugins import trajectory_xy
 from armtransfer.learning.trajectory import Trajectory
 from armtransfer.learning.transfer_reward import TransferReward
 from armtransfer.registration import MAX_EPISODE_STEPS
@@ -283,7 +284,7 @@ def eval_clock(evals: list[list], optimal: int, good_len: int, settled: int | No
 
 def _say(line: str) -> None:
     """A progress line on stderr, above a progress bar when one is drawn."""
-    from tqdm import tqdm
+    from tqdm import tqdm  # start-up: only when a long trial says how far it is
 
     tqdm.write(line, file=sys.stderr)
 
@@ -294,9 +295,6 @@ def handed(learner: Learner, method: str, target: DiscreteRobot, trajectory: Tra
     for a learner that asks for it (``Learner.transfer``), else none."""
     if not learner.transfer:
         return ()
-    from armtransfer.learning.learners import Transfer
-    from armtransfer.learning.plugins import trajectory_xy
-
     trajs = [] if trajectory is None else trajectory if isinstance(trajectory, list) else [trajectory]
     return (Transfer(method, tuple(trajectory_xy(t, target) for t in trajs),
                      None if term is None else term.transfer.shaping),)
@@ -329,8 +327,6 @@ def refuse_methods(learner: Learner, names: list[str] | tuple[str, ...]) -> None
     """A method ``learner`` cannot run (one that changes how the kernel chooses actions, or
     the action sequence mapping, whose macros are the kernel's) is a one-line error naming the
     learner and listing the methods it runs."""
-    from armtransfer.errors import InvalidParameterError
-
     can = [n for n in reward_methods(list(methods.METHODS)) if not methods.get(n).macros]
     for name in names:
         if name not in can:

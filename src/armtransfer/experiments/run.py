@@ -27,6 +27,7 @@ from typing import Any, ClassVar
 
 from armtransfer.errors import ArmTransferError
 from armtransfer.learning.config import LearnerConfig
+from armtransfer.learning import presets
 from armtransfer.learning.learner_names import SARSA
 
 SCHEMA = 1
@@ -218,8 +219,6 @@ class SweepRun(Run):
     def learner_config(self, own_cap: bool = False) -> LearnerConfig:
         """The learner's settings: every setting the run names, over its preset's; ``own_cap``:
         without the run's ``max_total_steps`` (robot 1 learns with its own step cap)."""
-        from armtransfer.learning import presets
-
         given = {name: getattr(self, name) for name in ("epsilon", "lam", "alpha", "gamma", "patience",
                                                         "max_episodes")}
         if self.max_total_steps is not None and not own_cap:

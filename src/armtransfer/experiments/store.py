@@ -338,7 +338,7 @@ def _run_problem(record: object, key: str) -> str | None:
     if not isinstance(result, dict):
         return "has no result"
     if str(record["config"].get("format", "")).startswith("armtransfer-benchmark-"):
-        from armtransfer.experiments.benchmark_runs import result_problem
+        from armtransfer.experiments.benchmark_runs import result_problem  # start-up: reading a store loads no kernel
 
         return result_problem(record["config"], result)
     lengths = set()

@@ -51,16 +51,22 @@ from __future__ import annotations
 
 import itertools
 import json
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
 
+from armtransfer.ik.tool import parse_held
+from armtransfer.models import ARMS
 from armtransfer.tasks.catalog import TABLE_I, parse_xy, world_task
+from armtransfer.tasks.grid_robots import GRID_ROBOTS
+from armtransfer.tasks.specs import CUSTOM
 from armtransfer.worlds.files import layout_data
 from armtransfer.worlds.resolve import is_default, layout_of_data
+from armtransfer.worlds.layout import ROOMS
 from armtransfer.worlds.resolve import world as resolve_world
 from armtransfer.errors import ArmTransferError
-from armtransfer.io import read_input
+from armtransfer.io import parse_toml_bytes, read_input
 from armtransfer.tasks.arms import ARM_NAME, ARM_NAME_FORM
 from armtransfer.learning import methods as _methods
 from armtransfer.learning.method import MAX_K
@@ -144,8 +150,6 @@ ARM_KEYS: dict[str, type | tuple[type, ...]] = {"xml": str, "tip_site": str, "ti
 
 def _arms(raw: object, where: str, base: Path | None) -> dict:
     """The ``[arms.NAME]`` tables, checked; ``xml`` made absolute (relative to the sweep file)."""
-    import math
-
     if not isinstance(raw, dict):
         raise SweepFileError(f"{where}: arms must be tables [arms.NAME]")
     out = {}
@@ -169,8 +173,6 @@ def _arms(raw: object, where: str, base: Path | None) -> dict:
                     isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in body[key])):
                 raise SweepFileError(f"{w}: {key} must be three finite numbers [X, Y, Z] (metres)")
         if "tool" in body:
-            from armtransfer.ik.tool import parse_held
-
             try:
                 parse_held(body["tool"])
             except ArmTransferError as err:
@@ -187,10 +189,6 @@ def _arms(raw: object, where: str, base: Path | None) -> dict:
 def _check_arm_names(arms: dict, pairs: list, where: str) -> None:
     """Every ``[arms.NAME]`` table is used by a pair, and no NAME is a robot's name already
     (a table named ``fine`` would silently lose to the grid robot)."""
-    from armtransfer.models import ARMS
-    from armtransfer.tasks.grid_robots import GRID_ROBOTS
-    from armtransfer.tasks.specs import CUSTOM
-
     taken = {*GRID_ROBOTS, *ARMS, CUSTOM, "gen"}
     used = {spec.partition(":")[0] for pair in pairs for spec in pair}
     for name in arms:
@@ -296,7 +294,7 @@ def _learners(body: dict, spec: dict, where: str) -> None:
     """``learner`` and ``max_total_steps`` of a sweep file into ``spec``: every learner known
     (a typo lists them), every method run by every learner (else one line naming the learner
     and the methods it runs); ``learner`` stays out of the spec when it is sarsa alone."""
-    from armtransfer.learning import learners
+    from armtransfer.learning import learners  # start-up: the registry loads Gymnasium
 
     names = _as_list("learner", body.get("learner", SARSA))
     if not names or len(names) != len(set(map(str, names))):
@@ -309,7 +307,7 @@ def _learners(body: dict, spec: dict, where: str) -> None:
             raise SweepFileError(f"{where}: unknown learner {name!r}; valid learners: {', '.join(learners.LEARNERS)}")
     outside = [n for n in names if n != SARSA]
     if outside:
-        from armtransfer.experiments.learner_trial import refuse_methods
+        from armtransfer.experiments.learner_trial import refuse_methods  # start-up: Gymnasium, for outside learners
 
         for name in outside:
             try:
@@ -387,8 +385,6 @@ def _world(given: object, where: str, base: Path | None):
 
 def sweep_world(spec_or_run: dict | SweepRun):
     """The world of a normalised spec or one of its runs (the paper's rooms when it names none)."""
-    from armtransfer.worlds.layout import ROOMS
-
     data = spec_or_run.world if isinstance(spec_or_run, SweepRun) else spec_or_run.get("world")
     return ROOMS if data is None else layout_of_data(data, "the sweep's world")
 
@@ -425,7 +421,6 @@ def load(path: str | os.PathLike, max_runs: int = MAX_RUNS) -> Sweep:
     p = Path(path)
     where = f"sweep file {str(p)!r}"
     data = read_input(p, "sweep file", SweepFileError)
-    from armtransfer.io import parse_toml_bytes
 
     try:
         raw = parse_toml_bytes(data)

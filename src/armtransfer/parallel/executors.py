@@ -9,18 +9,22 @@ wait for robot 1's path): they are run too, by the same workers.
 
 from __future__ import annotations
 
+import ipaddress
 import re
 import os
+import socket
 from collections import deque
 from collections.abc import Callable, Sequence
 from typing import Any, cast
 
+from armtransfer.experiments.benchmark_runs import robot_key
 from armtransfer.experiments.execute import execute
 from armtransfer.experiments.run import Run
 from armtransfer.checks import integer_text
 from armtransfer.errors import ArmTransferError
 from armtransfer.cpus import ENV as CPUS_ENV
 from armtransfer.parallel.pool import DONE, Pool
+from armtransfer.parallel.reaper import Reaper, children_of
 from armtransfer.tasks.robot import DiscreteRobot
 
 Done = Callable[[Any, dict, float], "list | None"]  # (run, result, seconds) -> runs it releases
@@ -81,8 +85,6 @@ def _robots_for(runs: Sequence[Run], robots: dict[str, DiscreteRobot]) -> dict[s
     """The robots ``runs`` read, by either key a worker may look them up by: the spec (a sweep's
     robots, resolved in the sweep's one world) and the spec in the run's world (a benchmark's,
     whose cases may each name a world)."""
-    from armtransfer.experiments.benchmark_runs import robot_key
-
     needed = {key for r in runs for spec in (r.source, r.target)
               for key in (spec, robot_key(spec, _world_name(r)))}
     return {k: v for k, v in robots.items() if k in needed}
@@ -96,7 +98,7 @@ def _world_name(run: Run) -> str | None:
 
 def _import_ray():
     try:
-        import ray
+        import ray  # the cluster extra
     except ImportError:
         raise ExecutorError(
             "--executor ray needs Ray: pip install -e \".[cluster]\" (or pip install ray)"
@@ -128,8 +130,6 @@ def check_address(address: object) -> tuple[str, int] | None:
     if not colon or number is None or not 1 <= number <= 65535:
         raise ExecutorError(f"{usage}, with a port 1..65535, got {shown!r}")
     if host.startswith("[") and host.endswith("]"):
-        import ipaddress
-
         try:
             ipaddress.IPv6Address(host[1:-1])
         except ValueError:
@@ -154,8 +154,6 @@ def _check_reachable(address: str) -> None:
     if found is None:
         return
     host, port_number = found
-    import socket
-
     try:
         with socket.create_connection((host, port_number), timeout=RAY_CONNECT_TIMEOUT) as conn:
             answer = _http2_answer(conn)
@@ -215,8 +213,6 @@ def run_ray(
                 _check_reachable(address)
                 ray.init(address=address, log_to_driver=False, configure_logging=False)
             else:  # a local instance: its processes are stopped with the sweep, even a killed one
-                from armtransfer.parallel.reaper import Reaper, children_of
-
                 reaper = Reaper()
                 before = children_of(os.getpid())
                 ray.init(num_cpus=workers or os.cpu_count(), include_dashboard=False,
@@ -267,7 +263,7 @@ class _RobotRefs(dict):
     def __getitem__(self, key):
         value = super().__getitem__(key)
         if not isinstance(value, DiscreteRobot):
-            import ray
+            import ray  # the cluster extra: only a Ray run's robots are references
 
             value = ray.get(value)
             super().__setitem__(key, value)
