@@ -101,11 +101,24 @@ def _plan_pin(plan: benchmark.Plan) -> dict:
             "results": hashlib.sha256(results).hexdigest(), "results_failed": hashlib.sha256(failed).hexdigest()}
 
 
+def _made_suite() -> suites.Suite:
+    """A suite of every kind of case and section a stored suite may hold (never run)."""
+    cases = (suites.Case("coarse", "fine", 1), suites.Case("coarse", "fine", None, wind=0.01, distance=(5, None)),
+             suites.Case("coarse", "planar3:joint", 2, state="continuous", noise=0.0),
+             suites.Case("coarse", "planar3:joint", 2, state="continuous", noise=0.2, world="rooms11"),
+             suites.Case("coarse", "fine", None, start=(0, 0), goal=(-20, -20), cells="even"))
+    sections = (suites.Section("a", "every case", cases, 2, 3, 1000),
+                suites.Section("b", "own learners and methods", cases[:1], 1, 1, 500, ("sarsa", "dqn"), ("pseudo",)),
+                suites.Section("c", "sarsa named", cases[:1], 1, 1, 500, ("sarsa",), ()))
+    return suites.Suite("made", 1, False, "made", sections, methods=("none", "pseudo"))
+
+
 def plan_pins() -> dict:
     out = {}
     ran, missing = benchmark.methods_to_run()
     named = dict(suites.SUITES)
     named["zigzag.toml"] = suite_files.load(ROOT / "examples" / "suites" / "zigzag.toml", suites.SUITES)
+    named["made"] = _made_suite()
     for name, suite in named.items():
         for variant, extra in PLAN_VARIANTS.items():
             if variant != "default" and name not in ("fast", "small"):

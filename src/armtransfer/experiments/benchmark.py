@@ -32,6 +32,7 @@ from armtransfer.experiments import benchmark_runs, engines, experiment, suites
 from armtransfer.learning import methods
 from armtransfer.learning import presets
 from armtransfer.experiments.run import SourceRun, TrialRun
+from armtransfer.experiments.stored_form import fill_in, leave_out
 from armtransfer.experiments.comparisons import GOAL_ONLY as GOAL_ONLY, baseline_of as baseline_of
 from armtransfer.experiments.comparisons import baselines_of as baselines_of
 from armtransfer.experiments.comparisons import registered_baseline as registered_baseline
@@ -50,6 +51,11 @@ DRAWS = 1000
 SOURCE_CONFIG = LearnerConfig()
 """Robot 1 learns with the learner's defaults (its own step cap), whatever a section caps
 robot 2's trials at."""
+
+PLAN_DEFAULTS = {"preset": "default", "learners": None, "quality": SOURCE_CONFIG.quality,
+                 "run_on": SOURCE_CONFIG.run_on}
+"""The fields a plan's stored spec leaves out at these values (``stored_form``): the default
+preset, each section's own learners, the default good-path threshold and run-on budget."""
 
 
 def learner_methods(learner: str, ran: Sequence[str]) -> list[str]:
@@ -347,16 +353,15 @@ class Plan:
         """What the store holding this plan's runs is for (its key is a hash of it)."""
         spec = {"suite": self.suite.to_dict(), "seed": self.seed, "methods": list(self.methods),
                 "not_in_registry": list(self.missing), "formats": list(benchmark_runs.FORMATS),
-                "source_config": SOURCE_CONFIG.to_dict()}
-        if self.preset != "default":  # the default's store keeps the key it had before presets
-            spec["preset"] = self.preset
-        if self.learners is not None:  # each section's own learners: the key it had before learners
-            spec["learners"] = list(self.learners)
-        if self.quality != SOURCE_CONFIG.quality:  # the default's store keeps its key
-            spec["quality"] = self.quality
-        if self.run_on != SOURCE_CONFIG.run_on:
-            spec["run_on"] = self.run_on
-        return {"benchmark": spec}
+                "source_config": SOURCE_CONFIG.to_dict(), "preset": self.preset,
+                "learners": None if self.learners is None else list(self.learners), "quality": self.quality,
+                "run_on": self.run_on}
+        return {"benchmark": leave_out(spec, PLAN_DEFAULTS)}
+
+    @staticmethod
+    def stored_fields(spec: dict) -> dict:
+        """A stored plan's spec (``spec()["benchmark"]``) with every field it leaves out filled in."""
+        return fill_in(spec, PLAN_DEFAULTS)
 
     def size(self) -> int:
         """Runs in all: a source run and every method's trials per pair."""
