@@ -28,6 +28,7 @@ from armtransfer.errors import InvalidParameterError, PluginError
 from armtransfer.experiments import benchmark, learner_trial, suite_files, suites
 from armtransfer.experiments.benchmark_runs import execute_recorded as execute
 from armtransfer.experiments.run import SourceRun, TrialRun
+from armtransfer.experiments.stored_form import leave_out
 from armtransfer.experiments.reports import benchmark_report
 from armtransfer.experiments.stats import benchmark_stats
 from armtransfer.experiments.store import ResultStore, StoreError
@@ -75,10 +76,9 @@ def results_bytes(suite: suites.Suite, seed: int, ran: list[str], missing: list[
                   summary: dict, failures: list[dict] | None = None) -> bytes:
     """results.json's bytes: the same for the same suite, seed and build. ``failures``: the
     records left out because a run of theirs failed (``Plan.failures``), listed when there are."""
-    data = {"suite": suite.to_dict(), "seed": seed, "methods": ran, "not_in_registry": missing,
-            "baselines": {m: list(benchmark.baselines_of(m)) for m in ran}, "records": records, "summary": summary}
-    if failures:  # a whole benchmark keeps the bytes it had before failures were reported
-        data["failed"] = failures
+    data = leave_out({"suite": suite.to_dict(), "seed": seed, "methods": ran, "not_in_registry": missing,
+                      "baselines": {m: list(benchmark.baselines_of(m)) for m in ran}, "records": records,
+                      "summary": summary, "failed": failures or []}, {"failed": []})
     return (json.dumps(data, indent=1, sort_keys=False) + "\n").encode()
 
 

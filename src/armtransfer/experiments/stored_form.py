@@ -18,7 +18,7 @@ import copy
 from collections.abc import Mapping
 from typing import Any
 
-Defaults = Mapping["str | tuple[str, ...]", Any]
+Defaults = Mapping[Any, Any]
 """A kind's defaults: a field's name and its default, or a group's names and their defaults."""
 
 

@@ -107,7 +107,7 @@ discrete target (with no noise); a task or a drawn one (no cells)."""
 SECTION_DEFAULTS = {"learners": DEFAULT_LEARNERS, "methods": None}
 """The fields a stored section leaves out at these values: the built-in learner alone; every method."""
 
-SUITE_DEFAULTS = {"worlds": {}}
+SUITE_DEFAULTS: dict[str, dict] = {"worlds": {}}
 """The fields a stored suite leaves out at these values: no layout file's world."""
 
 

@@ -288,8 +288,8 @@ def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, ba
 _OPTIONAL = ("world", "learner", "max_total_steps")
 """Keys a sweep file may give beside the axes and scalars."""
 
-SPEC_DEFAULTS = {"preset": _presets.DEFAULT, "world": None, "learner": [SARSA], "learner_options": {},
-                 "max_total_steps": None}
+SPEC_DEFAULTS: dict[str, object] = {"preset": _presets.DEFAULT, "world": None, "learner": [SARSA],
+                                    "learner_options": {}, "max_total_steps": None}
 """The fields a stored spec leaves out at these values (``stored_form``): a sweep of the default
 preset, the paper's rooms, sarsa alone, learners without settings and the preset's step cap."""
 
