@@ -146,3 +146,29 @@ def test_stored_specs_keep_their_bytes_and_keys():
 
 if __name__ == "__main__" and sys.argv[1:] == ["--write"]:
     PINS.write_text(json.dumps(pins(), indent=1, sort_keys=True) + "\n")
+
+
+def test_each_defaults_table_is_what_reading_fills_in():
+    """A stored suite is read back through its dataclasses (``suite_files.from_dict``), a plan
+    through ``Plan.stored_fields``, a sweep spec through ``spec_fields``: each table's defaults are
+    the values reading gives a field left out, and a group is left out only whole."""
+    import dataclasses
+
+    from armtransfer.experiments import suite_model
+    from armtransfer.experiments.stored_form import fill_in, leave_out
+
+    for kind, table in ((suites.Case, suite_model.CASE_DEFAULTS), (suites.Section, suite_model.SECTION_DEFAULTS),
+                        (suites.Suite, suite_model.SUITE_DEFAULTS)):
+        fields = {f.name: f.default if f.default is not dataclasses.MISSING else f.default_factory()  # type: ignore[misc]
+                  for f in dataclasses.fields(kind)
+                  if f.default is not dataclasses.MISSING or f.default_factory is not dataclasses.MISSING}
+        for names, defaults in table.items():
+            names, defaults = ((names,), (defaults,)) if isinstance(names, str) else (names, defaults)
+            assert [fields[n] for n in names] == list(defaults), (kind, names)
+    case = dataclasses.asdict(suites.Case("coarse", "planar3:joint", 2, state="continuous", noise=0.0))
+    assert leave_out(case, suite_model.CASE_DEFAULTS)["noise"] == 0.0  # a continuous case keeps its noise
+    assert fill_in(leave_out(case, suite_model.CASE_DEFAULTS), suite_model.CASE_DEFAULTS) == case
+    stored = sweeps.normalise({"sweep": {"tasks": [1]}})
+    assert set(sweeps.SPEC_DEFAULTS).isdisjoint(stored)
+    assert sweeps.spec_fields(stored) == {**stored, **sweeps.SPEC_DEFAULTS}
+    assert benchmark.Plan.stored_fields({}) == benchmark.PLAN_DEFAULTS

@@ -33,6 +33,7 @@ from armtransfer.learning import methods
 from armtransfer.learning import presets
 from armtransfer.experiments.run import SourceRun, TrialRun
 from armtransfer.experiments.stored_form import fill_in, leave_out
+from armtransfer.experiments.suite_model import CASE_DEFAULTS
 from armtransfer.experiments.comparisons import GOAL_ONLY as GOAL_ONLY, baseline_of as baseline_of
 from armtransfer.experiments.comparisons import baselines_of as baselines_of
 from armtransfer.experiments.comparisons import registered_baseline as registered_baseline
@@ -56,6 +57,9 @@ PLAN_DEFAULTS = {"preset": "default", "learners": None, "quality": SOURCE_CONFIG
                  "run_on": SOURCE_CONFIG.run_on}
 """The fields a plan's stored spec leaves out at these values (``stored_form``): the default
 preset, each section's own learners, the default good-path threshold and run-on budget."""
+
+RECORD_DEFAULTS = {"learner": benchmark_runs.LEARNER}
+"""The fields a record leaves out at these values: the built-in learner."""
 
 
 def learner_methods(learner: str, ran: Sequence[str]) -> list[str]:
@@ -255,8 +259,8 @@ class Pair:
                 "source_steps": None if traj is None else len(traj["cells"]),
                 "source_failure": source_result["failure"], "optimal": self.optimal,
                 "cap": self.section.max_total_steps, "budget": suites.BUDGET_FACTOR * self.optimal,
-                **({} if self.case.world == suites.DEFAULT_WORLD else {"world": self.case.world}),
-                **({} if self.case.state == "discrete" else {"state": self.case.state, "noise": self.case.noise})}
+                **leave_out({"world": self.case.world, "state": self.case.state, "noise": self.case.noise},
+                            CASE_DEFAULTS)}
 
 
 def record(pair: Pair, name: str, source_result: dict, trials: list[dict], ran: Sequence[str] | None = None) -> dict:
@@ -268,8 +272,7 @@ def record(pair: Pair, name: str, source_result: dict, trials: list[dict], ran: 
     method, learner = parse_label(name)
     if source_result["trajectory"] is None and benchmark_runs.needs_trajectory(method):
         rec["told_nothing"] = benchmark_runs.told_nothing(method)
-    if learner != benchmark_runs.LEARNER:  # the built-in learner's records keep their bytes
-        rec["learner"] = learner
+    rec["learner"] = learner
     n = len(trials)
     errors = [t["error"] for t in trials if t["error"] is not None]
     if errors:
@@ -277,7 +280,7 @@ def record(pair: Pair, name: str, source_result: dict, trials: list[dict], ran: 
         rec.update(first_exposure=[None] * n, converged=[False] * n, convergence_steps=[None] * n,
                    greedy_steps=[None] * n, episodes=[0] * n, area=[None] * n, curves=[],
                    **{name: [None] * n for name in benchmark_runs.CLOCK_FIELDS})
-        return rec
+        return leave_out(rec, RECORD_DEFAULTS)
     said = list(dict.fromkeys(w for t in trials for w in t.get("warnings") or ()))
     if said:  # a potential of one's own that was squashed, constant or not 0 at the goal
         rec["warnings"] = said
@@ -288,7 +291,7 @@ def record(pair: Pair, name: str, source_result: dict, trials: list[dict], ran: 
     notes = sorted({t["clock_note"] for t in trials if t.get("clock_note")})
     if notes:
         rec["clock_note"] = notes[0]
-    return rec
+    return leave_out(rec, RECORD_DEFAULTS)
 
 
 @dataclass(frozen=True)
