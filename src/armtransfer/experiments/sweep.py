@@ -104,7 +104,7 @@ class SweepFileError(ArmTransferError):
 class Sweep:
     name: str
     spec: dict
-    """The normalised sweep (every key present, lists everywhere)."""
+    """The normalised sweep (lists everywhere; the keys at their ``SPEC_DEFAULTS`` left out)."""
     runs: tuple[SweepRun, ...]
 
     @property
@@ -204,8 +204,8 @@ def _check_arm_names(arms: dict, pairs: list, where: str) -> None:
 
 
 def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, base: Path | None = None) -> dict:
-    """Validate a parsed sweep file; returns the spec with every key filled in (``base``: the
-    folder that relative arm files are found in)."""
+    """Validate a parsed sweep file; returns the spec in its stored form, every key filled in but
+    those at their :data:`SPEC_DEFAULTS` (``base``: the folder that relative arm files are found in)."""
     if not set(raw) <= {"sweep", "arms"} or not isinstance(raw.get("sweep"), dict):
         extra = sorted(set(raw) - {"sweep", "arms"})
         what = f"unknown table {extra[0]!r}" if extra else "missing the [sweep] table"
