@@ -28,6 +28,7 @@ from armtransfer.errors import InvalidParameterError, PluginError
 from armtransfer.experiments import benchmark, learner_trial, suite_files, suites
 from armtransfer.experiments.benchmark_runs import execute_recorded as execute
 from armtransfer.experiments.run import SourceRun, TrialRun
+from armtransfer.experiments.stored_form import leave_out
 from armtransfer.experiments.reports import benchmark_report
 from armtransfer.experiments.stats import benchmark_stats
 from armtransfer.experiments.store import ResultStore, StoreError
@@ -75,10 +76,9 @@ def results_bytes(suite: suites.Suite, seed: int, ran: list[str], missing: list[
                   summary: dict, failures: list[dict] | None = None) -> bytes:
     """results.json's bytes: the same for the same suite, seed and build. ``failures``: the
     records left out because a run of theirs failed (``Plan.failures``), listed when there are."""
-    data = {"suite": suite.to_dict(), "seed": seed, "methods": ran, "not_in_registry": missing,
-            "baselines": {m: list(benchmark.baselines_of(m)) for m in ran}, "records": records, "summary": summary}
-    if failures:  # a whole benchmark keeps the bytes it had before failures were reported
-        data["failed"] = failures
+    data = leave_out({"suite": suite.to_dict(), "seed": seed, "methods": ran, "not_in_registry": missing,
+                      "baselines": {m: list(benchmark.baselines_of(m)) for m in ran}, "records": records,
+                      "summary": summary, "failed": failures or []}, {"failed": []})
     return (json.dumps(data, indent=1, sort_keys=False) + "\n").encode()
 
 
@@ -263,7 +263,7 @@ def write_report_files(out: Path, suite: suites.Suite, seed: int, ran: list[str]
 def plan_of(store: ResultStore) -> benchmark.Plan:
     """The plan of a benchmark store, made again by this build; a store of a suite this build
     defines otherwise (another version) or does not have is a one-line error."""
-    spec = store.meta["spec"]["benchmark"]
+    spec = benchmark.Plan.stored_fields(store.meta["spec"]["benchmark"])
     try:
         suite = suite_files.from_dict(spec["suite"], f"{str(store.root)!r}")
     except Exception:  # noqa: BLE001 - any malformed spec is the same one-line refusal
@@ -273,8 +273,8 @@ def plan_of(store: ResultStore) -> benchmark.Plan:
         raise StoreError(f"{str(store.root)!r} holds the seed {str(seed)[:40]}, which no benchmark takes (--seed is an "
                          f"integer 0..{MAX_COUNT}); it was not written by armtransfer")
     plan = benchmark.plan(suite, seed, ran=spec["methods"], missing=spec["not_in_registry"],
-                          preset=spec.get("preset", "default"), learners=spec.get("learners"),
-                          quality=spec.get("quality"), run_on=spec.get("run_on"))
+                          preset=spec["preset"], learners=spec["learners"], quality=spec["quality"],
+                          run_on=spec["run_on"])
     if content_key(plan.spec()) != store.meta.get("key") or (suite.name in suites.SUITES and not suites.is_builtin(suite)):
         raise StoreError(f"{str(store.root)!r} holds a benchmark of suite {suite.name!r} as another build defined "
                          "it (its version, methods or learner settings differ); rebuild it with that build")

@@ -33,6 +33,8 @@ from armtransfer.learning import methods
 from armtransfer.learning import presets
 from armtransfer.experiments.learner_trial import reward_methods
 from armtransfer.experiments.run import SourceRun, TrialRun
+from armtransfer.experiments.stored_form import fill_in, leave_out
+from armtransfer.experiments.suite_model import CASE_DEFAULTS
 from armtransfer.experiments.comparisons import GOAL_ONLY as GOAL_ONLY, baseline_of as baseline_of
 from armtransfer.experiments.comparisons import baselines_of as baselines_of
 from armtransfer.experiments.comparisons import registered_baseline as registered_baseline
@@ -57,6 +59,14 @@ DRAWS = 1000
 SOURCE_CONFIG = LearnerConfig()
 """Robot 1 learns with the learner's defaults (its own step cap), whatever a section caps
 robot 2's trials at."""
+
+PLAN_DEFAULTS = {"preset": "default", "learners": None, "quality": SOURCE_CONFIG.quality,
+                 "run_on": SOURCE_CONFIG.run_on}
+"""The fields a plan's stored spec leaves out at these values (``stored_form``): the default
+preset, each section's own learners, the default good-path threshold and run-on budget."""
+
+RECORD_DEFAULTS = {"learner": benchmark_runs.LEARNER}
+"""The fields a record leaves out at these values: the built-in learner."""
 
 
 def learner_methods(learner: str, ran: Sequence[str]) -> list[str]:
@@ -244,8 +254,8 @@ class Pair:
                 "source_steps": None if traj is None else len(traj["cells"]),
                 "source_failure": source_result["failure"], "optimal": self.optimal,
                 "cap": self.section.max_total_steps, "budget": suites.BUDGET_FACTOR * self.optimal,
-                **({} if self.case.world == suites.DEFAULT_WORLD else {"world": self.case.world}),
-                **({} if self.case.state == "discrete" else {"state": self.case.state, "noise": self.case.noise})}
+                **leave_out({"world": self.case.world, "state": self.case.state, "noise": self.case.noise},
+                            CASE_DEFAULTS)}
 
 
 def record(pair: Pair, name: str, source_result: dict, trials: list[dict], ran: Sequence[str] | None = None) -> dict:
@@ -257,8 +267,7 @@ def record(pair: Pair, name: str, source_result: dict, trials: list[dict], ran: 
     method, learner = parse_label(name)
     if source_result["trajectory"] is None and benchmark_runs.needs_trajectory(method):
         rec["told_nothing"] = benchmark_runs.told_nothing(method)
-    if learner != benchmark_runs.LEARNER:  # the built-in learner's records keep their bytes
-        rec["learner"] = learner
+    rec["learner"] = learner
     n = len(trials)
     errors = [t["error"] for t in trials if t["error"] is not None]
     if errors:
@@ -266,7 +275,7 @@ def record(pair: Pair, name: str, source_result: dict, trials: list[dict], ran: 
         rec.update(first_exposure=[None] * n, converged=[False] * n, convergence_steps=[None] * n,
                    greedy_steps=[None] * n, episodes=[0] * n, area=[None] * n, curves=[],
                    **{name: [None] * n for name in benchmark_runs.CLOCK_FIELDS})
-        return rec
+        return leave_out(rec, RECORD_DEFAULTS)
     said = list(dict.fromkeys(w for t in trials for w in t.get("warnings") or ()))
     if said:  # a potential of one's own that was squashed, constant or not 0 at the goal
         rec["warnings"] = said
@@ -277,7 +286,7 @@ def record(pair: Pair, name: str, source_result: dict, trials: list[dict], ran: 
     notes = sorted({t["clock_note"] for t in trials if t.get("clock_note")})
     if notes:
         rec["clock_note"] = notes[0]
-    return rec
+    return leave_out(rec, RECORD_DEFAULTS)
 
 
 @dataclass(frozen=True)
@@ -340,16 +349,15 @@ class Plan:
         """What the store holding this plan's runs is for (its key is a hash of it)."""
         spec = {"suite": self.suite.to_dict(), "seed": self.seed, "methods": list(self.methods),
                 "not_in_registry": list(self.missing), "formats": list(benchmark_runs.FORMATS),
-                "source_config": SOURCE_CONFIG.to_dict()}
-        if self.preset != "default":  # the default's store keeps the key it had before presets
-            spec["preset"] = self.preset
-        if self.learners is not None:  # each section's own learners: the key it had before learners
-            spec["learners"] = list(self.learners)
-        if self.quality != SOURCE_CONFIG.quality:  # the default's store keeps its key
-            spec["quality"] = self.quality
-        if self.run_on != SOURCE_CONFIG.run_on:
-            spec["run_on"] = self.run_on
-        return {"benchmark": spec}
+                "source_config": SOURCE_CONFIG.to_dict(), "preset": self.preset,
+                "learners": None if self.learners is None else list(self.learners), "quality": self.quality,
+                "run_on": self.run_on}
+        return {"benchmark": leave_out(spec, PLAN_DEFAULTS)}
+
+    @staticmethod
+    def stored_fields(spec: dict) -> dict:
+        """A stored plan's spec (``spec()["benchmark"]``) with every field it leaves out filled in."""
+        return fill_in(spec, PLAN_DEFAULTS)
 
     def size(self) -> int:
         """Runs in all: a source run and every method's trials per pair."""

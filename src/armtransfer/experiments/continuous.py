@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 import armtransfer.checks as checks
 from armtransfer.errors import InvalidParameterError
 from armtransfer.experiments.experiment import MethodResult, summarize, trial_rng
+from armtransfer.experiments.stored_form import leave_out
 from armtransfer.experiments import frames, tables
 from armtransfer.learning import cells, linear
 from armtransfer.learning.config import LearnerConfig
@@ -70,8 +71,8 @@ class Approximation:
         return linear.LinearConfig(self.traces, self.greedy_cap)
 
     def to_json(self) -> dict:
-        hashed = {"table_bits": self.table_bits} if self.table_bits else {}  # the dense runs' JSON is as it was
-        return {"tilings": self.tilings, "tile_width_steps": self.width, "traces": self.traces, **hashed}
+        return leave_out({"tilings": self.tilings, "tile_width_steps": self.width, "traces": self.traces,
+                          "table_bits": self.table_bits}, {"table_bits": 0})  # dense tiles: none
 
 
 def approximation_for(arm) -> Approximation:
@@ -146,13 +147,14 @@ class ContinuousResult:
     def to_json(self) -> dict:
         summary = summarize(list(self.methods.values()), baseline="none" if "none" in self.methods else "")
         t = self.task
-        world = {} if is_default(t.layout) else {"world": world_name(t.layout)}  # the rooms' JSON is as it was
-        return {"state": "continuous", "task": {"name": t.name, "start": list(t.start), "goal": list(t.goal)},
-                **world, "source": self.source, "target": self.target,
+        return leave_out({
+                "state": "continuous", "task": {"name": t.name, "start": list(t.start), "goal": list(t.goal)},
+                "world": None if is_default(t.layout) else world_name(t.layout), "source": self.source,
+                "target": self.target,
                 "trajectories": [tr.to_json(t.layout) for tr in self.trajectories], "seed": self.seed, "trials": self.trials,
                 "config": self.config.to_dict(),
                 "approximation": self.approximation.to_json(),
-                "results": {m: summary[r.label] for m, r in self.methods.items()}}
+                "results": {m: summary[r.label] for m, r in self.methods.items()}}, {"world": None})
 
     def _rows(self, out: dict) -> list[list[str]]:
         """The table of :meth:`__repr__` and :meth:`_repr_html_`: a header, then per method its

@@ -69,19 +69,12 @@ def matrix_spec(robots: Sequence[str], tasks: Sequence[int | str], methods: Sequ
     methods = with_baselines(["none", *methods])
     if len(methods) < 2:
         raise InvalidParameterError("a matrix needs a transfer method beside 'none'")
-    raw = {"sweep": {"name": name, "tasks": list(tasks), "pairs": [[s, t] for s in robots for t in robots],
-                     "methods": methods, "seeds": list(seeds), "trials": trials, "trajectory": trajectory}}
-    if preset != "default":  # the default's spec (and its store's key) is the one it was before presets
-        raw["sweep"]["preset"] = preset
-    if arms:
-        raw["arms"] = arms
-    if world is not None:
-        raw["sweep"]["world"] = world
-    if list(learners) != [SARSA]:  # sarsa alone: the spec (and its store's key) it was before learners
-        raw["sweep"]["learner"] = list(learners)
-    if max_total_steps is not None:
-        raw["sweep"]["max_total_steps"] = max_total_steps
-    return sweeps.normalise(raw, where="matrix")
+    body = {"name": name, "tasks": list(tasks), "pairs": [[s, t] for s in robots for t in robots],
+            "methods": methods, "seeds": list(seeds), "trials": trials, "trajectory": trajectory, "preset": preset,
+            "learner": list(learners)}
+    given = {"world": world, "max_total_steps": max_total_steps}  # None: not given (the sweep's default)
+    body.update({key: value for key, value in given.items() if value is not None})
+    return sweeps.normalise({"sweep": body, "arms": arms or {}}, where="matrix")
 
 
 def matrix_sweep(robots: Sequence[str], tasks: Sequence[int | str], methods: Sequence[str], trials: int,

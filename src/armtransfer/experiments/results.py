@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 
 from armtransfer.experiments import frames, tables
 from armtransfer.experiments.experiment import MethodResult, summary_of
+from armtransfer.experiments.stored_form import leave_out
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.mapping import ActionMapping
 from armtransfer.learning.trajectory import Trajectory
@@ -27,6 +28,9 @@ from armtransfer.worlds.resolve import is_default, world_name
 
 if TYPE_CHECKING:
     import pandas as pd
+
+JSON_DEFAULTS = {"world": None, "learner": "sarsa"}
+"""The fields a result's JSON leaves out at these values (``stored_form``): the paper's rooms, sarsa."""
 
 
 @dataclass(frozen=True)
@@ -133,10 +137,9 @@ class TransferResult:
         summary = self._summary()
         t = self.task
         layout = self.target.layout
-        world = {} if is_default(layout) else {"world": world_name(layout)}  # the rooms' JSON is as it was
-        return {
+        return leave_out({
             "task": {"name": t.name, "start": list(t.start), "goal": list(t.goal)},
-            **world,
+            "world": None if is_default(layout) else world_name(layout),
             "distance": self.distance,
             "source": self.source.name,
             "target": self.target.name,
@@ -147,8 +150,8 @@ class TransferResult:
             "trials": self.trials,
             "wind": self.wind,
             "config": self.config.to_dict(),
-            **({} if self.learner == "sarsa" else {"learner": self.learner}),  # sarsa's JSON is as it was
+            "learner": self.learner,
             "mapping": None if self.mapping is None else self.mapping.to_json(),
             "results": {m: summary[r.label] for m, r in self.methods.items()},
             "controls": {kind: {m: summary[r.label] for m, r in by.items()} for kind, by in self.controls.items()},
-        }
+        }, JSON_DEFAULTS)

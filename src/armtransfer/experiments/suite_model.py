@@ -15,6 +15,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 
 from armtransfer.errors import InvalidParameterError
+from armtransfer.experiments.stored_form import leave_out
 from armtransfer.worlds.resolve import layout_of_data
 
 METHODS = ("none", "pseudo", "dense", "guided", "plan", "goal-only", "pseudo-plan", "corridor")
@@ -99,6 +100,16 @@ class Case:
 
 DEFAULT_LEARNERS = ("sarsa",)
 
+CASE_DEFAULTS = {"world": DEFAULT_WORLD, ("state", "noise"): ("discrete", 0.0), ("start", "goal"): (None, None)}
+"""The fields a stored case leaves out at these values (``stored_form``): the paper's rooms; a
+discrete target (with no noise); a task or a drawn one (no cells)."""
+
+SECTION_DEFAULTS = {"learners": DEFAULT_LEARNERS, "methods": None}
+"""The fields a stored section leaves out at these values: the built-in learner alone; every method."""
+
+SUITE_DEFAULTS: dict[str, dict] = {"worlds": {}}
+"""The fields a stored suite leaves out at these values: no layout file's world."""
+
 
 @dataclass(frozen=True)
 class Section:
@@ -119,24 +130,14 @@ class Section:
     None: all of them."""
 
     def to_dict(self) -> dict:
-        """The section as stored and reported; the default learners are left out, so a suite that
-        runs the built-in learner alone keeps the store key and the bytes it had before."""
+        """The section as stored and reported, its cases' and its own fields at their defaults
+        (:data:`CASE_DEFAULTS`, :data:`SECTION_DEFAULTS`) left out."""
         out = asdict(self)
-        for case in out["cases"]:  # a case of the default world keeps the bytes it had before worlds
-            if case["world"] == DEFAULT_WORLD:
-                del case["world"]
-            if case["state"] == "discrete":  # a discrete case keeps the bytes it had before states
-                del case["state"], case["noise"]
-            if case["start"] is None:  # a case of a task or drawn one keeps the bytes it had before cells
-                del case["start"], case["goal"]
-        if self.learners == DEFAULT_LEARNERS:
-            del out["learners"]
-        else:
-            out["learners"] = list(self.learners)
-        if self.methods is None:  # every method: the bytes a section had before sections chose
-            del out["methods"]
-        else:
-            out["methods"] = list(self.methods)
+        out["cases"] = tuple(leave_out(case, CASE_DEFAULTS) for case in out["cases"])
+        out = leave_out(out, SECTION_DEFAULTS)
+        for name in ("learners", "methods"):
+            if name in out:
+                out[name] = list(out[name])
         return out
 
 
@@ -156,10 +157,9 @@ class Suite:
     def to_dict(self) -> dict:
         out = {"name": self.name, "version": self.version, "held_out": self.held_out,
                "description": self.description, "methods": list(METHODS if self.methods is None else self.methods),
-               "budget_factor": BUDGET_FACTOR, "sections": [s.to_dict() for s in self.sections]}
-        if self.worlds:  # a suite on built-in worlds keeps the bytes it had before suite files
-            out["worlds"] = {k: self.worlds[k] for k in sorted(self.worlds)}
-        return out
+               "budget_factor": BUDGET_FACTOR, "sections": [s.to_dict() for s in self.sections],
+               "worlds": {k: self.worlds[k] for k in sorted(self.worlds)}}
+        return leave_out(out, SUITE_DEFAULTS)
 
     def layouts(self) -> dict:
         """The worlds of :attr:`worlds`, by id (``worlds.layout.Layout``)."""

@@ -75,6 +75,7 @@ from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.lazy_registry import Names
 from armtransfer.learning.learner_names import SARSA
 from armtransfer.experiments.run import SWEEP_FORMAT, SweepRun, content_key as content_key
+from armtransfer.experiments.stored_form import fill_in, leave_out
 
 RUN_FORMAT = SWEEP_FORMAT
 METHODS = Names(_methods.METHODS, lambda name, m: not m.macros)
@@ -109,7 +110,7 @@ class SweepFileError(ArmTransferError):
 class Sweep:
     name: str
     spec: dict
-    """The normalised sweep (every key present, lists everywhere)."""
+    """The normalised sweep (lists everywhere; the keys at their ``SPEC_DEFAULTS`` left out)."""
     runs: tuple[SweepRun, ...]
 
     @property
@@ -201,8 +202,8 @@ def _check_arm_names(arms: dict, pairs: list, where: str) -> None:
 
 
 def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, base: Path | None = None) -> dict:
-    """Validate a parsed sweep file; returns the spec with every key filled in (``base``: the
-    folder that relative arm files are found in)."""
+    """Validate a parsed sweep file; returns the spec in its stored form, every key filled in but
+    those at their :data:`SPEC_DEFAULTS` (``base``: the folder that relative arm files are found in)."""
     if not set(raw) <= {"sweep", "arms"} or not isinstance(raw.get("sweep"), dict):
         extra = sorted(set(raw) - {"sweep", "arms"})
         what = f"unknown table {extra[0]!r}" if extra else "missing the [sweep] table"
@@ -223,8 +224,6 @@ def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, ba
         spec[key] = body.get(key, chosen[key] if key in _FROM_PRESET else default)
     for key, default in _AXES.items():
         spec[key] = _as_list(key, body[key]) if key in body else ([chosen[key]] if key in _FROM_PRESET else list(default))
-    if preset == _presets.DEFAULT:
-        del spec["preset"]  # a sweep without a preset keeps the spec (and its store's key) it had before presets
     w = where
     if not isinstance(spec["name"], str) or not spec["name"]:
         raise SweepFileError(f"{w}: name must be a non-empty string")
@@ -234,8 +233,7 @@ def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, ba
     if spec["trajectory"] not in ("optimal", "learned"):
         raise SweepFileError(f"{w}: trajectory must be 'optimal' or 'learned', got {spec['trajectory']!r}")
     layout = _world(body.get("world"), w, base)
-    if layout is not None:
-        spec["world"] = layout_data(layout)
+    spec["world"] = None if layout is None else layout_data(layout)
     names = [t[0] for t in layout.tasks] if layout is not None else None
     for t in spec["tasks"]:
         if names is not None:
@@ -282,18 +280,27 @@ def normalise(raw: dict, where: str = "sweep file", max_runs: int = MAX_RUNS, ba
     if n > max_runs:
         raise SweepFileError(f"{w}: the sweep has {n:,} runs, over the limit of {max_runs:,}; "
                              "raise it with --max-runs")
-    return spec
+    return leave_out(spec, SPEC_DEFAULTS)
 
 
 _OPTIONAL = ("world", "learner", "max_total_steps")
-"""Keys a sweep file may give that its spec holds only when given (or, for ``learner``, when not
-the default): a sweep without them keeps the spec, and its store the key, it had before them."""
+"""Keys a sweep file may give beside the axes and scalars."""
+
+SPEC_DEFAULTS: dict[str, object] = {"preset": _presets.DEFAULT, "world": None, "learner": [SARSA],
+                                    "learner_options": {}, "max_total_steps": None}
+"""The fields a stored spec leaves out at these values (``stored_form``): a sweep of the default
+preset, the paper's rooms, sarsa alone, learners without settings and the preset's step cap."""
+
+
+def spec_fields(spec: dict) -> dict:
+    """A stored (normalised) spec with every field it leaves out filled in at its default."""
+    return fill_in(spec, SPEC_DEFAULTS)
 
 
 def _learners(body: dict, spec: dict, where: str) -> None:
     """``learner`` and ``max_total_steps`` of a sweep file into ``spec``: every learner known
     (a typo lists them), every method run by every learner (else one line naming the learner
-    and the methods it runs); ``learner`` stays out of the spec when it is sarsa alone."""
+    and the methods it runs)."""
     from armtransfer.learning import learners  # start-up: the registry loads Gymnasium
 
     names = _as_list("learner", body.get("learner", SARSA))
@@ -314,20 +321,16 @@ def _learners(body: dict, spec: dict, where: str) -> None:
                 refuse_methods(learners.LEARNERS[name], spec["methods"])
             except ArmTransferError as err:
                 raise SweepFileError(f"{where}: {err}") from None
-    if names != [SARSA]:
-        spec["learner"] = names
-    options = {n: learners.options_of(n) for n in outside if learners.options_of(n)}
-    if options:  # a learner's own settings key its runs and the store (a learner without them: the keys it had)
-        spec["learner_options"] = options
-    if "max_total_steps" in body:
-        spec["max_total_steps"] = _check_number(f"{where}: max_total_steps", body["max_total_steps"], 1,
-                                                LearnerConfig.__dataclass_fields__["max_total_steps"].metadata["hi"],
-                                                integer=True)
+    spec["learner"] = names
+    spec["learner_options"] = {n: learners.options_of(n) for n in outside if learners.options_of(n)}
+    spec["max_total_steps"] = None if "max_total_steps" not in body else _check_number(
+        f"{where}: max_total_steps", body["max_total_steps"], 1,
+        LearnerConfig.__dataclass_fields__["max_total_steps"].metadata["hi"], integer=True)
 
 
 def learners_of(spec: dict) -> list[str]:
     """The learners of a normalised spec (sarsa when it names none)."""
-    return list(spec.get("learner", [SARSA]))
+    return list(spec_fields(spec)["learner"])
 
 
 def check_stored(spec: object, where: str) -> dict:
@@ -336,7 +339,7 @@ def check_stored(spec: object, where: str) -> dict:
     form; else ``SweepFileError``, one line naming ``where`` and the field."""
     if not isinstance(spec, dict):
         raise SweepFileError(f"{where}: field 'spec' " + ("is missing" if spec is None else f"must be a table, got {type(spec).__name__}"))
-    optional = {*_OPTIONAL, "preset", "learner_options"}  # written only when not the default (the old key)
+    optional = set(SPEC_DEFAULTS)  # written only when not the default
     keys = {*_SCALARS, *_AXES, "arms"} - optional
     for key in sorted(keys - set(spec)):
         raise SweepFileError(f"{where}: field 'spec' has no {key!r}")
@@ -385,13 +388,14 @@ def _world(given: object, where: str, base: Path | None):
 
 def sweep_world(spec_or_run: dict | SweepRun):
     """The world of a normalised spec or one of its runs (the paper's rooms when it names none)."""
-    data = spec_or_run.world if isinstance(spec_or_run, SweepRun) else spec_or_run.get("world")
+    data = spec_or_run.world if isinstance(spec_or_run, SweepRun) else spec_fields(spec_or_run)["world"]
     return ROOMS if data is None else layout_of_data(data, "the sweep's world")
 
 
 def expand(spec: dict) -> list[SweepRun]:
     """Every run of the sweep, in a fixed order (a run ``none`` shares with every K once)."""
-    if spec.get("world") is None:
+    spec = spec_fields(spec)
+    if spec["world"] is None:
         tasks = [{"task": t, "start": list(TABLE_I[t].start), "goal": list(TABLE_I[t].goal)} for t in spec["tasks"]]
     else:
         layout = sweep_world(spec)
@@ -403,14 +407,14 @@ def expand(spec: dict) -> list[SweepRun]:
         learners_of(spec), tasks, spec["pairs"], spec["methods"], spec["seeds"], spec["K"], spec["epsilon"],
         spec["lam"], spec["alpha"], spec["gamma"], spec["wind"],
     ):
-        used = {p.partition(":")[0] for p in pair} & set(spec.get("arms", {}))
+        used = {p.partition(":")[0] for p in pair} & set(spec["arms"])
         run = SweepRun(
-            world=spec.get("world"), **task, source=pair[0], target=pair[1], method=method, seed=seed,
+            world=spec["world"], **task, source=pair[0], target=pair[1], method=method, seed=seed,
             trials=spec["trials"], trajectory=spec["trajectory"], K=None if method == "none" else K, epsilon=eps,
             lam=lam, alpha=alpha, gamma=gamma, wind=wind, patience=spec["patience"],
-            max_episodes=spec["max_episodes"], preset=spec.get("preset", _presets.DEFAULT),
-            max_total_steps=spec.get("max_total_steps"), learner=learner,
-            learner_options=spec.get("learner_options", {}).get(learner),
+            max_episodes=spec["max_episodes"], preset=spec["preset"],
+            max_total_steps=spec["max_total_steps"], learner=learner,
+            learner_options=spec["learner_options"].get(learner),
             arms={name: spec["arms"][name] for name in sorted(used)},  # a named arm's definition keys the run
         )
         runs.setdefault(run.key(), run)
