@@ -315,7 +315,7 @@ def test_ray_tasks_get_the_robots_of_a_case_in_another_world(monkeypatch):
     of such a run is handed them (it used to look them up by the bare spec, a KeyError)."""
     from armtransfer.parallel import executors
 
-    monkeypatch.setattr(executors, "_import_ray", lambda: _InlineRay())
+    monkeypatch.setattr(executors, "import_ray", lambda: _InlineRay())
     robots = {"coarse in rooms11": grid_robot("coarse"), "fine in rooms11": grid_robot("fine"),
               "fine": grid_robot("fine")}
     runs = [types.SimpleNamespace(source="coarse", target="fine", world="rooms11", key=lambda: "k0")]

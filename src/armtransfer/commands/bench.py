@@ -16,7 +16,7 @@ from armtransfer.commands.common import (add_world_argument, non_negative_int, o
 from armtransfer.experiments import learner_trial
 from armtransfer.experiments.stored_form import leave_out
 from armtransfer.io import check_writable, write_json_atomic
-from armtransfer.learning import reference, sarsa
+from armtransfer.learning import plugin_calls, reference, sarsa
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning.learners import BUILTIN, get
 from armtransfer.registration import MAX_EPISODE_STEPS
@@ -91,10 +91,10 @@ def measure_learner(name: str, steps: int, seed: int, layout: Layout = ROOMS) ->
     env = learner_trial.Monitor(gym.wrappers.TimeLimit(learner_trial.case_env(robot, start, goal, 0.0, config),
                                                        max_episode_steps=MAX_EPISODE_STEPS), said)
     env.reset(seed=seed)
-    model = learner_trial._call(said, "make", learner.make, env, seed,
+    model = plugin_calls.call(said, "make", learner.make, env, seed,
                                 *learner_trial.handed(learner, "none", robot, None, None))
     t0 = time.perf_counter()
-    learner_trial._call(said, "learn", model.learn, steps)
+    plugin_calls.call(said, "learn", model.learn, steps)
     return env.total, time.perf_counter() - t0
 
 

@@ -37,7 +37,7 @@ from armtransfer.io import check_writable, write_bytes_atomic, write_json_atomic
 from armtransfer.learning import methods
 from armtransfer.learning.learners import BUILTIN, LEARNERS, RUN_TIME, get, parse
 from armtransfer.learning.methods import probe_on, refuse_run_time
-from armtransfer.parallel.executors import _check_reachable, _import_ray, run_local, run_ray
+from armtransfer.parallel.executors import check_reachable, import_ray, run_local, run_ray
 
 HELP = "Compare every method with the baselines that share its learner on a fixed suite, over many source seeds."
 EXAMPLE = "armtransfer benchmark --suite fast --out runs/bench-fast"
@@ -90,9 +90,9 @@ def run(args: argparse.Namespace) -> int:
         f"benchmark-{suite.name}-%Y%m%d-%H%M%S")
     check_writable(out / "sweep.json")  # a name too long, a file in the way: before any arm is compiled
     if args.executor == "ray":
-        _import_ray()  # say how to install Ray before anything is written
+        import_ray()  # say how to install Ray before anything is written
         if args.address:
-            _check_reachable(args.address)
+            check_reachable(args.address)
     wanted = suite.methods
     if not suites.is_builtin(suite) and all(s.methods is not None for s in suite.sections):
         # a suite file's methods: those its sections name (a section may name its own)

@@ -11,7 +11,7 @@ from armtransfer.experiments import learner_trial
 from armtransfer.experiments.execute import robot_specs
 from armtransfer.experiments.run import SweepRun
 from armtransfer.tasks.catalog import custom_task
-from armtransfer.parallel.executors import ExecutorError, _check_reachable, check_address, _import_ray, run_local, run_ray
+from armtransfer.parallel.executors import ExecutorError, check_reachable, check_address, import_ray, run_local, run_ray
 from armtransfer.tasks.specs import resolve
 from armtransfer.experiments import sweep as sweeps
 from armtransfer.experiments.store import ResultStore
@@ -65,9 +65,9 @@ def run_sweep(sweep: sweeps.Sweep, args: argparse.Namespace) -> int:
     checked (every robot built, every task's cells checked for both robots) before anything
     is written. The caller has checked the executor options (:func:`check_executor_options`)."""
     if args.executor == "ray":
-        _import_ray()  # say how to install Ray before anything is written
+        import_ray()  # say how to install Ray before anything is written
         if args.address:
-            _check_reachable(args.address)
+            check_reachable(args.address)
     robots = check_runs(list(sweep.runs), getattr(args, "probe_timeout", 60.0))
     store = ResultStore.open_for(args.out, sweep)
     try:

@@ -1,6 +1,6 @@
 """An episode of the linear learner on the continuous arm, compiled whole: the arm's move
 (``ik.fastmove.move``, MuJoCo called from numba) and the learner's update
-(``learning.linear._update``) in one loop, with no Python per step.
+(``learning.linear.td_step``) in one loop, with no Python per step.
 
 :func:`episode_steps` gives ``learning.linear.learn`` its ``steps_by``: the same steps as
 ``learn``'s own loop, in the same order, with the same draws (the uniforms are refilled from the
@@ -36,7 +36,7 @@ def _run(arm, w, q, lower, width, offsets, dims, strides, per_tiling, table, fea
         if label2 < 0:
             label2 = label
         steps += 1
-        a, best = linear._update(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa,
+        a, best = linear.td_step(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa,
                                  tr_e, pos, p, c, u, bonus, traj_index, phi, paid, a, label, label2, goal, best)
         if label2 == goal:
             return REACHED, a, label2, best, steps
@@ -57,7 +57,7 @@ def _run3d(arm, w, q, lower, width, offsets, dims, strides, per_tiling, table, f
         if label2 < 0:
             label2 = label
         steps += 1
-        a, best = linear._update(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa,
+        a, best = linear.td_step(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa,
                                  tr_e, pos, p, c, u, bonus, traj_index, phi, paid, a, label, label2, goal, best)
         if label2 == goal:
             return REACHED, a, label2, best, steps
@@ -72,7 +72,7 @@ def episode_steps(arm) -> linear.EpisodeSteps | None:
         return None
     kernel = _run3d if hasattr(arm, "vox") else _run
 
-    def run(L: linear._Learner, a: int, label: int, best: float, limit: int, goal: int) -> tuple[int, int, float, bool]:
+    def run(L: linear.Learner, a: int, label: int, best: float, limit: int, goal: int) -> tuple[int, int, float, bool]:
         steps = 0
         bonus, traj_index, phi, paid = L.rewards
         while True:
@@ -94,7 +94,7 @@ def episode_steps(arm) -> linear.EpisodeSteps | None:
             steps += 1
             if L.c[linear.I_U] > L.low:
                 L.refill()
-            a, best = linear._update(L.w, arm.q, *L.coding, L.feats, L.qrow, L.tr_sa, L.tr_e, L.pos, L.p, L.c, L.u,
+            a, best = linear.td_step(L.w, arm.q, *L.coding, L.feats, L.qrow, L.tr_sa, L.tr_e, L.pos, L.p, L.c, L.u,
                                      bonus, traj_index, phi, paid, a, label, label2, goal, best)
             if label2 == goal:
                 return steps, a, best, True

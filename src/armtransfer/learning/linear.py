@@ -83,7 +83,7 @@ DRAWS_PER_STEP = 2
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def _draw(u, c):
-    """The next uniform of the trial's stream (``u`` refilled by :class:`_Learner` as it runs low)."""
+    """The next uniform of the trial's stream (``u`` refilled by :class:`Learner` as it runs low)."""
     i = c[I_U]
     c[I_U] = i + 1
     return u[i]
@@ -138,7 +138,7 @@ def _greedy(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats
 
 
 @numba.njit(cache=True, nogil=True)
-def _update(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa, tr_e, pos, p, c, u,
+def td_step(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa, tr_e, pos, p, c, u,
             bonus, traj_index, phi, paid_stamp, a, label, label2, goal, best):
     """One step of Algorithm 1 after action ``a`` took the robot from a state labelled
     ``label`` (features ``feats[0]``) to one labelled ``label2`` at configuration ``q``: the
@@ -196,7 +196,7 @@ class LinearConfig:
             raise InvalidParameterError(f"greedy_cap must be an integer of at least 2, got {self.greedy_cap!r}")
 
 
-class _Learner:
+class Learner:
     """The arrays of one trial, and the kernel calls on them (the arguments in the kernels' order)."""
 
     def __init__(self, coding: TileCoding, n_actions: int, config: LearnerConfig, linear: LinearConfig,
@@ -234,7 +234,7 @@ class _Learner:
         return _greedy(self.w, q, *self.coding, self.feats, self.qrow)
 
 
-EpisodeSteps = Callable[["_Learner", int, int, float, int, int], tuple[int, int, float, bool]]
+EpisodeSteps = Callable[["Learner", int, int, float, int, int], tuple[int, int, float, bool]]
 """Runs an episode's steps: (learner, a, label, best, limit, goal) -> (steps, a, best, reached),
 exactly as :func:`learn`'s own loop (``experiments.fastloop``: compiled, with the arm's move)."""
 
@@ -251,7 +251,7 @@ def learn(mover: Mover, goal: int, coding: TileCoding, config: LearnerConfig, rn
     sh = shaping if shaping is not None else Shaping.none(1)
     if sh.guide is not None:
         raise InvalidParameterError("the linear learner has no guide: its methods are reward terms only")
-    L = _Learner(coding, mover.n_actions, config, linear, sh, rng)
+    L = Learner(coding, mover.n_actions, config, linear, sh, rng)
     w, (lower, width, offsets, dims, strides, per_tiling, table), feats, qrow = L.w, L.coding, L.feats, L.qrow
     tr_sa, tr_e, pos, p, c, u, low = L.tr_sa, L.tr_e, L.pos, L.p, L.c, L.u, L.low
     bonus, traj_index, phi, paid = L.rewards
@@ -284,7 +284,7 @@ def learn(mover: Mover, goal: int, coding: TileCoding, config: LearnerConfig, rn
             steps += 1
             if c[I_U] > low:
                 L.refill()
-            a, best = _update(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa, tr_e, pos,
+            a, best = td_step(w, q, lower, width, offsets, dims, strides, per_tiling, table, feats, qrow, tr_sa, tr_e, pos,
                               p, c, u, bonus, traj_index, phi, paid, a, label, label2, goal, best)
             if label2 == goal:
                 reached = True
@@ -322,7 +322,7 @@ def learn(mover: Mover, goal: int, coding: TileCoding, config: LearnerConfig, rn
     )
 
 
-def _greedy_path(mover: Mover, learner: _Learner, goal: int, cap: int) -> tuple[list, bool]:
+def _greedy_path(mover: Mover, learner: Learner, goal: int, cap: int) -> tuple[list, bool]:
     """The greedy path from the start: (the states' keys, whether it reached the goal). It
     stops at the goal, at a state visited before, or after ``cap`` states (without noise, when
     the robot has ``noiseless()``)."""
@@ -333,7 +333,7 @@ def _greedy_path(mover: Mover, learner: _Learner, goal: int, cap: int) -> tuple[
     return _greedy_path_of(mover, learner, goal, cap)
 
 
-def _greedy_path_of(mover: Mover, learner: _Learner, goal: int, cap: int) -> tuple[list, bool]:
+def _greedy_path_of(mover: Mover, learner: Learner, goal: int, cap: int) -> tuple[list, bool]:
     move = getattr(mover, "fast_step", mover.move)  # an arm's compiled move: the same moves, faster
     label = mover.reset()
     key = mover.key()
@@ -354,5 +354,5 @@ def _greedy_path_of(mover: Mover, learner: _Learner, goal: int, cap: int) -> tup
         seen.add(key)
 
 
-_jitcache.invalidate_stale(__name__, [_draw, _egreedy, _values, _begin, _greedy, _update],
+_jitcache.invalidate_stale(__name__, [_draw, _egreedy, _values, _begin, _greedy, td_step],
                            [_tiles.__file__, _traces.__file__, _sarsa.__file__])

@@ -96,7 +96,7 @@ def _world_name(run: Run) -> str | None:
     return world if isinstance(world, str) else None
 
 
-def _import_ray():
+def import_ray():
     try:
         import ray  # the cluster extra
     except ImportError:
@@ -146,7 +146,7 @@ def check_address(address: object) -> tuple[str, int] | None:
     return host, number
 
 
-def _check_reachable(address: str) -> None:
+def check_reachable(address: str) -> None:
     """Fail in one line within ``RAY_CONNECT_TIMEOUT`` when nothing answers at ``address``
     (``host:port`` or ``ray://host:port``, checked first by :func:`check_address`); ``ray.init``
     alone would retry for minutes."""
@@ -204,13 +204,13 @@ def run_ray(
     each running ``fn(run, robots)``.
 
     Each robot is put in Ray's object store once and shared by every task that needs it."""
-    ray = _import_ray()
+    ray = import_ray()
     started_here = False
     reaper = None
     if not ray.is_initialized():
         try:
             if address:
-                _check_reachable(address)
+                check_reachable(address)
                 ray.init(address=address, log_to_driver=False, configure_logging=False)
             else:  # a local instance: its processes are stopped with the sweep, even a killed one
                 reaper = Reaper()
