@@ -11,19 +11,19 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_the_built_in_learner_has_an_engine_for_either_state_and_an_outside_one_for_a_table():
-    assert engines.engine_of("sarsa") == engines.TABULAR
-    assert engines.engine_of("sarsa", "continuous") == engines.CONTINUOUS
-    assert engines.engine_of("dqn", "discrete") == engines.OUTSIDE
+    assert engines.engine_for("sarsa").name == engines.TABULAR
+    assert engines.engine_for("sarsa", "continuous").name == engines.CONTINUOUS
+    assert engines.engine_for("dqn", "discrete").name == engines.OUTSIDE
     assert set(engines.ENGINES) == {engines.TABULAR, engines.CONTINUOUS, engines.OUTSIDE}
 
 
 def test_a_pairing_no_engine_runs_is_one_line_naming_the_valid_ones():
     with pytest.raises(InvalidParameterError) as err:
-        engines.engine_of("dqn", "continuous", "case 3 has")
+        engines.engine_for("dqn", "continuous", "case 3 has")
     text = str(err.value)
     assert "\n" not in text and "'dqn'" in text and "case 3 has a continuous one" in text and text.endswith("sarsa")
     with pytest.raises(InvalidParameterError, match="unknown state 'voxel'; valid states: discrete, continuous"):
-        engines.engine_of("sarsa", "voxel")
+        engines.engine_for("sarsa", "voxel")
 
 
 def test_no_driver_makes_its_own_choice_of_engine():
@@ -36,7 +36,7 @@ def test_no_driver_makes_its_own_choice_of_engine():
     assert holders == ["experiments/engines.py"]
     for path in ("api.py", "experiments/benchmark.py", "experiments/benchmark_runs.py", "experiments/execute.py"):
         text = (src / path).read_text()
-        assert "engines.engine_of(" in text or "engines.engine_for(" in text, path
+        assert "engines.engine_for(" in text, path
     for path in ("experiments/benchmark_runs.py", "experiments/execute.py"):
         text = (src / path).read_text()
         assert ".trials(work_of(run)" in text and "run_method(" not in text, path

@@ -455,7 +455,7 @@ def plan(suite: suites.Suite, seed: int = 0, robots: Robots | None = None,
         outside = [lr for lr in (section.learners if learners is None else learners) if lr != benchmark_runs.LEARNER]
         for ci, case in enumerate(section.cases):
             for lr in outside:
-                engines.engine_of(lr, case.state, f"{case.label} has")
+                engines.engine_for(lr, case.state, f"{case.label} has")
             source, target = robots(case.source, case.world), robots(case.target, case.world)
             arm, placed = None, set()
             if case.state != "discrete":  # a continuous target: its arm, placed over every start before anything runs

@@ -6,8 +6,8 @@ table of states (``learning.sarsa``); ``continuous``, the linear SARSA(lambda) l
 coding on the arm's joint configuration (``learning.linear``); and ``outside``, a learner of the
 registry from outside the package, on the target's Gymnasium environment through the harness
 (``experiments.learner_trial``). ``armtransfer.transfer``, the benchmark's trial runs and sweep
-runs (so the matrix) describe what to learn as a :class:`Work`, ask :func:`engine_for` (or
-:func:`engine_of`, its name) for the engine, and call its :meth:`Engine.trials`, which returns
+runs (so the matrix) describe what to learn as a :class:`Work`, ask :func:`engine_for` for the
+engine, and call its :meth:`Engine.trials`, which returns
 the one result type, ``experiment.MethodResult``. A pairing no engine runs is refused by the
 engine, in one line (:meth:`Engine.accepts`).
 """
@@ -155,8 +155,3 @@ def engine_for(learner: str, state: str = "discrete", subject: str = "the target
         engine = _BY_NAME[OUTSIDE]
     engine.accepts(learner, state, subject)
     return engine
-
-
-def engine_of(learner: str, state: str = "discrete", subject: str = "the target is") -> str:
-    """The name of :func:`engine_for`'s engine (:data:`ENGINES`)."""
-    return engine_for(learner, state, subject).name
