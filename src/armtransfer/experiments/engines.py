@@ -20,6 +20,7 @@ from collections.abc import Sequence
 from armtransfer.errors import ArmTransferError, InvalidParameterError
 from armtransfer.experiments import experiment
 from armtransfer.experiments.experiment import MethodResult
+from armtransfer.experiments.run import STATES as STATES
 from armtransfer.experiments.work import Work as Work
 from armtransfer.learning.learner_names import SARSA
 from armtransfer.learning.potentials import DENSE_BETA
@@ -31,8 +32,6 @@ CONTINUOUS = "continuous"
 OUTSIDE = "outside"
 ENGINES = (TABULAR, CONTINUOUS, OUTSIDE)
 
-STATES = ("discrete", "continuous")
-"""How the target robot's state is known: its table of states, or its joint configuration."""
 
 
 class Engine(ABC):

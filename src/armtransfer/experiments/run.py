@@ -29,6 +29,7 @@ from armtransfer.errors import ArmTransferError
 from armtransfer.learning.config import LearnerConfig
 from armtransfer.learning import presets
 from armtransfer.learning.learner_names import SARSA
+from armtransfer.worlds.resolve import DEFAULT_WORLD as DEFAULT_WORLD  # the world a run names when it names none
 
 SCHEMA = 1
 """The schema version of the runs this build writes (version 1: implied, not hashed)."""
@@ -43,8 +44,6 @@ STATES = ("discrete", "continuous")
 TRAJECTORY_KINDS = ("optimal", "learned")
 """The trajectory a sweep run's robot 1 hands over: its shortest path, or its learned greedy path."""
 
-DEFAULT_WORLD = "rooms"
-"""The world a benchmark run names when it names none (the paper's rooms)."""
 
 
 class RunError(ArmTransferError):

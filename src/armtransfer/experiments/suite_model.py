@@ -16,7 +16,8 @@ from dataclasses import asdict, dataclass, field
 
 from armtransfer.errors import InvalidParameterError
 from armtransfer.experiments.stored_form import leave_out
-from armtransfer.worlds.resolve import layout_of_data
+from armtransfer.experiments.run import STATES as STATES  # discrete (its table) or continuous (an arm's joints)
+from armtransfer.worlds.resolve import DEFAULT_WORLD as DEFAULT_WORLD, layout_of_data
 
 METHODS = ("none", "pseudo", "dense", "guided", "plan", "goal-only", "pseudo-plan", "corridor")
 """The methods every suite runs (those this build's registry has), each beside its baseline."""
@@ -35,13 +36,6 @@ CELLS = ("any", "even", "odd")
 cells every parameter of this package was chosen on, ``research/select_defaults.py``), ``odd``
 (at least one coordinate odd: cells no choice ever saw) or ``any``."""
 
-
-DEFAULT_WORLD = "rooms"
-
-STATES = ("discrete", "continuous")
-"""What robot 2's state is in a case: ``discrete`` (its compiled table, learned by the tabular
-SARSA(lambda)) or ``continuous`` (an arm's joint configuration with MuJoCo at every move, learned
-by the linear learner over tile coding: ``armtransfer.transfer(..., state="continuous")``'s)."""
 
 
 @dataclass(frozen=True)
